@@ -1,0 +1,58 @@
+/* iterate.cl: the escape-time iteration and the distance estimate.
+ *
+ * A point p is inside when |q_n| <= bailout for n = 0 .. max_iter, with q_0 = p and
+ * q_{n+1} = f(q_n) (seed 003: "none of the vectors in the sequence escapes";
+ * seed 000 §2.1, eq. 5). */
+
+inline int julia_inside(real4 p, julia_params jp)
+{
+    real4 q = p;
+    for (int n = 0; n < jp.max_iter; ++n) {
+        if (dot(q, q) > jp.bailout2)
+            return 0;
+        q = julia_f(q, jp.c);
+    }
+    return dot(q, q) <= jp.bailout2;
+}
+
+/* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (seed 001 §3.1, eq. 8)
+ * evaluated at the last iterate, whether or not it escaped.  The derivative is
+ * carried squared, so the loop needs no sqrt: |q'_{n+1}|^2 = 4 |q_n|^2 |q'_n|^2, and
+ * d = sqrt(m2 / dm2) ln(m2) / 4.  Where |q'| would overflow, it is carried as a
+ * mantissa times 2^e (ldexp), so the estimate stays finite at any max_iter.
+ * Sets *escaped.  This is the smooth field the gradient normal differentiates. */
+inline real julia_distance_formula(real4 p, julia_params jp, int *escaped)
+{
+    real4 q = p;
+    real m2 = dot(q, q);
+    real dm2 = (real)1;
+    int e = 0;                      /* dm2 is really dm2 * 2^e */
+    int n = 0;
+    for (; n < jp.max_iter; ++n) {
+        if (m2 > jp.bailout2)
+            break;
+        dm2 *= JULIA_DF2(m2);
+        if (dm2 > (real)1e16) {     /* rescale long before float32 overflows (3e38) */
+            int k;
+            dm2 = frexp(dm2, &k);
+            e += k;
+        }
+        q = julia_f(q, jp.c);
+        m2 = dot(q, q);
+    }
+    *escaped = m2 > jp.bailout2;
+    /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
+    real mq = fmax(m2, REAL_MIN);
+    real ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
+    if (e & 1)
+        ratio *= (real)0.70710678118654752;
+    return ratio * log(mq) / ((real)2 * JULIA_DEGREE);
+}
+
+/* The distance estimate the march steps by: 0 inside (the point never escaped). */
+inline real julia_distance(real4 p, julia_params jp)
+{
+    int escaped;
+    real d = julia_distance_formula(p, jp, &escaped);
+    return escaped ? d : (real)0;
+}

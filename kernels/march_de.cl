@@ -1,0 +1,37 @@
+/* march_de.cl: distance-estimate marching (seed 001 §3.2, eq. 9):
+ *     r_{n+1} = r_n + m max(d(r_n), epsilon),
+ * a hit when d < epsilon (which adds thickness to thin dendrites, seed 001 §3.3).
+ * The march starts at the bounding sphere (seed 001 §3.4 avoids bad estimates far
+ * away) and is capped at max_steps estimates; a ray that runs into the cap is
+ * reported as STATUS_CAPPED, never left running. */
+
+inline int hit_test(real4 p, julia_params jp) { return julia_distance(p, jp) < jp.epsilon; }
+
+inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
+                      int z_resolution, int post_steps, int max_steps, int *status, int *samples)
+{
+    real t = near;
+    real t_prev = near;
+    for (int i = 0; i < max_steps; ++i) {
+        if (t > far) {
+            *samples = i;
+            *status = STATUS_MISS;
+            return INFINITY;
+        }
+        real dist = julia_distance(o + t * d, jp);
+        if (dist < jp.epsilon) {
+            *samples = i + 1;
+            *status = STATUS_HIT;
+#ifdef POST_STEP
+            if (i > 0)
+                return post_step(o, d, t, t - t_prev, post_steps, jp);
+#endif
+            return t;
+        }
+        t_prev = t;
+        t += fmax(dist, jp.epsilon);
+    }
+    *samples = max_steps;
+    *status = STATUS_CAPPED;
+    return INFINITY;
+}

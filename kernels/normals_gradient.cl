@@ -1,0 +1,34 @@
+/* normals_gradient.cl: central-difference gradient of the distance estimate
+ * (seed 001 §4.1.2, eq. 15, the 6-point gradient; seed 004 "method 1"), taken
+ * along the camera's right, up and forward axes so the result is already the
+ * normal of the 3D section the rays see.  It differences the estimate formula
+ * without the "0 inside" clamp, which is continuous across the surface. */
+
+inline real de_field(real4 p, julia_params jp)
+{
+    int escaped;
+    return julia_distance_formula(p, jp, &escaped);
+}
+
+inline real4 normal_gradient(real4 p, julia_params jp, real h, real4 right, real4 up, real4 forward)
+{
+    return (real4)(de_field(p + h * right, jp) - de_field(p - h * right, jp),
+                   de_field(p + h * up, jp) - de_field(p - h * up, jp),
+                   de_field(p - h * forward, jp) - de_field(p + h * forward, jp), 0);
+}
+
+__kernel void normals_gradient(__global const real4 *point, __global const int *status,
+                               const real4 c, const int max_iter, const real bailout,
+                               const real h, const real4 right, const real4 up,
+                               const real4 forward, __global real4 *normal)
+{
+    size_t i = get_global_id(0);
+    if (status[i] != STATUS_HIT) {
+        normal[i] = (real4)(0);
+        return;
+    }
+    julia_params jp = { c, bailout * bailout, 0, max_iter };
+    real4 n = normal_gradient(point[i], jp, h, right, up, forward);
+    real l = length(n);
+    normal[i] = l > (real)0 && isfinite(l) ? n / l : (real4)(0);
+}

@@ -1,0 +1,63 @@
+/* normals_zbuffer.cl: normals from Z-buffer neighbours (seed 000 §5.1, eqs. 7-9;
+ * seed 001 §4.1.1, eqs. 12-14): the normal of the plane through the hit point and
+ * its neighbours' hit points, in camera coordinates.  Of the two neighbours along
+ * each image axis the one with the smaller depth jump is used (a one-sided
+ * difference, as in seed 001), so silhouettes do not tilt the normal; an axis with
+ * no neighbour hit falls back to the image axis itself. */
+
+inline real3 cam_point(__global const real4 *point, size_t i, real4 eye,
+                       real4 right, real4 up, real4 forward)
+{
+    real4 v = point[i] - eye;
+    return (real3)(dot(v, right), dot(v, up), -dot(v, forward));
+}
+
+/* Tangent along one image axis: neighbour a (step -1) or b (step +1), the one
+ * whose depth is closer to ours; returned as the +1 direction. */
+inline real3 zb_tangent(__global const real4 *point, __global const real *depth,
+                        __global const int *status, size_t i, size_t ia, size_t ib,
+                        int has_a, int has_b, real3 p, real3 axis,
+                        real4 eye, real4 right, real4 up, real4 forward)
+{
+    int ok_a = has_a && status[ia] == STATUS_HIT;
+    int ok_b = has_b && status[ib] == STATUS_HIT;
+    if (ok_a && ok_b) {
+        if (fabs(depth[ia] - depth[i]) < fabs(depth[ib] - depth[i]))
+            ok_b = 0;
+        else
+            ok_a = 0;
+    }
+    if (ok_b)
+        return cam_point(point, ib, eye, right, up, forward) - p;
+    if (ok_a)
+        return p - cam_point(point, ia, eye, right, up, forward);
+    return axis;
+}
+
+__kernel void normals_zbuffer(__global const real4 *point, __global const real *depth,
+                              __global const int *status, const int width, const int height,
+                              const real4 eye, const real4 right, const real4 up,
+                              const real4 forward, __global real4 *normal)
+{
+    int x = get_global_id(0);
+    int y = get_global_id(1);
+    size_t i = (size_t)y * width + x;
+    if (status[i] != STATUS_HIT) {
+        normal[i] = (real4)(0);
+        return;
+    }
+    real3 p = cam_point(point, i, eye, right, up, forward);
+    /* +x is right; +y in the image is down, so "up" is row y - 1 */
+    real3 tx = zb_tangent(point, depth, status, i, i - 1, i + 1, x > 0, x < width - 1, p,
+                          (real3)(1, 0, 0), eye, right, up, forward);
+    real3 ty = zb_tangent(point, depth, status, i, i + width, i - width, y < height - 1, y > 0, p,
+                          (real3)(0, 1, 0), eye, right, up, forward);
+    real3 n = cross(tx, ty);
+    real3 view = -p;                          /* towards the eye */
+    if (dot(n, view) < (real)0)
+        n = -n;
+    real l = length(n);
+    if (!(l > (real)0) || !isfinite(l))
+        n = view, l = length(view);
+    normal[i] = (real4)(n / l, 0);
+}

@@ -1,0 +1,30 @@
+/* real.cl: the scalar and vector types every kernel piece is written in.
+ * -D REAL_DOUBLE builds the double-precision variant (needs cl_khr_fp64);
+ * the default is float, which is what GPUs run fast. */
+#ifdef REAL_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double real;
+typedef double4 real4;
+typedef double3 real3;
+#define REAL_MAX DBL_MAX
+#define REAL_MIN DBL_MIN
+#else
+typedef float real;
+typedef float4 real4;
+typedef float3 real3;
+#define REAL_MAX FLT_MAX
+#define REAL_MIN FLT_MIN
+#endif
+
+/* The scene's fractal constants, passed by value to every piece. */
+typedef struct {
+    real4 c;         /* Julia constant */
+    real bailout2;   /* escape radius squared */
+    real epsilon;    /* distance-estimate hit threshold */
+    int max_iter;
+} julia_params;
+
+/* Pixel status codes written by the march kernel (mirrored in reference.py). */
+#define STATUS_MISS 0
+#define STATUS_HIT 1
+#define STATUS_CAPPED 2   /* the step cap ended the march before a hit or the far plane */

@@ -1,0 +1,38 @@
+/* shade.cl: Lambert diffuse with the light at the eye by default, so every visible
+ * point is lit (seed 001 §4), or at a positioned light (-D LIGHT_POINT); Blinn-Phong
+ * specular (-D SPECULAR; seed 000 §5.2); ambient; background colour on a miss.
+ *     rgb = light_color (color (ambient + diffuse max(n.l, 0)) + specular max(n.h, 0)^shininess)
+ * All vectors in camera coordinates; output is float RGBA whatever the precision. */
+
+__kernel void shade(__global const int *status, __global const real4 *normal,
+                    __global const real4 *point, const real4 eye, const real4 right,
+                    const real4 up, const real4 forward, const real4 light_pos,
+                    const float4 color, const float4 background, const float4 light_color,
+                    const float ambient, const float diffuse, const float specular,
+                    const float shininess, __global float4 *rgba)
+{
+    size_t i = get_global_id(0);
+    if (status[i] != STATUS_HIT) {
+        rgba[i] = (float4)(background.xyz, 0.0f);
+        return;
+    }
+    real4 pv = point[i] - eye;
+    float3 p = normalize((float3)(dot(pv, right), dot(pv, up), -dot(pv, forward)));
+    float3 n = (float3)(normal[i].x, normal[i].y, normal[i].z);
+    float3 v = -p;                                   /* towards the eye */
+#ifdef LIGHT_POINT
+    real4 lv = light_pos - point[i];
+    float3 l = normalize((float3)(dot(lv, right), dot(lv, up), -dot(lv, forward)));
+#else
+    float3 l = v;
+#endif
+    float lambert = fmax(dot(n, l), 0.0f);
+    float3 rgb = color.xyz * (ambient + diffuse * lambert);
+#ifdef SPECULAR
+    if (lambert > 0.0f) {
+        float3 hv = normalize(l + v);
+        rgb += specular * pow(fmax(dot(n, hv), 0.0f), shininess);
+    }
+#endif
+    rgba[i] = (float4)(rgb * light_color.xyz, 1.0f);
+}

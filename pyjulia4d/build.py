@@ -1,0 +1,76 @@
+"""Assemble and build the OpenCL program a scene needs.
+
+A scene compiles only the pieces it uses (the way Mandelbulber2 stitches only the
+formula files a scene uses): one .cl file per concern, concatenated in data-flow
+order, with -D switches for the optional terms.  Built programs are cached per
+(context, pieces, switches).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pyopencl as cl
+
+from .resources import kernel_dir
+from .scene import Scene
+
+
+@dataclass(frozen=True)
+class KernelConfig:
+    """What to compile: the pieces (file stems, in order) and the -D switches."""
+    pieces: tuple[str, ...]
+    defines: tuple[str, ...] = ()
+
+
+def iteration_pieces(scene: Scene) -> tuple[str, ...]:
+    f = scene.fractal
+    return ("real", f"algebra_{f.algebra}", f"function_{f.function}", "iterate")
+
+
+def precision_defines(scene: Scene) -> tuple[str, ...]:
+    return ("REAL_DOUBLE",) if scene.render.float == "double" else ()
+
+
+def scene_config(scene: Scene) -> KernelConfig:
+    """The pieces and switches of one scene's render program."""
+    m = scene.march
+    pieces = list(iteration_pieces(scene))
+    defines = list(precision_defines(scene))
+    if m.post_steps > 0:
+        pieces.append("post_step")
+        defines.append("POST_STEP")
+    pieces += [f"march_{m.method}", "march", "rays", f"normals_{scene.normals.method}", "shade"]
+    if scene.shading.specular > 0:
+        defines.append("SPECULAR")
+    if not isinstance(scene.shading.light, str):
+        defines.append("LIGHT_POINT")
+    return KernelConfig(tuple(pieces), tuple(defines))
+
+
+def probe_config(scene: Scene) -> KernelConfig:
+    """The iteration alone, wrapped for the tests (kernels/probe.cl)."""
+    return KernelConfig(iteration_pieces(scene) + ("probe",), precision_defines(scene))
+
+
+def source(config: KernelConfig) -> str:
+    """Concatenated source; #line keeps compiler messages pointing at the .cl file."""
+    d = kernel_dir()
+    parts = []
+    for name in config.pieces:
+        path = d / f"{name}.cl"
+        parts.append(f'#line 1 "{name}.cl"\n' + path.read_text())
+    return "\n".join(parts)
+
+
+_programs: dict[tuple, cl.Program] = {}
+
+
+def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
+    """Build (once per context and configuration) and return the program."""
+    key = (ctx.int_ptr, config)
+    prg = _programs.get(key)
+    if prg is None:
+        opts = [f"-D{d}" for d in config.defines]
+        prg = cl.Program(ctx, source(config)).build(options=opts)
+        _programs[key] = prg
+    return prg

@@ -1,0 +1,130 @@
+"""The 4D camera frame, the slice transform and the bounding sphere.
+
+Host-side set-up only (a handful of 4-vectors per scene); the per-pixel ray
+generation is the kernel ``generate_rays`` in kernels/rays.cl and its twin
+``reference.generate_rays``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .scene import Scene, SceneError
+
+
+def cross4(a, b, c) -> np.ndarray:
+    """The 4D cross product of seed 000_1dc675fe64448cc1.txt §4: a vector
+    perpendicular to a, b and c (the signed cofactors of the 3x4 matrix [a; b; c])."""
+    a1, a2, a3, a4 = a
+    b1, b2, b3, b4 = b
+    c1, c2, c3, c4 = c
+    return np.array([
+        a2 * (b4 * c3 - b3 * c4) + b2 * (a3 * c4 - a4 * c3) + c2 * (a4 * b3 - a3 * b4),
+        a1 * (b3 * c4 - b4 * c3) + b1 * (a4 * c3 - a3 * c4) + c1 * (a3 * b4 - a4 * b3),
+        a1 * (b4 * c2 - b2 * c4) + b1 * (a2 * c4 - a4 * c2) + c1 * (a4 * b2 - a2 * b4),
+        a1 * (b2 * c3 - b3 * c2) + b1 * (a3 * c2 - a2 * c3) + c1 * (a2 * b3 - a3 * b2),
+    ])
+
+
+def slice_rotation(normal) -> np.ndarray:
+    """The rotation R with R e_w = n/|n| that turns in the plane of e_w and n only.
+
+    Camera coordinates are mapped to the world by p = R p_cam + distance n/|n|, so a
+    3D camera (w = 0, limbo = e_w) looks into the hyperplane n.p = distance: POV-Ray's
+    slice (seed 003_8ca5f9108f52d3d6.txt).  Unlike POV-Ray, which keeps x, y, z and
+    solves for w, this map is an isometry: the section is seen undistorted and a
+    normal with zero w-component is allowed.
+    """
+    n = np.asarray(normal, float)
+    n = n / np.linalg.norm(n)
+    e = np.array([0.0, 0.0, 0.0, 1.0])
+    cos = float(n @ e)
+    if 1.0 + cos < 1e-12:  # n = -e_w: flip w only; x, y, z (the view) are unchanged
+        return np.diag([1.0, 1.0, 1.0, -1.0])
+    k = np.outer(n, e) - np.outer(e, n)  # generator of the rotation in span(e, n)
+    return np.eye(4) + k + (k @ k) / (1.0 + cos)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """World-space pinhole camera: every ray starts at position, looks along
+    normalize(forward + u right + v up)."""
+    position: np.ndarray
+    forward: np.ndarray
+    right: np.ndarray
+    up: np.ndarray
+    tan_half_fov: float
+
+
+def _unit(v: np.ndarray, key: str, what: str) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    if not n > 1e-9 or not math.isfinite(n):
+        raise SceneError(key, what)
+    return v / n
+
+
+def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
+    """Camera/light coordinates -> world: R p (+ distance n/|n| for positions)."""
+    r = slice_rotation(scene.slice.normal)
+    v = r @ np.asarray(p, float)
+    if not direction:
+        n = np.asarray(scene.slice.normal, float)
+        v = v + scene.slice.distance * n / np.linalg.norm(n)
+    return v
+
+
+def camera_frame(scene: Scene) -> Frame:
+    """Orthonormal frame of seed 000 §4: forward from position to target; limbo and up
+    made orthogonal to it (Gram-Schmidt); right = 4Dcross(forward, up, limbo), so the
+    image plane is perpendicular to limbo.  limbo = e_w with w = 0 everywhere drops the
+    fourth dimension; any other choice makes the rays travel in w."""
+    cam = scene.camera
+    pos = to_world(scene, cam.position)
+    fwd = _unit(to_world(scene, cam.target) - pos, "camera.target", "equals camera.position")
+    limbo = to_world(scene, cam.limbo, direction=True)
+    limbo = _unit(limbo - (limbo @ fwd) * fwd, "camera.limbo", "parallel to the view direction")
+    up = to_world(scene, cam.up, direction=True)
+    up = up - (up @ fwd) * fwd - (up @ limbo) * limbo
+    up = _unit(up, "camera.up", "parallel to the view direction or to camera.limbo")
+    right = cross4(fwd, up, limbo)
+    right /= np.linalg.norm(right)
+    return Frame(pos, fwd, right, up, math.tan(math.radians(cam.fov) / 2.0))
+
+
+def light_position(scene: Scene) -> np.ndarray | None:
+    """World position of the positioned light, or None for the light at the eye."""
+    if isinstance(scene.shading.light, str):
+        return None
+    return to_world(scene, scene.shading.light)
+
+
+def bounding_radius(c, bailout: float, max_iter: int) -> float:
+    """Radius of a 4-ball that provably holds every point with |q_n| <= bailout for
+    n = 0..max_iter (the set the fixed scan finds).
+
+    With R = 1/2 + sqrt(1/4 + |c|), |q| = r > R gives |q^2 + c| >= r^2 - |c| > r, so
+    |q_n| >= g^n(r), g(r) = r^2 - |c|.  A point that stays within the bailout b after N
+    steps therefore has |q_0| <= g^-N(b) = h^N(b), h(s) = sqrt(s + |c|), and also
+    |q_0| <= b.  The bound shrinks from b towards R as N grows.
+    """
+    cabs = float(np.linalg.norm(c))
+    s = float(bailout)
+    for _ in range(min(int(max_iter), 200)):  # h^N converges to R geometrically
+        s_next = math.sqrt(s + cabs)
+        if abs(s_next - s) < 1e-15:
+            break
+        s = s_next
+    return min(float(bailout), s)
+
+
+def march_radius(scene: Scene) -> float:
+    """Bounding radius for the march: the escape-time bound, plus 4 epsilon for the
+    distance-estimate method, whose d < epsilon shell lies outside the set and whose
+    estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
+    f = scene.fractal
+    r = bounding_radius(f.c, f.bailout, f.max_iter)
+    if scene.march.method == "de":
+        r += 4.0 * scene.march.epsilon
+    return r
