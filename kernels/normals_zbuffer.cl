@@ -1,9 +1,10 @@
 /* normals_zbuffer.cl: normals from Z-buffer neighbours (seed 000 §5.1, eqs. 7-9;
  * seed 001 §4.1.1, eqs. 12-14): the normal of the plane through the hit point and
- * its neighbours' hit points, in camera coordinates.  Of the two neighbours along
- * each image axis the one with the smaller depth jump is used (a one-sided
- * difference, as in seed 001), so silhouettes do not tilt the normal; an axis with
- * no neighbour hit falls back to the image axis itself. */
+ * its neighbours' hit points, in camera coordinates (so perspective is handled).
+ * Along each image axis: the central difference of seed 000 when both neighbours
+ * hit with depth jumps within a factor 2 of each other; at a depth discontinuity
+ * the one-sided difference with the smaller jump (seed 001), so silhouettes do not
+ * tilt the normal; with no neighbour hit, the image axis itself. */
 
 inline real3 cam_point(__global const real4 *point, size_t i, real4 eye,
                        real4 right, real4 up, real4 forward)
@@ -12,8 +13,8 @@ inline real3 cam_point(__global const real4 *point, size_t i, real4 eye,
     return (real3)(dot(v, right), dot(v, up), -dot(v, forward));
 }
 
-/* Tangent along one image axis: neighbour a (step -1) or b (step +1), the one
- * whose depth is closer to ours; returned as the +1 direction. */
+/* Tangent along one image axis from neighbours a (step -1) and b (step +1),
+ * returned as the +1 direction. */
 inline real3 zb_tangent(__global const real4 *point, __global const real *depth,
                         __global const int *status, size_t i, size_t ia, size_t ib,
                         int has_a, int has_b, real3 p, real3 axis,
@@ -22,7 +23,11 @@ inline real3 zb_tangent(__global const real4 *point, __global const real *depth,
     int ok_a = has_a && status[ia] == STATUS_HIT;
     int ok_b = has_b && status[ib] == STATUS_HIT;
     if (ok_a && ok_b) {
-        if (fabs(depth[ia] - depth[i]) < fabs(depth[ib] - depth[i]))
+        real da = fabs(depth[ia] - depth[i]), db = fabs(depth[ib] - depth[i]);
+        if (fmax(da, db) <= (real)2 * fmin(da, db))
+            return (real)0.5 * (cam_point(point, ib, eye, right, up, forward) -
+                                cam_point(point, ia, eye, right, up, forward));
+        if (da < db)
             ok_b = 0;
         else
             ok_a = 0;

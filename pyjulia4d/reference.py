@@ -303,7 +303,8 @@ def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame):
 
 def normals_zbuffer(point, depth, status, width, height, frame: Frame):
     """Plane through the hit and its neighbours' hits (seed 000 §5.1, seed 001 §4.1.1);
-    per axis the neighbour with the smaller depth jump, the image axis if none hit."""
+    per axis the central difference where both neighbours' depth jumps are within a
+    factor 2, else the one-sided difference with the smaller jump, else the image axis."""
     P = _to_camera(np.nan_to_num(point.reshape(height, width, 4)) - frame.position, frame)
     Z = depth.reshape(height, width)
     H = (status == STATUS_HIT).reshape(height, width)
@@ -322,13 +323,16 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame):
         ok_a, ok_b = shifted(H, *da, False), shifted(H, *db, False)
         za, zb = shifted(Z, *da, np.inf), shifted(Z, *db, np.inf)
         both = ok_a & ok_b
-        a_wins = both & (np.abs(za - Z) < np.abs(zb - Z))
+        ja, jb = np.abs(za - Z), np.abs(zb - Z)
+        central = both & (np.maximum(ja, jb) <= 2 * np.minimum(ja, jb))
+        a_wins = both & (ja < jb)
         ok_a_final = ok_a & (~both | a_wins)
         ok_b_final = ok_b & (~both | ~a_wins)
+        pa, pb = shifted(P, *da, 0.0), shifted(P, *db, 0.0)
         t = np.broadcast_to(np.asarray(axis, float), P.shape).copy()
-        t = np.where(ok_a_final[..., None], P - shifted(P, *da, 0.0), t)
-        t = np.where(ok_b_final[..., None], shifted(P, *db, 0.0) - P, t)
-        return t
+        t = np.where(ok_a_final[..., None], P - pa, t)
+        t = np.where(ok_b_final[..., None], pb - P, t)
+        return np.where(central[..., None], 0.5 * (pb - pa), t)
 
     tx = tangent((0, -1), (0, 1), (1, 0, 0))   # left, right
     ty = tangent((1, 0), (-1, 0), (0, 1, 0))   # row below, row above (image y grows down)

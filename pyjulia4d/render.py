@@ -112,7 +112,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     queue.finish()
     t_kernels = time.perf_counter()
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
-    prg.generate_rays(queue, (w, h), None, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
+    cl.Kernel(prg, "generate_rays")(queue, (w, h), None, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
                       np.int32(w), np.int32(h), origins.data, dirs.data)
 
     c = pr.v4(f.c)
@@ -135,20 +135,20 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
 
     nm = scene.normals.method
     if nm == "jacobian":
-        prg.normals_jacobian(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
+        cl.Kernel(prg, "normals_jacobian")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
                              pr.scalar(f.bailout), right, up, fwd, normal.data)
     elif nm == "gradient":
         step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
-        prg.normals_gradient(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
+        cl.Kernel(prg, "normals_gradient")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
                              pr.scalar(f.bailout), pr.scalar(step), right, up, fwd, normal.data)
     else:
-        prg.normals_zbuffer(queue, (w, h), None, point.data, depth.data, status.data,
+        cl.Kernel(prg, "normals_zbuffer")(queue, (w, h), None, point.data, depth.data, status.data,
                             np.int32(w), np.int32(h), eye, right, up, fwd, normal.data)
 
     sh = scene.shading
     lp = light_position(scene)
     light = pr.v4(lp if lp is not None else frame.position)
-    prg.shade(queue, (n,), None, status.data, normal.data, point.data, eye, right, up, fwd, light,
+    cl.Kernel(prg, "shade")(queue, (n,), None, status.data, normal.data, point.data, eye, right, up, fwd, light,
               _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
               np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
               np.float32(sh.shininess), rgba.data)

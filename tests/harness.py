@@ -1,0 +1,56 @@
+"""Run single kernels of a scene's program on plain numpy arrays (test helper)."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pyopencl as cl
+import pyopencl.array as cla
+
+from pyjulia4d import build
+from pyjulia4d.devices import select_device
+from pyjulia4d.render import queue_for
+
+
+def device():
+    """The device under test: PYJULIA4D_DEVICE if set, else the default choice."""
+    return select_device(os.environ.get("PYJULIA4D_DEVICE") or None)
+
+
+class Runner:
+    """Kernels of one build configuration; arrays in, arrays out."""
+
+    def __init__(self, config: build.KernelConfig):
+        self.ctx, self.queue = queue_for(device())
+        self.prg = build.program(self.ctx, config)
+        self.double = "REAL_DOUBLE" in config.defines
+        self.real = np.float64 if self.double else np.float32
+        self.vdt = cl.cltypes.double4 if self.double else cl.cltypes.float4
+
+    def vec(self, v):
+        mk = cl.cltypes.make_double4 if self.double else cl.cltypes.make_float4
+        return mk(*[float(x) for x in v])
+
+    def scalar(self, x):
+        return self.real(x)
+
+    def buf4(self, a):
+        a = np.ascontiguousarray(np.asarray(a, self.real).reshape(-1, 4))
+        return cla.to_device(self.queue, a.view(self.vdt).ravel())
+
+    def buf(self, a, dtype=None):
+        return cla.to_device(self.queue, np.ascontiguousarray(a, dtype or self.real))
+
+    def out4(self, n):
+        return cla.empty(self.queue, n, self.vdt)
+
+    def out(self, n, dtype=None):
+        return cla.empty(self.queue, n, dtype or self.real)
+
+    def get4(self, a):
+        return a.get().view(self.real).reshape(-1, 4).astype(np.float64)
+
+    def __call__(self, name, size, *args):
+        conv = [a.data if isinstance(a, cla.Array) else a for a in args]
+        cl.Kernel(self.prg, name)(self.queue, size, None, *conv)
+        self.queue.finish()

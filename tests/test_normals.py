@@ -1,0 +1,71 @@
+"""normals_jacobian.cl, normals_gradient.cl and normals_zbuffer.cl against the reference,
+on identical hit points."""
+import numpy as np
+import pytest
+
+from harness import Runner
+from pyjulia4d import build, reference as ref
+from pyjulia4d.camera import camera_frame, march_radius
+from pyjulia4d.scene import Scene
+
+W, H = 64, 48
+
+
+def hits(s: Scene, real):
+    """Reference hit points of a small image, rounded to the kernel's precision."""
+    f, m = s.fractal, s.march
+    o, d = ref.generate_rays(camera_frame(s), W, H)
+    depth, point, status, _ = ref.march(o, d, f.c, f.max_iter, f.bailout, m.epsilon,
+                                        march_radius(s), -1.0, -1.0, m.z_resolution,
+                                        m.post_steps, m.max_steps, m.method)
+    return depth.astype(real).astype(float), point.astype(real).astype(float), status
+
+
+def angles(a, b):
+    return np.degrees(np.arccos(np.clip(np.sum(a * b, -1), -1, 1)))
+
+
+@pytest.mark.parametrize("method", ["jacobian", "gradient", "zbuffer"])
+@pytest.mark.parametrize("fl", ["single", "double"])
+@pytest.mark.parametrize("c", [(-0.2, 0.8, 0, 0), (-0.125, -0.256, 0.847, 0.0895)])
+def test_normals_match_reference(method, fl, c):
+    s = Scene.default().with_overrides([f"normals.method={method}", f"render.float={fl}",
+                                        "fractal.c=" + ",".join(map(str, c))])
+    R = Runner(build.scene_config(s))
+    fr = camera_frame(s)
+    depth, point, status = hits(s, R.real)
+    n = len(point)
+    out = R.out4(n)
+    f = s.fractal
+    vec = R.vec
+    if method == "jacobian":
+        R("normals_jacobian", (n,), R.buf4(point), R.buf(status, np.int32), vec(f.c),
+          np.int32(f.max_iter), R.scalar(f.bailout), vec(fr.right), vec(fr.up), vec(fr.forward), out)
+        want = ref.normals_jacobian(point, status, f.c, f.max_iter, f.bailout, fr)
+    elif method == "gradient":
+        h = s.march.epsilon
+        R("normals_gradient", (n,), R.buf4(point), R.buf(status, np.int32), vec(f.c),
+          np.int32(f.max_iter), R.scalar(f.bailout), R.scalar(h), vec(fr.right), vec(fr.up),
+          vec(fr.forward), out)
+        want = ref.normals_gradient(point, status, f.c, f.max_iter, f.bailout, h, fr)
+    else:
+        R("normals_zbuffer", (W, H), R.buf4(point), R.buf(depth), R.buf(status, np.int32),
+          np.int32(W), np.int32(H), vec(fr.position), vec(fr.right), vec(fr.up), vec(fr.forward), out)
+        with np.errstate(invalid="ignore"):
+            want = ref.normals_zbuffer(point, depth, status, W, H, fr)
+    got = R.get4(out)
+    assert np.all(got[:, 3] == 0)
+    got = got[:, :3]
+    hit = status == 1
+    assert hit.sum() > 300
+    np.testing.assert_allclose(np.linalg.norm(got[hit], axis=1), 1, atol=1e-5)
+    assert np.all(got[~hit] == 0)
+    a = angles(got[hit], want[hit])
+    # float32: the gradient direction at max_iter 12 turns by ~1e3 rad per unit of position,
+    # so float32 rounding of the iterates (~1e-7 relative) gives ~0.01 deg typically; the
+    # 6-point difference divides d's rounding by 2h, a few pixels reach degrees (measured
+    # max 5 deg on 80x60).  double: rounding only.
+    if fl == "double":
+        assert a.max() < 1e-5
+    else:
+        assert np.median(a) < 0.05 and np.percentile(a, 99) < (2.0 if method == "gradient" else 0.5)

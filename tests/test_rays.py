@@ -1,0 +1,66 @@
+"""rays.cl (generate_rays) against reference.generate_rays, and the camera frame."""
+import numpy as np
+import pytest
+
+from harness import Runner
+from pyjulia4d import build, reference as ref
+from pyjulia4d.camera import camera_frame, cross4, slice_rotation
+from pyjulia4d.scene import Scene, SceneError
+
+
+@pytest.mark.parametrize("over", [[], ["camera.position=-2,1,5,8", "camera.fov=60"],
+                                  ["camera.limbo=0,0.3,0,1", "camera.position=1,2,-3,0.5"],
+                                  ["slice.normal=0.2,0,0.3,1", "slice.distance=0.3"]])
+def test_generate_rays_matches_reference(over):
+    s = Scene.default().with_overrides(over + ["image.width=37", "image.height=23"])
+    R = Runner(build.scene_config(s))
+    f = camera_frame(s)
+    w, h = 37, 23
+    o, d = R.out4(w * h), R.out4(w * h)
+    R("generate_rays", (w, h), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
+      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), o, d)
+    ro, rd = ref.generate_rays(f, w, h)
+    # float32 rounding of the frame and one normalise: a few ulp of a unit vector
+    np.testing.assert_allclose(R.get4(d), rd, atol=2e-6)
+    np.testing.assert_allclose(R.get4(o), ro, atol=2e-6 * np.abs(ro).max())
+    np.testing.assert_allclose(np.linalg.norm(R.get4(d), axis=1), 1, atol=1e-6)
+
+
+def test_frame_is_orthonormal_and_default_drops_w():
+    s = Scene.default()
+    f = camera_frame(s)
+    m = np.stack([f.forward, f.right, f.up])
+    np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
+    assert np.allclose(m[:, 3], 0)   # limbo e_w, w = 0: the 3D view of seed 000 §4
+    np.testing.assert_allclose(f.right, [1, 0, 0, 0], atol=1e-12)  # looking +z with y up: x is right
+
+
+def test_cross4_is_perpendicular():
+    rng = np.random.default_rng(1)
+    a, b, c = rng.normal(size=(3, 4))
+    q = cross4(a, b, c)
+    assert max(abs(q @ a), abs(q @ b), abs(q @ c)) < 1e-12
+
+
+def test_slice_rotation_maps_w_to_normal():
+    for n in ([0, 0, 0, 1], [0, 0, 0, -1], [1, 2, 3, 0], [0.2, 0, 0.3, 1], [0, 0, 1e-9, -1]):
+        r = slice_rotation(n)
+        np.testing.assert_allclose(r @ r.T, np.eye(4), atol=1e-12)
+        np.testing.assert_allclose(r[:, 3], np.array(n) / np.linalg.norm(n), atol=1e-9)
+
+
+def test_slice_camera_rays_stay_in_hyperplane():
+    s = Scene.default().with_overrides(["slice.normal=0.3,-0.2,0.1,1", "slice.distance=0.25",
+                                        "image.width=8", "image.height=6"])
+    f = camera_frame(s)
+    o, d = ref.generate_rays(f, 8, 6)
+    n = np.array([0.3, -0.2, 0.1, 1.0]) / np.linalg.norm([0.3, -0.2, 0.1, 1.0])
+    np.testing.assert_allclose(o @ n, 0.25, atol=1e-12)
+    np.testing.assert_allclose(d @ n, 0, atol=1e-12)
+
+
+@pytest.mark.parametrize("over,key", [(["camera.up=0,0,1,0"], "camera.up"),
+                                      (["camera.limbo=0,0,1,0"], "camera.limbo")])
+def test_degenerate_camera_names_the_key(over, key):
+    with pytest.raises(SceneError, match=f"^{key}"):
+        camera_frame(Scene.default().with_overrides(over))
