@@ -14,7 +14,7 @@ from pyjulia4d.render import render
 from pyjulia4d.scene import Scene
 
 W, H = 64, 48
-BASE = ["fractal.c=0,0,0,0", f"image.width={W}", f"image.height={H}"]
+BASE = ["fractal.c=0,0,0,0", "camera.position=0,0,-3.2", f"image.width={W}", f"image.height={H}"]
 
 
 def sphere_entry(o, d, radius):

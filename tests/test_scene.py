@@ -1,0 +1,258 @@
+"""Scene loading, overrides, TOML round trip and validation messages."""
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+
+import pytest
+
+from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+
+def test_defaults() -> None:
+    s = Scene.default()
+    assert s == Scene.from_dict({})
+    assert s.fractal.c == (-0.2, 0.8, 0.0, 0.0)
+    assert s.fractal.max_iter == 12 and s.fractal.bailout == 4.0
+    assert s.camera.position == (1.8, 1.6, -2.2, 0.0) and s.camera.fov == 40.0
+    assert s.march.method == "de" and s.march.near == "auto" and s.march.max_steps == 4096
+    assert s.normals.method == "jacobian" and s.shading.light == "eye"
+    assert (s.image.width, s.image.height) == (640, 480)
+    assert s.render.float == "single"
+
+
+def test_checks_cover_every_field() -> None:
+    for name, cls in _SECTIONS.items():
+        assert [f.name for f in dataclasses.fields(cls)] == list(_CHECKS[name])
+
+
+def test_frozen() -> None:
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Scene.default().image.width = 3  # type: ignore[misc]
+
+
+def _custom() -> Scene:
+    return Scene.from_dict(
+        {
+            "fractal": {"c": [0.1, -0.3, 1e-5, 0], "max_iter": 9},
+            "camera": {"position": [1, 2, 3], "fov": 33.3},
+            "march": {"method": "fixed", "near": 0.5, "far": 7},
+            "normals": {"step": 1e-4},
+            "shading": {"light": [3, 4, 5, 0.25], "color": [1, 0.5, 0.1]},
+            "image": {"width": 17, "height": 9},
+            "render": {"float": "double"},
+        }
+    )
+
+
+@pytest.mark.parametrize("scene", [Scene.default(), _custom()], ids=["default", "custom"])
+def test_toml_round_trip(scene: Scene, tmp_path) -> None:
+    text = scene.to_toml()
+    assert Scene.from_dict(tomllib.loads(text)) == scene
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert Scene.from_toml(path) == scene
+    assert Scene.from_dict(scene.to_dict()) == scene
+
+
+def test_three_vectors_get_w_zero() -> None:
+    s = _custom()
+    assert s.camera.position == (1.0, 2.0, 3.0, 0.0)
+    assert s.shading.light == (3.0, 4.0, 5.0, 0.25)
+    assert all(isinstance(x, float) for x in s.fractal.c)
+
+
+def test_overrides_parse() -> None:
+    s = Scene.default().with_overrides(
+        [
+            "fractal.c=-0.2,0.8,0,0.1",
+            "fractal.max_iter=20",
+            "fractal.bailout=3",
+            "march.method=fixed",
+            "march.near=auto",
+            "march.far=9.5",
+            "shading.light=eye",
+            "shading.light_color=[1, 0.5, 0.5]",
+            "camera.up = 1,1,0",
+            "image.width=32",
+        ]
+    )
+    assert s.fractal.c == (-0.2, 0.8, 0.0, 0.1)
+    assert s.fractal.max_iter == 20 and isinstance(s.fractal.max_iter, int)
+    assert s.fractal.bailout == 3.0 and isinstance(s.fractal.bailout, float)
+    assert s.march.method == "fixed" and s.march.near == "auto" and s.march.far == 9.5
+    assert s.shading.light == "eye" and s.shading.light_color == (1.0, 0.5, 0.5)
+    assert s.camera.up == (1.0, 1.0, 0.0, 0.0)
+    assert s.image.width == 32
+
+
+def test_overrides_apply_after_file(tmp_path) -> None:
+    path = tmp_path / "s.toml"
+    path.write_text("[image]\nwidth = 100\nheight = 50\n")
+    s = Scene.from_toml(path, ["image.width=7", "shading.light=1,2,3"])
+    assert (s.image.width, s.image.height) == (7, 50)
+    assert s.shading.light == (1.0, 2.0, 3.0, 0.0)
+
+
+def test_replace() -> None:
+    s = Scene.default().replace(**{"march.post_steps": 10, "fractal.c": (0, 0, 0, 0)})
+    assert s.march.post_steps == 10 and s.fractal.c == (0.0, 0.0, 0.0, 0.0)
+    with pytest.raises(SceneError, match=r"^march\.zres: unknown key$"):
+        Scene.default().replace(**{"march.zres": 1})
+
+
+BAD = [
+    # (override, key the message must start with)
+    ("march.zres=3", "march.zres"),
+    ("zork.x=1", "zork.x"),
+    ("fractal.max_iter=abc", "fractal.max_iter"),
+    ("fractal.max_iter=12.0", "fractal.max_iter"),
+    ("fractal.max_iter=true", "fractal.max_iter"),
+    ("fractal.max_iter=0", "fractal.max_iter"),
+    ("fractal.algebra=octonion", "fractal.algebra"),
+    ("fractal.function=cube", "fractal.function"),
+    ("fractal.bailout=0", "fractal.bailout"),
+    ("fractal.bailout=nan", "fractal.bailout"),
+    ("fractal.c=1,2,3", "fractal.c"),
+    ("fractal.c=1,2,x,4", "fractal.c"),
+    ("fractal.c=1,2,inf,4", "fractal.c"),
+    ("camera.up=0,0,0", "camera.up"),
+    ("camera.up=0,0,0,0", "camera.up"),
+    ("camera.limbo=0,0,0,0", "camera.limbo"),
+    ("camera.position=1,2", "camera.position"),
+    ("camera.target=1.8,1.6,-2.2", "camera.target"),
+    ("camera.limbo=-1.8,-1.6,2.2", "camera.limbo"),
+    ("camera.up=0,0,0,1", "camera.up"),
+    ("camera.fov=0", "camera.fov"),
+    ("camera.fov=180", "camera.fov"),
+    ("camera.fov=inf", "camera.fov"),
+    ("slice.normal=0,0,0,0", "slice.normal"),
+    ("slice.distance=-inf", "slice.distance"),
+    ("march.method=sphere", "march.method"),
+    ("march.z_resolution=0", "march.z_resolution"),
+    ("march.post_steps=-1", "march.post_steps"),
+    ("march.epsilon=0", "march.epsilon"),
+    ("march.epsilon=-1e-3", "march.epsilon"),
+    ("march.max_steps=0", "march.max_steps"),
+    ("march.near=-1", "march.near"),
+    ("march.near=fast", "march.near"),
+    ("march.far=0", "march.far"),
+    ("normals.method=magic", "normals.method"),
+    ("normals.step=0", "normals.step"),
+    ("shading.color=1,-0.1,0", "shading.color"),
+    ("shading.color=1,1,1,1", "shading.color"),
+    ("shading.ambient=-0.1", "shading.ambient"),
+    ("shading.shininess=0", "shading.shininess"),
+    ("shading.light=sun", "shading.light"),
+    ("shading.light=1,2", "shading.light"),
+    ("image.width=0", "image.width"),
+    ("image.height=-5", "image.height"),
+    ("image.width=1.5", "image.width"),
+    ("image.width=99999999999", "image.width"),
+    ("render.float=half", "render.float"),
+]
+
+
+@pytest.mark.parametrize("override,key", BAD, ids=[b[0] for b in BAD])
+def test_bad_override(override: str, key: str) -> None:
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict({}, [override])
+    msg = str(info.value)
+    assert msg.startswith(key + ": "), msg
+    assert info.value.key == key and "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    "value,reason",
+    [
+        (float("nan"), "not a finite number"),
+        (float("inf"), "not a finite number"),
+        (-math.inf, "not a finite number"),
+        (True, "expected a number, got True"),
+        ("1.0", "expected a number, got '1.0'"),
+    ],
+)
+def test_bad_float_values(value: object, reason: str) -> None:
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict({"march": {"epsilon": value}})
+    assert str(info.value) == f"march.epsilon: {reason}"
+
+
+def test_exact_messages() -> None:
+    cases = {
+        "camera.up=0,0,0": "camera.up: zero-length vector",
+        "march.zres=1": "march.zres: unknown key",
+        "fractal.max_iter=abc": "fractal.max_iter: expected an integer, got 'abc'",
+        "camera.target=1.8,1.6,-2.2,0": "camera.target: equals camera.position",
+        "fractal.c=1,2": "fractal.c: expected a list of 4 numbers, got 2",
+    }
+    for override, message in cases.items():
+        with pytest.raises(SceneError) as info:
+            Scene.default().with_overrides([override])
+        assert str(info.value) == message
+
+
+def test_dict_errors() -> None:
+    with pytest.raises(SceneError, match=r"^zork: unknown key$"):
+        Scene.from_dict({"zork": {}})
+    with pytest.raises(SceneError, match=r"^image: expected a table"):
+        Scene.from_dict({"image": 3})
+    with pytest.raises(SceneError, match=r"^fractal\.max_iter: expected an integer, got 12\.0$"):
+        Scene.from_dict({"fractal": {"max_iter": 12.0}})
+    with pytest.raises(SceneError, match=r"^fractal\.c: expected a list of 4 numbers"):
+        Scene.from_dict({"fractal": {"c": "0,0,0,0"}})
+
+
+def test_far_must_exceed_near() -> None:
+    with pytest.raises(SceneError, match=r"^march\.far: must be greater than march\.near"):
+        Scene.from_dict({"march": {"near": 2.0, "far": 2.0}})
+    assert Scene.from_dict({"march": {"near": 2, "far": "auto"}}).march.near == 2.0
+
+
+def test_malformed_override() -> None:
+    with pytest.raises(SceneError, match=r"^fractal\.c: malformed override"):
+        Scene.from_dict({}, ["fractal.c"])
+    with pytest.raises(SceneError, match=r"^width: unknown key$"):
+        Scene.from_dict({}, ["width=3"])
+
+
+def test_unreadable_file(tmp_path) -> None:
+    missing = tmp_path / "missing.toml"
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(missing)
+    assert str(info.value).startswith(f"{missing}: cannot read: ")
+    with pytest.raises(SceneError, match=r": cannot read: "):
+        Scene.from_toml(tmp_path)  # a directory
+
+
+def test_toml_syntax_error(tmp_path) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text("[fractal\nmax_iter = 3\n")
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    assert str(info.value).startswith(f"{path}: invalid TOML: ")
+    path.write_bytes(b"[image]\nwidth = \xff\n")
+    with pytest.raises(SceneError, match=r": invalid TOML"):
+        Scene.from_toml(path)
+
+
+def test_toml_values_validated(tmp_path) -> None:
+    path = tmp_path / "s.toml"
+    path.write_text("[march]\nepsilon = nan\n")
+    with pytest.raises(SceneError, match=r"^march\.epsilon: not a finite number$"):
+        Scene.from_toml(path)
+    path.write_text("[camera]\nlimbo = [0, 0, 0, 0]\n")
+    with pytest.raises(SceneError, match=r"^camera\.limbo: zero-length vector$"):
+        Scene.from_toml(path)
+
+
+def test_error_single_argument_form() -> None:
+    e = SceneError("camera.up: parallel to the view direction")
+    assert (e.key, e.reason) == ("camera.up", "parallel to the view direction")
+    assert str(SceneError("a.b", "c")) == "a.b: c"
