@@ -323,7 +323,8 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame):
         ok_a, ok_b = shifted(H, *da, False), shifted(H, *db, False)
         za, zb = shifted(Z, *da, np.inf), shifted(Z, *db, np.inf)
         both = ok_a & ok_b
-        ja, jb = np.abs(za - Z), np.abs(zb - Z)
+        with np.errstate(invalid="ignore"):  # inf - inf where neither hit: masked below
+            ja, jb = np.abs(za - Z), np.abs(zb - Z)
         central = both & (np.maximum(ja, jb) <= 2 * np.minimum(ja, jb))
         a_wins = both & (ja < jb)
         ok_a_final = ok_a & (~both | a_wins)
