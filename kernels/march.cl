@@ -15,9 +15,15 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
     real4 o = origins[i];
     real4 d = dirs[i];
 
-    /* |o + t d|^2 = radius^2  ->  t = -b -+ sqrt(b^2 - (|o|^2 - radius^2)) */
+    /* |o + t d|^2 = radius^2  ->  t = -b -+ sqrt(b^2 - (|o|^2 - radius^2)).  The
+     * discriminant is taken as radius^2 - |o - b d|^2 (the squared distance of the
+     * ray's closest approach), which is the same for |d| = 1 but does not cancel
+     * catastrophically: b^2 - |o|^2 loses everything in float32 for a camera 1e4 away
+     * (ulp(1e8) = 8 > radius^2), which threw near/far off by ~1 (extreme case
+     * camera_far). */
     real b = dot(o, d);
-    real disc = b * b - (dot(o, o) - radius * radius);
+    real4 perp = o - b * d;
+    real disc = radius * radius - dot(perp, perp);
     int st = STATUS_MISS;
     int n = 0;
     real t = INFINITY;

@@ -30,6 +30,11 @@ inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
         }
         t_prev = t;
         t += fmax(dist, jp.epsilon);
+        if (t == t_prev) {          /* step below the spacing of t (epsilon < ulp(t) / 2): */
+            *samples = i + 1;       /* the march cannot advance; stop now, reported as    */
+            *status = STATUS_CAPPED;/* capped (counted; samples < max_steps tells them   */
+            return INFINITY;        /* apart from the step cap), not spun to max_steps    */
+        }
     }
     *samples = max_steps;
     *status = STATUS_CAPPED;

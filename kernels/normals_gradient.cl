@@ -30,5 +30,7 @@ __kernel void normals_gradient(__global const real4 *point, __global const int *
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 n = normal_gradient(point[i], jp, h, right, up, forward);
     real l = length(n);
-    normal[i] = l > (real)0 && isfinite(l) ? n / l : (real4)(0);
+    /* a flat or non-finite difference: the view axis, flagged (real.cl), never 0 on a hit */
+    normal[i] = l > (real)0 && isfinite(l) ? n / l
+                                           : (real4)(0, 0, 1, (real)GUARD_NORMAL_FALLBACK);
 }

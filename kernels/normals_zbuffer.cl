@@ -62,7 +62,14 @@ __kernel void normals_zbuffer(__global const real4 *point, __global const real *
     if (dot(n, view) < (real)0)
         n = -n;
     real l = length(n);
-    if (!(l > (real)0) || !isfinite(l))
+    int guard = 0;
+    if (!(l > (real)0) || !isfinite(l)) {
+        /* degenerate plane: face the eye; if the hit is the eye itself (camera inside the
+         * set, depth 0) the view axis.  Flagged either way (real.cl). */
+        guard = GUARD_NORMAL_FALLBACK;
         n = view, l = length(view);
-    normal[i] = (real4)(n / l, 0);
+        if (!(l > (real)0) || !isfinite(l))
+            n = (real3)(0, 0, 1), l = 1;
+    }
+    normal[i] = (real4)(n / l, (real)guard);
 }

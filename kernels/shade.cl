@@ -17,7 +17,10 @@ __kernel void shade(__global const int *status, __global const real4 *normal,
         return;
     }
     real4 pv = point[i] - eye;
-    float3 p = normalize((float3)(dot(pv, right), dot(pv, up), -dot(pv, forward)));
+    float3 p = (float3)(dot(pv, right), dot(pv, up), -dot(pv, forward));
+    /* the hit is the eye itself (camera inside the set, depth 0): no eye-to-point
+     * direction, take the view axis (counted on the host as guards["eye_hit"]) */
+    p = dot(p, p) > 0.0f ? normalize(p) : (float3)(0.0f, 0.0f, -1.0f);
     float3 n = (float3)(normal[i].x, normal[i].y, normal[i].z);
     float3 v = -p;                                   /* towards the eye */
 #ifdef LIGHT_POINT

@@ -12,10 +12,15 @@ import time
 import numpy as np
 
 from .camera import Frame, camera_frame, light_position, march_radius
-from .render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, RenderResult
+from .render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, RenderResult, count_guards
 from .scene import Scene
 
 REAL_MIN = np.finfo(np.float64).tiny
+
+# Guard flags (kernels/real.cl): written into the normal buffer's w by the kernels,
+# returned through the optional ``guard`` array here; RenderResult.guards counts them.
+GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
+GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
 
 
 def _dot(a, b):
@@ -191,6 +196,11 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         k = idx[~hit]
         t_prev[k] = t[k]
         t[k] = t[k] + np.maximum(dist[~hit], epsilon)
+        # the step fell below the spacing of t: stop, reported capped (march_de.cl)
+        stall = k[t[k] == t_prev[k]]
+        status[stall] = STATUS_CAPPED
+        samples[stall] = i + 1
+        active[stall] = False
     t[status != STATUS_HIT] = np.inf
     return t, status, samples
 
@@ -203,7 +213,9 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = _dot(o, d)
-    disc = b * b - (_dot(o, o) - radius * radius)
+    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye (march.cl)
+    perp = o - b[:, None] * d
+    disc = radius * radius - _dot(perp, perp)
     s = np.sqrt(np.maximum(disc, 0.0))
     near = np.maximum(-b - s, 0.0)
     far = -b + s
@@ -246,38 +258,65 @@ def _to_camera(g, frame: Frame):
 
 
 def _unit_or_zero(n):
+    """Normalise, 0 where degenerate (used by truth.py; the normals kernels use
+    to_camera_unit, which never returns 0 on a hit)."""
     l = np.linalg.norm(n, axis=-1, keepdims=True)
     ok = (l > 0) & np.isfinite(l)
     return np.where(ok, n / np.where(ok, l, 1), 0.0)
 
 
-def normal_jacobian(p, c, max_iter, bailout):
-    """grad |q_n|^2 = 2 J^T q_n with J carried by the chain rule (seed 004 method 3)."""
+def to_camera_unit(n, guard=None):
+    """Normalise (the caller projects with _to_camera); a zero or non-finite vector becomes
+    the view axis (0, 0, 1), flagged GUARD_NORMAL_FALLBACK in ``guard``
+    (normals_jacobian.cl / normals_gradient.cl)."""
+    l = np.linalg.norm(n, axis=-1, keepdims=True)
+    ok = (l > 0) & np.isfinite(l)
+    if guard is not None:
+        guard |= np.where(ok[..., 0], 0, GUARD_NORMAL_FALLBACK)
+    return np.where(ok, n / np.where(ok, l, 1), np.array([0.0, 0.0, 1.0]))
+
+
+def normal_jacobian(p, c, max_iter, bailout, guard=None):
+    """grad |q_n|^2 = 2 J^T q_n with J carried by the chain rule (seed 004 method 3).
+    J is rescaled both ways (no underflow on orbits drawn to an attracting cycle), and the
+    iteration stops while q is a normal number, |q|^2 >= sqrt(REAL_MIN): inside points of
+    c ~ 0 go to exactly 0 otherwise, and the normal with them (GUARD_JACOBIAN_TINY)."""
     q = np.array(p, np.float64)
     c = np.asarray(c, np.float64)
     J = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4)).copy()  # J[..., k, :] = column k
     live = np.ones(q.shape[:-1], bool)
+    tiny = np.zeros(q.shape[:-1], bool)
     for _ in range(max_iter):
-        live &= _dot(q, q) <= bailout * bailout
+        m2 = _dot(q, q)
+        live &= m2 <= bailout * bailout
+        stop = live & (m2 < np.sqrt(REAL_MIN))
+        tiny |= stop
+        live &= ~stop
         if not live.any():
             break
         ql = q[live]
         J[live] = julia_f_jvp(ql[:, None, :], J[live])
         q[live] = julia_f(ql, c)
         s = np.linalg.norm(J[live], axis=-1).max(axis=-1)
-        big = s > 1e12
+        big = (s > 1e12) | ((s < 1e-12) & (s > 0))
         if big.any():
             Jl = J[live]
             Jl[big] /= s[big][:, None, None]
             J[live] = Jl
+    if guard is not None:
+        guard |= np.where(tiny, GUARD_JACOBIAN_TINY, 0)
     return np.einsum("...kj,...j->...k", J, q)
 
 
-def normals_jacobian(point, status, c, max_iter, bailout, frame: Frame):
+def normals_jacobian(point, status, c, max_iter, bailout, frame: Frame, guard=None):
+    """Unit normals of the hits, 0 elsewhere; ``guard`` (int array, optional) gets the flags."""
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
-        out[hit] = _unit_or_zero(_to_camera(normal_jacobian(point[hit], c, max_iter, bailout), frame))
+        g = np.zeros(int(hit.sum()), np.int64)
+        out[hit] = to_camera_unit(_to_camera(normal_jacobian(point[hit], c, max_iter, bailout, g), frame), g)
+        if guard is not None:
+            guard[hit] |= g
     return out
 
 
@@ -293,15 +332,19 @@ def normal_gradient(p, c, max_iter, bailout, h, frame: Frame):
                      f(p - h * w) - f(p + h * w)], axis=-1)
 
 
-def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame):
+def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame, guard=None):
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
-        out[hit] = _unit_or_zero(normal_gradient(point[hit], c, max_iter, bailout, h, frame))
+        g = np.zeros(int(hit.sum()), np.int64)
+        with np.errstate(invalid="ignore"):
+            out[hit] = to_camera_unit(normal_gradient(point[hit], c, max_iter, bailout, h, frame), g)
+        if guard is not None:
+            guard[hit] |= g
     return out
 
 
-def normals_zbuffer(point, depth, status, width, height, frame: Frame):
+def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=None):
     """Plane through the hit and its neighbours' hits (seed 000 §5.1, seed 001 §4.1.1);
     per axis the central difference where both neighbours' depth jumps are within a
     factor 2, else the one-sided difference with the smaller jump, else the image axis."""
@@ -343,7 +386,12 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame):
     l = np.linalg.norm(n, axis=-1, keepdims=True)
     bad = ~((l > 0) & np.isfinite(l))
     n = np.where(bad, view, n)
+    # the hit is the eye itself (camera inside the set): the view axis (normals_zbuffer.cl)
+    lv = np.linalg.norm(n, axis=-1, keepdims=True)
+    n = np.where(bad & ~((lv > 0) & np.isfinite(lv)), np.array([0.0, 0.0, 1.0]), n)
     n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    if guard is not None:
+        guard |= np.where((bad[..., 0] & H).ravel(), GUARD_NORMAL_FALLBACK, 0)
     return np.where(H[..., None], n, 0.0).reshape(-1, 3)
 
 
@@ -358,7 +406,9 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     if not hit.any():
         return rgba
     p = _to_camera(point[hit] - frame.position, frame)
-    p /= np.linalg.norm(p, axis=-1, keepdims=True)
+    lp = np.linalg.norm(p, axis=-1, keepdims=True)
+    # the hit is the eye itself (depth 0, camera inside the set): the view axis (shade.cl)
+    p = np.where(lp > 0, p / np.where(lp > 0, lp, 1), np.array([0.0, 0.0, -1.0]))
     v = -p
     if light_pos is None:
         l = v
@@ -392,18 +442,20 @@ def render(scene: Scene) -> RenderResult:
     depth, point, status, samples = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
                                           m.post_steps, m.max_steps, m.method)
+    guard = np.zeros(len(status), np.int64)
     if scene.normals.method == "jacobian":
-        normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame)
+        normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard)
     elif scene.normals.method == "gradient":
         step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
-        normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame)
+        normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard)
     else:
-        normal = normals_zbuffer(point, depth, status, w, h, frame)
+        normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
     rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
                  sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess)
     res = RenderResult(color=rgba[:, :3].reshape(h, w, 3), alpha=rgba[:, 3].reshape(h, w),
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
-                       samples=samples.reshape(h, w), device_name="numpy float64 reference")
+                       samples=samples.reshape(h, w), device_name="numpy float64 reference",
+                       guards=count_guards(status, samples, depth, guard, m.max_steps))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

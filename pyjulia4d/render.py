@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pyopencl as cl
 import pyopencl.array as cla
 from tqdm import tqdm
 
-from . import build
+from . import build, workload
 from .camera import camera_frame, light_position, march_radius
 from .devices import has_fp64, select_device
 from .scene import Scene, SceneError
@@ -36,6 +36,7 @@ class RenderResult:
     device_name: str = ""
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
     kernel_seconds: float = 0.0  # the kernels alone
+    guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
 
     @property
     def hit_fraction(self) -> float:
@@ -55,6 +56,24 @@ class RenderResult:
         for k, name in enumerate("XYZW"):
             ch[f"P.{name}"] = self.position[..., k]
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
+
+
+def count_guards(status, samples, depth, guard, max_steps) -> dict[str, int]:
+    """Pixels each numerical guard fired on (issue 4: nothing clamped without being counted).
+    ``guard`` holds the flags the normals kernels write into the normal's w (kernels/real.cl)."""
+    status, samples, guard = (np.asarray(a).ravel() for a in (status, samples, guard))
+    hit = status == STATUS_HIT
+    guard = guard.astype(np.int64)
+    return {
+        # de march stopped because t + step == t (march_de.cl), reported STATUS_CAPPED
+        "stalled": int(np.sum((status == STATUS_CAPPED) & (samples < max_steps))),
+        # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
+        "normal_fallback": int(np.sum(hit & ((guard & 1) != 0))),
+        # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
+        "jacobian_tiny": int(np.sum(hit & ((guard & 2) != 0))),
+        # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
+        "eye_hit": int(np.sum(hit & (np.asarray(depth).ravel() == 0))),
+    }
 
 
 _queues: dict[int, tuple[cl.Context, cl.CommandQueue]] = {}
@@ -85,10 +104,13 @@ def _float4(v3, w=0.0):
     return cl.cltypes.make_float4(*[float(x) for x in v3], float(w))
 
 
-def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False) -> RenderResult:
-    """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL)."""
+def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
+           force: bool = False) -> RenderResult:
+    """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL).
+    ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work)."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
+    workload.check(scene, dev, force=force)  # before any kernel: hopeless or overflowing settings
     double = scene.render.float == "double"
     if double and not has_fp64(dev):
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
@@ -159,12 +181,15 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         return a.get().view(pr.scalar).reshape(h, w, 4)[..., :k].astype(np.float32)
 
     col = rgba.get().view(np.float32).reshape(h, w, 4)
+    nflags = normal.get().view(pr.scalar).reshape(n, 4)[:, 3]  # guard flags (kernels/real.cl)
+    st, sm = status.get(), samples.get()
     result = RenderResult(
         color=np.ascontiguousarray(col[..., :3]), alpha=np.ascontiguousarray(col[..., 3]),
         depth=depth.get().reshape(h, w).astype(np.float32),
         normal=vec(normal, 3), position=vec(point, 4),
-        status=status.get().reshape(h, w), samples=samples.get().reshape(h, w),
-        device_name=dev.name.strip(), kernel_seconds=kernel_seconds)
+        status=st.reshape(h, w), samples=sm.reshape(h, w),
+        device_name=dev.name.strip(), kernel_seconds=kernel_seconds,
+        guards=count_guards(st, sm, depth.get(), nflags, m.max_steps))
     result.seconds = time.perf_counter() - t_start
     return result
 

@@ -1,0 +1,230 @@
+"""A named catalogue of extreme cases (issue 4): the places where quaternion Julia
+rendering is known to break, each with what it stresses, what pyjulia4d must do,
+and how close the float32 render must come to the float64 one.
+
+Every case is a list of scene overrides on top of the default scene, runnable with
+either march method (``scene(case, "fixed" | "de", "single" | "double")``).  Images
+are tiny (the costly cases a handful of pixels) so that tests/test_extreme.py runs
+the whole catalogue, both methods and both precisions, in well under a minute;
+benchmarks/extreme_cases.py runs the same scenes and writes the error table.
+
+Tolerances are against the float64 render of the same scene (the double-precision
+kernels, themselves held to the numpy reference by tests/test_march.py and
+tests/test_extreme.py): ``status_tol`` bounds the fraction of pixels whose status
+(miss / hit / capped) differs, and ``depth_tol`` the depth error on pixels both
+renders hit (the median must be below it, and at most ``status_tol`` of those
+pixels above it).  A case whose float32 error is inherently larger is marked with
+``limit``: a documented precision limit, whose measured error is reported by the
+benchmark instead of asserted.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from .scene import Scene
+
+METHODS = ("fixed", "de")
+
+# Pinned here so that a change of the default camera does not move the targets below.
+EYE = (1.8, 1.6, -2.2, 0.0)
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    overrides: tuple[str, ...]
+    stresses: str
+    expected: str
+    status_tol: float = 0.02       # fraction of pixels whose status may differ from float64
+    depth_tol: float = 1e-4        # depth error on common hits (median below; <= status_tol above)
+    limit: str = ""                # non-empty: a documented float32 precision limit (measured, not asserted)
+    size: tuple[int, int] = (24, 18)
+    per_method: dict = field(default_factory=dict)  # method -> extra overrides
+    both_hit_min: int = 1          # pixels both renders must hit (0: a case that may see nothing)
+    fixed_depth_tol: float = 0.0   # depth_tol for the fixed scan where it differs (0: the same)
+
+    def depth_tol_for(self, method: str) -> float:
+        return self.fixed_depth_tol if method == "fixed" and self.fixed_depth_tol else self.depth_tol
+
+    def overrides_for(self, method: str) -> list[str]:
+        w, h = self.size
+        return ([f"march.method={method}", f"image.width={w}", f"image.height={h}"]
+                + list(self.overrides) + list(self.per_method.get(method, ())))
+
+
+@lru_cache(maxsize=None)
+def surface_point() -> tuple[float, float, float, float]:
+    """A point on the surface of the default set: where the centre ray from EYE
+    meets it, by a float64 reference scan (z_resolution 4000, 40 post-steps: the
+    bracket is below 1e-15)."""
+    from . import reference as ref
+    from .camera import camera_frame, march_radius
+    s = Scene.default().with_overrides([f"camera.position={_v(EYE)}", "camera.target=0,0,0,0",
+                                        "march.method=fixed"])
+    f = s.fractal
+    fr = camera_frame(s)
+    depth, point, status, _ = ref.march(fr.position[None], fr.forward[None], f.c, f.max_iter,
+                                        f.bailout, 1e-3, march_radius(s), -1.0, -1.0, 4000, 40,
+                                        1, "fixed")
+    assert status[0] == 1, "the centre ray of the default scene must hit the set"
+    return tuple(float(x) for x in point[0])
+
+
+def _v(v) -> str:
+    return ",".join(repr(float(x)) for x in v)
+
+
+def _far_camera() -> list[str]:
+    """Eye at distance 1e4 along EYE's direction, field of view just holding the bounding
+    ball (radius ~1.6) so the set fills the frame."""
+    u = np.asarray(EYE) / np.linalg.norm(EYE)
+    fov = math.degrees(2 * math.atan(1.2 / 1e4))
+    return [f"camera.position={_v(1e4 * u)}", "camera.target=0,0,0,0", f"camera.fov={fov!r}"]
+
+
+def _deep_zoom() -> list[str]:
+    return [f"camera.position={_v(EYE)}", f"camera.target={_v(surface_point())}",
+            "camera.fov=1e-5"]
+
+
+def _build() -> list[Case]:
+    cheap = (24, 18)
+    small = (12, 9)
+    tiny = (4, 3)
+    cases = [
+        Case("c_zero", ("fractal.c=0,0,0,0",),
+             "c = 0: the set is a ball; inside orbits go to 0 and underflow (the Jacobian "
+             "normal would be 0); the bounding sphere IS the surface, so the fixed scan's "
+             "first sample lies exactly on the boundary",
+             "a ball of radius bailout^(2^-max_iter), radial normals (jacobian_tiny counted); "
+             "fixed: rounding decides the boundary sample, in float64 too (depth within a step)",
+             size=cheap, fixed_depth_tol=1e-2),
+        Case("c_parabolic_0.25", ("fractal.c=0.25,0,0,0", "fractal.max_iter=100"),
+             "c = 1/4 on the cardioid cusp: orbits creep to the parabolic fixed point 1/2 "
+             "(|f'| = 1), escape-time classification is stiff",
+             "terminates; float32 agrees with float64 up to the stiff boundary pixels",
+             0.05, 1e-3, "", cheap),
+        Case("c_parabolic_-0.75", ("fractal.c=-0.75,0,0,0", "fractal.max_iter=100"),
+             "c = -3/4, the parabolic 2-cycle root: slow convergence, stiff classification",
+             "terminates; float32 agrees with float64 up to the stiff boundary pixels",
+             0.05, 1e-3, "", cheap),
+        Case("c_dust_0.2501", ("fractal.c=0.2501,0,0,0", "fractal.max_iter=100"),
+             "c just outside the Mandelbrot set: the Julia set is dust, orbits escape only "
+             "after ~300 iterations (slow passage by 1/2)",
+             "terminates; at max_iter 100 still a solid (truncated) set",
+             0.05, 1e-3, "", cheap),
+        Case("c_dust_0.26", ("fractal.c=0.26,0,0,0", "fractal.max_iter=100"),
+             "c outside the Mandelbrot set: Cantor dust, no interior at all; the truncated set "
+             "is a thin hull that marching may step over",
+             "terminates; the fixed scan may miss the thin hull (as float64 does)",
+             0.05, 1e-3, "", cheap),
+        Case("c_dendrite_-2", ("fractal.c=-2,0,0,0", "fractal.max_iter=30"),
+             "c = -2: the set is the segment [-2, 2] (zero volume); thin object",
+             "fixed: the truncated set is a thin spindle the scan steps over; de: the "
+             "epsilon shell around it (seed 001 §3.3 adds thickness), thinner than a pixel "
+             "here: both precisions see (almost) nothing",
+             0.05, 1e-3, "", cheap, both_hit_min=0),
+        Case("c_dendrite_i", ("fractal.c=0,1,0,0", "fractal.max_iter=30"),
+             "c = i: a dendrite (no interior), thin branches",
+             "fixed: thin hull, mostly stepped over; de: the epsilon shell",
+             0.05, 1e-3, "", cheap),
+        Case("max_iter_1", ("fractal.max_iter=1",),
+             "max_iter 1: the estimate and normals from a single iterate",
+             "a smooth blob; exact agreement", 0.02, 1e-4, "", cheap),
+        Case("max_iter_1000", ("fractal.max_iter=1000",),
+             "max_iter 1000: |q'| ~ 2^1000 overflows float32 (and float64) without rescaling",
+             "no NaN/inf: derivative carried as mantissa * 2^e, Jacobian rescaled; fixed: a "
+             "sample grazing the rough boundary may flip, moving the hit by one step (1.2e-2)",
+             0.05, 1e-3, "", small, fixed_depth_tol=1.2e-2),
+        Case("max_iter_10000", ("fractal.max_iter=10000",),
+             "max_iter 10000: |q'| ~ 2^10000, far beyond float64 too",
+             "no NaN/inf: derivative carried as mantissa * 2^e, Jacobian rescaled; fixed: a "
+             "sample grazing the rough boundary may flip, moving the hit by one step (1.2e-2)",
+             0.1, 1e-3, "", tiny, fixed_depth_tol=1.2e-2),
+        Case("bailout_2", ("fractal.bailout=2",),
+             "bailout 2: the smallest radius that still bounds the set; crude estimate",
+             "terminates; estimate low but safe", 0.02, 1e-4, "", cheap),
+        Case("bailout_1e3", ("fractal.bailout=1e3",),
+             "bailout 1e3: |q|^2 up to 1e6 before one more squaring",
+             "no overflow; sharper estimate", 0.02, 1e-4, "", cheap),
+        Case("bailout_1e6", ("fractal.bailout=1e6", "fractal.max_iter=100"),
+             "bailout 1e6: |q|^2 up to 1e12 -> 1e24 after a squaring, derivative squared "
+             "up to 1e40 before rescaling in float32",
+             "no NaN/inf from the estimate or the normals", 0.05, 1e-3, "", small, fixed_depth_tol=1.2e-2),
+        Case("camera_far", tuple(_far_camera()),
+             "camera at distance 1e4 with a 0.014 degree field of view: the march starts at "
+             "the bounding sphere ~1e4 away, where float32 spacing of t is ~1e-3",
+             "terminates; float32 depth quantised to ulp(1e4) ~ 1e-3",
+             0.1, 2e-3, "float32 depth resolution at t = 1e4 is ~1e-3 (ulp), the size of "
+             "the set's fine detail", cheap),
+        Case("deep_zoom", tuple(_deep_zoom()),
+             "field of view 1e-5 degrees onto a surface point: the frame is ~5e-7 wide, "
+             "about two float32 ulps of the eye position and of t",
+             "terminates; float32 rays and depths quantised to ~2e-7, the image is blocky",
+             0.1, 1e-5, "float32 cannot resolve a 5e-7 frame at distance 3: pixels share "
+             "rays and depths (ulp(3) = 2.4e-7)", small),
+        Case("camera_inside", ("camera.position=0.05,0.1,-0.1,0", "camera.target=0,0,1,0",
+                               "camera.up=0,1,0,0"),
+             "the eye inside the set: near = 0, the first sample is inside, the hit point "
+             "is the eye itself (no eye-to-point direction for shading)",
+             "every pixel a hit at depth 0 (guards eye_hit = all), finite colour; "
+             "zbuffer normals fall back to the view axis (normal_fallback)", 0.0, 1e-6, "", small),
+        Case("critical_point_eye", ("camera.position=0,0,0,0", "camera.target=0,0,1,0",
+                                    "camera.up=0,1,0,0"),
+             "the eye at the critical point 0 inside the set: f'(0) = 0, so the Jacobian "
+             "and the derivative vanish exactly on the first step",
+             "every pixel a hit at depth 0; the zero gradient is replaced by the view axis "
+             "and counted (normal_fallback, jacobian_tiny), never a zero or NaN normal",
+             0.0, 1e-6, "", small),
+        Case("epsilon_below_ulp", ("march.epsilon=1e-8", "march.post_steps=0",
+                                   "fractal.max_iter=100"),
+             "epsilon 1e-8 below float32 spacing at the hit distance (ulp(2.5) = 2.4e-7): "
+             "t + d == t, the DE march cannot advance",
+             "terminates: a stalled march stops at once and is reported as capped "
+             "(counted), never a hang",
+             0.02, 1e-4, "float32 cannot step below ulp(t): the de march stalls short of "
+             "the surface and reports the pixels capped", small),
+        Case("z_resolution_1", ("march.z_resolution=1",),
+             "z_resolution 1: only the near and far samples",
+             "fixed: almost nothing hit (first sample inside only); de unaffected",
+             0.02, 1e-4, "", cheap, both_hit_min=0),
+        Case("z_resolution_1e6", ("march.z_resolution=1000000",),
+             "z_resolution 10^6: steps of ~3e-6, close to float32 spacing of t",
+             "terminates; fixed depth within a few ulp of float64",
+             0.1, 1e-5, "", tiny),
+        Case("post_steps_0", ("march.post_steps=0",),
+             "no post-stepping: depth error up to one step", "exact agreement",
+             0.02, 1e-4, "", cheap),
+        Case("post_steps_60", ("march.post_steps=60",),
+             "60 post-steps: the bracket h / 2^60 is far below float32 (and float64) spacing",
+             "terminates; depth converges to float precision and stays there",
+             0.02, 1e-4, "", cheap),
+    ]
+    return cases
+
+
+@lru_cache(maxsize=None)
+def catalogue() -> tuple[Case, ...]:
+    return tuple(_build())
+
+
+def names() -> list[str]:
+    return [c.name for c in catalogue()]
+
+
+def get(name: str) -> Case:
+    for c in catalogue():
+        if c.name == name:
+            return c
+    raise KeyError(name)
+
+
+def scene(case: Case | str, method: str, precision: str = "single") -> Scene:
+    """The scene of one case with one march method in one precision."""
+    if isinstance(case, str):
+        case = get(case)
+    return Scene.default().with_overrides(case.overrides_for(method) + [f"render.float={precision}"])

@@ -1,0 +1,157 @@
+"""Refuse hopeless settings before any kernel runs (issue 4, "Hopeless settings"),
+and refuse settings whose arithmetic the chosen precision cannot hold.
+
+``estimate(scene)`` bounds the work from above, in iterations of the set test
+(one q -> q^2 + c step with its bailout check):
+
+    fixed:  pixels x (z_resolution + 1 + post_steps) x max_iter
+    de:     pixels x (max_steps + post_steps) x max_iter
+    normals: + pixels x max_iter x (4 jacobian columns | 6 gradient estimates | 0 zbuffer)
+
+and turns it into hours with a measured throughput.  ``check(scene)`` raises a
+:class:`WorkloadError` (a SceneError: one line, starting with the key that dominates)
+above ``REFUSE_ITERATIONS`` and warns above ``WARN_ITERATIONS``; ``render(scene,
+force=True)`` skips the refusal.  render() calls it right after picking the device.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+from .scene import Scene, SceneError
+
+# Measured set-test throughput, iterations per second.  "CPU": PoCL on the 2-core
+# development machine, measured with render() on c = 0, max_iter 20000, the eye at
+# (0.1, 0.1, 0.1, 0) inside the set, fixed scan, zbuffer normals, 256x128 pixels: every
+# ray's first sample is inside, so each pixel runs exactly max_iter iterations;
+# kernel_seconds 8.9 s single (7.3e7 it/s), 9.9 s double (6.7e7 it/s).
+# "GPU" is NOT measured here (no GPU OpenCL device on the development machine): an
+# assumed 2e10 it/s, a conservative figure for a current discrete GPU (~30 flops per
+# iteration, a few TFLOP/s sustained); fp64 on consumer GPUs can be 32x slower.
+ITERATIONS_PER_SECOND = {
+    ("CPU", "single"): 7.3e7,
+    ("CPU", "double"): 6.7e7,
+    ("GPU", "single"): 2e10,
+    ("GPU", "double"): 2e10 / 32,
+}
+REFUSE_ITERATIONS = 1e13   # ~40 h on the development CPU, minutes to hours on a GPU
+WARN_ITERATIONS = 1e11     # ~25 min on the development CPU
+
+NORMAL_COST = {"jacobian": 4, "gradient": 6, "zbuffer": 0}
+
+# Defaults the dominant key is judged against (the default scene's values).
+_TYPICAL = {"image": 640 * 480, "march.z_resolution": 250, "march.max_steps": 4096,
+            "march.post_steps": 4, "fractal.max_iter": 12}
+
+
+class WorkloadError(SceneError):
+    """A legal scene that would take hours (or that the precision cannot hold)."""
+
+
+@dataclass(frozen=True)
+class Estimate:
+    iterations: float          # upper bound of set-test iterations, march + normals
+    seconds: float             # predicted at ITERATIONS_PER_SECOND[kind, precision]
+    kind: str                  # "CPU" or "GPU": the throughput used
+    dominant: str              # the dotted key furthest above its typical value
+
+    @property
+    def hours(self) -> float:
+        return self.seconds / 3600.0
+
+
+def _kind(device) -> str:
+    if device is None:
+        return "CPU"
+    if isinstance(device, str):
+        return "GPU" if device.upper() == "GPU" else "CPU"
+    from .devices import device_type
+    return "GPU" if device_type(device) == "GPU" else "CPU"
+
+
+def estimate(scene: Scene, device=None) -> Estimate:
+    """Upper bound of the work of ``scene`` and its predicted time on ``device``
+    (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
+    f, m = scene.fractal, scene.march
+    pixels = scene.image.width * scene.image.height
+    if m.method == "fixed":
+        per_ray = m.z_resolution + 1 + m.post_steps
+        march_key = "march.z_resolution"
+    else:
+        per_ray = m.max_steps + m.post_steps
+        march_key = "march.max_steps"
+    its = float(pixels) * per_ray * f.max_iter
+    its += float(pixels) * f.max_iter * NORMAL_COST.get(scene.normals.method, 6)
+    kind = _kind(device)
+    ips = ITERATIONS_PER_SECOND[kind, scene.render.float]
+    factors = {"image": pixels, march_key: getattr(m, march_key.split(".")[1]),
+               "march.post_steps": max(m.post_steps, 1), "fractal.max_iter": f.max_iter}
+    dominant = max(factors, key=lambda k: factors[k] / _TYPICAL[k])
+    if dominant == "image":
+        dominant = "image.width" if scene.image.width >= scene.image.height else "image.height"
+    return Estimate(its, its / ips, kind, dominant)
+
+
+def _value(scene: Scene, dotted: str):
+    section, _, key = dotted.partition(".")
+    return getattr(getattr(scene, section), key)
+
+
+# The largest bailout whose square survives one more squaring: the iterate that first
+# exceeds the bailout has |q|^2 <= (bailout^2 + |c|)^2, which must stay below REAL_MAX / 4
+# (the margin covers the dot product and the derivative's 4 |q|^2 factor).  float32:
+# bailout <= ~9.6e8 (measured: 1e10 turns 34% of a de image's hits into misses, 1e20
+# squares to inf and zeroes the normals).
+REAL_MAX = {"single": 3.4028234663852886e38, "double": 1.7976931348623157e308}
+
+
+def max_bailout(precision: str, cabs: float = 0.0) -> float:
+    return math.sqrt(math.sqrt(REAL_MAX[precision] / 4.0) - cabs)
+
+
+def check_numerics(scene: Scene) -> None:
+    """Refuse settings the kernels' arithmetic cannot hold (always; not skipped by force)."""
+    f, m = scene.fractal, scene.march
+    cabs = math.sqrt(sum(x * x for x in f.c))
+    lim = max_bailout(scene.render.float, cabs)
+    if f.bailout > lim:
+        alt = ' or render.float="double"' if scene.render.float == "single" else ""
+        raise WorkloadError("fractal.bailout",
+                            f"{f.bailout:g} overflows {scene.render.float} precision (|q|^2 "
+                            f"reaches ~1e{4 * math.log10(f.bailout):.0f} one squaring past the "
+                            f"bailout, above {REAL_MAX[scene.render.float]:.1e}); use at most "
+                            f"{lim:.2g}{alt}")
+    if m.method == "de" and scene.render.float == "single":
+        from .camera import camera_frame, march_radius
+        t_far = float(sum(x * x for x in camera_frame(scene).position)) ** 0.5 + march_radius(scene)
+        ulp = t_far * 2.0 ** -23
+        if m.epsilon < ulp / 2:
+            warnings.warn(f"march.epsilon: {m.epsilon:g} is below half the float32 spacing of the "
+                          f"ray parameter ({ulp:.1e} at t = {t_far:.3g}): the de march will stall "
+                          f"short of the surface (pixels reported capped, counted as "
+                          f'guards["stalled"]); raise it or use render.float="double"',
+                          RuntimeWarning, stacklevel=4)
+    # the fixed scan counts i = 0 .. z_resolution and post-stepping n = 1 .. post_steps in
+    # an OpenCL int: at 2^31 - 1 the loop counter would overflow instead of ending
+    for key, v in (("march.z_resolution", m.z_resolution), ("march.post_steps", m.post_steps)):
+        if v >= 2**31 - 2:
+            raise WorkloadError(key, f"must be below {2**31 - 2} (the kernel's int loop counter), got {v}")
+
+
+def check(scene: Scene, device=None, force: bool = False) -> Estimate:
+    """Before any kernel runs: refuse what the precision cannot hold, refuse work above
+    REFUSE_ITERATIONS (unless ``force``), warn above WARN_ITERATIONS.  Returns the estimate."""
+    check_numerics(scene)
+    est = estimate(scene, device)
+    text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
+            f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
+            f"on a {est.kind}")
+    if est.iterations > REFUSE_ITERATIONS and not force:
+        raise WorkloadError(est.dominant,
+                            f"{_value(scene, est.dominant)} would take {text}, over the limit of "
+                            f"{REFUSE_ITERATIONS:.0e}; lower {est.dominant} or pass force=True")
+    if est.iterations > WARN_ITERATIONS:
+        warnings.warn(f"{est.dominant}: {_value(scene, est.dominant)} may take {text}",
+                      RuntimeWarning, stacklevel=3)
+    return est
