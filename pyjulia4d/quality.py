@@ -1,0 +1,59 @@
+"""Quality presets: one knob (``march.quality`` = draft | normal | final) that picks
+march settings from the measured error-against-time trade-off (issue 3).
+
+How they were derived: ``benchmarks/error_vs_time.py`` (results in
+benchmarks/results/error_vs_time.csv and .md, section "Cheapest settings meeting an
+error bound on every scene") rendered nine scenes - seed 000's Figs. 1, 5, 6, 8
+(max_iter 8 and 12) and 9, POV-Ray's example, c = 0 and real c = -1 - with every
+fixed (z_resolution x post_steps) and distance-estimate (epsilon x post_steps)
+setting of its grid, against ground truth from pyjulia4d/truth.py.  Each preset is
+the setting with the least total kernel time over the nine scenes whose depth error
+at the 99th percentile of the pixels that hit is within the preset's ``p99_bound``
+(scene units) on *every* scene, with the silhouette (pixels hit by one of render
+and truth but not the other) wrong on at most ``silhouette_bound`` of the pixels.
+Such a setting is on the Pareto front by construction.  The bounds are what was
+measured on those scenes at the benchmark's image size; a scene with thinner parts
+than any of them (high max_iter, seed 000 Fig. 4 and 9) can need a finer
+z-resolution than the preset gives.
+"""
+from __future__ import annotations
+
+from .scene import Scene
+
+QUALITIES = ("custom", "draft", "normal", "final")
+
+# From benchmarks/results/error_vs_time.md (96x72 px, PoCL on 2 CPU cores), section
+# "Cheapest settings meeting an error bound on every scene".  Measured worst case over
+# the nine scenes: draft p99 0.0275, silhouette 0.04 %; normal p99 2.6e-5; final p99
+# 1.2e-6 (float32's floor: the kernels place p = o + t d to ~1e-6).  Total kernel time
+# over the nine scenes: 0.14 s, 0.16 s, 0.20 s - against 1.25 s for the cheapest fixed
+# scan within 1e-4 (z_resolution 4000 with 10 post-steps).
+PRESETS: dict[str, dict] = {
+    "draft": {"method": "de", "z_resolution": 250, "post_steps": 0, "epsilon": 1e-4,
+              "p99_bound": 3e-2, "silhouette_bound": 0.005},
+    "normal": {"method": "de", "z_resolution": 250, "post_steps": 10, "epsilon": 1e-5,
+               "p99_bound": 1e-4, "silhouette_bound": 0.005},
+    "final": {"method": "de", "z_resolution": 250, "post_steps": 20, "epsilon": 1e-5,
+              "p99_bound": 2e-6, "silhouette_bound": 0.005},
+}
+
+MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon")
+
+
+def preset_overrides(quality: str) -> list[str]:
+    """The ``march.*=VALUE`` overrides of one preset."""
+    p = PRESETS[quality]
+    return [f"march.{k}={p[k]}" for k in MARCH_KEYS]
+
+
+def apply_quality(scene: Scene, quality: str | None = None) -> Scene:
+    """``scene`` with the preset's march.method / z_resolution / post_steps / epsilon
+    applied, for ``quality`` (default: ``scene.march.quality``, "custom" if the scene
+    has no such key).  "custom" returns the scene unchanged."""
+    if quality is None:
+        quality = getattr(scene.march, "quality", "custom")
+    if quality == "custom":
+        return scene
+    if quality not in PRESETS:
+        raise ValueError(f"march.quality: expected one of {', '.join(map(repr, QUALITIES))}, got {quality!r}")
+    return scene.with_overrides(preset_overrides(quality))

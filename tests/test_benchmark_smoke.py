@@ -1,0 +1,36 @@
+"""CI smoke run of benchmarks/error_vs_time.py --quick, so the benchmark cannot rot."""
+import csv
+import importlib.util
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def load_benchmark():
+    spec = importlib.util.spec_from_file_location("error_vs_time", ROOT / "benchmarks" / "error_vs_time.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_quick_run_writes_sane_results(tmp_path):
+    bench = load_benchmark()
+    assert bench.main(["--quick", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "error_vs_time.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows and set(bench.COLUMNS) <= set(rows[0])
+    assert {r["scene"] for r in rows} == set(bench.QUICK_SCENES)
+    assert {r["method"] for r in rows} == {"fixed", "de"}
+    for r in rows:
+        assert float(r["kernel_s"]) > 0 and float(r["render_s"]) >= float(r["kernel_s"])
+        assert 0 <= float(r["silhouette_err"]) <= 1
+        assert 0 <= float(r["depth_err_median"]) <= float(r["depth_err_p99"]) <= float(r["depth_err_max"]) < 1
+        for m in bench.NORMAL_METHODS:
+            assert 0 <= float(r[f"normal_err_{m}_median"]) <= 180
+        assert r["device"] and r["commit"] and r["date"]
+    # post-stepping makes the fixed scan's depth more accurate (seed 000 eq. 12)
+    sphere = {(r["method"], r["post_steps"]): float(r["depth_err_p99"]) for r in rows if r["scene"] == "sphere"}
+    assert sphere[("fixed", "10")] < sphere[("fixed", "0")] / 100
+    md = (tmp_path / "error_vs_time.md").read_text()
+    assert "device:" in md and "commit:" in md and "| method | z_res |" in md
+    assert (tmp_path / "error_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -1,0 +1,59 @@
+"""Each quality preset meets its stated error on the exact oracles: c = 0 (the ball)
+and real c (the 2D oracle)."""
+import numpy as np
+import pytest
+
+from pyjulia4d import reference as ref
+from pyjulia4d import truth
+from pyjulia4d.camera import camera_frame
+from pyjulia4d.quality import PRESETS, apply_quality, preset_overrides
+from pyjulia4d.render import render
+from pyjulia4d.scene import Scene
+
+W, H = 40, 30
+ORACLES = {
+    "sphere": ["fractal.c=0,0,0,0"],
+    "real": ["fractal.c=-1,0,0,0"],
+}
+
+
+@pytest.fixture(scope="module")
+def truths():
+    out = {}
+    for name, over in ORACLES.items():
+        s = Scene.default().with_overrides(over + [f"image.width={W}", f"image.height={H}"])
+        out[name] = (s, truth.ground_truth(s, n_scan=4000))
+    return out
+
+
+@pytest.mark.parametrize("quality", list(PRESETS))
+@pytest.mark.parametrize("oracle", list(ORACLES))
+def test_preset_meets_its_stated_error(truths, quality, oracle):
+    scene, tr = truths[oracle]
+    s = apply_quality(scene, quality)
+    p = PRESETS[quality]
+    assert (s.march.method, s.march.z_resolution, s.march.post_steps, s.march.epsilon) == \
+        (p["method"], p["z_resolution"], p["post_steps"], p["epsilon"])
+    res = render(s)
+    hit = res.status == 1
+    both = hit & tr.hit
+    assert both.sum() > 0.2 * W * H
+    err = np.abs(res.depth[both].astype(np.float64) - tr.depth[both])
+    assert np.mean(hit != tr.hit) <= p["silhouette_bound"]
+    assert np.percentile(err, 99) <= p["p99_bound"]
+
+
+def test_custom_leaves_the_scene_alone():
+    s = Scene.default().with_overrides(["march.z_resolution=123"])
+    assert apply_quality(s, "custom") is s
+    if hasattr(s.march, "quality"):          # march.quality defaults to "custom"
+        assert apply_quality(s) is s
+
+
+def test_presets_are_valid_overrides_and_ordered():
+    bounds = [PRESETS[q]["p99_bound"] for q in ("draft", "normal", "final")]
+    assert bounds == sorted(bounds, reverse=True)
+    for q in PRESETS:
+        Scene.default().with_overrides(preset_overrides(q))
+    with pytest.raises(ValueError):
+        apply_quality(Scene.default(), "ultra")
