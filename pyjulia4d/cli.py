@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -25,6 +26,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable)")
     r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
+    r.add_argument("--force", action="store_true",
+                   help="render settings whose estimated work is refused as hopeless (hours)")
 
     sub.add_parser("devices", help="list the OpenCL devices")
     return ap
@@ -54,7 +57,7 @@ def _render(args: argparse.Namespace) -> int:
 
     from .render import render  # heavy (kernel build); only once the input is known good
 
-    result = render(scene, device=device, progress=True)
+    result = render(scene, device=device, progress=True, force=args.force)
     header = {
         "pyjulia4d.scene": scene.to_toml(),
         "pyjulia4d.device": result.device_name,
@@ -73,9 +76,14 @@ def _one_line(e: BaseException) -> str:
     return " ".join(str(e).splitlines()) or type(e).__name__
 
 
+def _warn_one_line(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"pyjulia4d: warning: {_one_line(Warning(message))}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit status (2 on bad input, 130 on Ctrl-C)."""
     args = _parser().parse_args(argv)
+    warnings.showwarning = _warn_one_line  # workload and precision warnings: one line each
     try:
         if args.command == "devices":
             from .devices import describe_devices

@@ -18,7 +18,10 @@ z-resolution than the preset gives.
 """
 from __future__ import annotations
 
-from .scene import Scene
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # scene.py imports this module for the presets
+    from .scene import Scene
 
 QUALITIES = ("custom", "draft", "normal", "final")
 
@@ -40,20 +43,24 @@ PRESETS: dict[str, dict] = {
 MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon")
 
 
-def preset_overrides(quality: str) -> list[str]:
-    """The ``march.*=VALUE`` overrides of one preset."""
-    p = PRESETS[quality]
-    return [f"march.{k}={p[k]}" for k in MARCH_KEYS]
-
-
-def apply_quality(scene: Scene, quality: str | None = None) -> Scene:
-    """``scene`` with the preset's march.method / z_resolution / post_steps / epsilon
-    applied, for ``quality`` (default: ``scene.march.quality``, "custom" if the scene
-    has no such key).  "custom" returns the scene unchanged."""
-    if quality is None:
-        quality = getattr(scene.march, "quality", "custom")
+def preset_values(quality: str) -> dict:
+    """The march keys a preset sets ({} for "custom")."""
     if quality == "custom":
-        return scene
+        return {}
     if quality not in PRESETS:
         raise ValueError(f"march.quality: expected one of {', '.join(map(repr, QUALITIES))}, got {quality!r}")
-    return scene.with_overrides(preset_overrides(quality))
+    return {k: PRESETS[quality][k] for k in MARCH_KEYS}
+
+
+def preset_overrides(quality: str) -> list[str]:
+    """The ``march.*=VALUE`` overrides of one preset."""
+    return [f"march.{k}={v}" for k, v in preset_values(quality).items()]
+
+
+def apply_quality(scene: Scene, quality: str) -> Scene:
+    """``scene`` with ``march.quality`` set to ``quality``: the preset's method,
+    z_resolution, post_steps and epsilon replace the scene's ("custom" changes nothing)."""
+    if quality == "custom":
+        return scene
+    preset_values(quality)  # the error for an unknown name
+    return scene.with_overrides([f"march.quality={quality}"])

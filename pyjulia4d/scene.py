@@ -6,12 +6,15 @@ overrides are applied, and the result is validated in one pass. Every error is a
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import sys
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, Mapping, Union
+
+from .quality import PRESETS, QUALITIES, preset_values
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -77,8 +80,10 @@ class Slice:
 
 @dataclass(frozen=True)
 class March:
-    """[march]: how rays find the surface."""
+    """[march]: how rays find the surface.  ``quality`` other than "custom" sets
+    method, z_resolution, post_steps and epsilon from a measured preset (quality.py)."""
 
+    quality: str = "custom"
     method: str = "de"
     z_resolution: int = 250
     post_steps: int = 4
@@ -261,6 +266,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "distance": _real(),
     },
     "march": {
+        "quality": _choice(*QUALITIES),
         "method": _choice("fixed", "de"),
         "z_resolution": _integer(1),
         "post_steps": _integer(0),
@@ -291,6 +297,16 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "float": _choice("single", "double"),
     },
 }
+
+
+def _apply_quality(march: dict[str, Any], keep: set[str]) -> None:
+    """Set the preset's march values for ``march["quality"]``, except the keys in ``keep``."""
+    if "quality" not in march:
+        return
+    quality = _CHECKS["march"]["quality"]("march.quality", march["quality"])
+    for k, v in preset_values(quality).items():
+        if k not in keep:
+            march[k] = v
 
 
 # ---------------------------------------------------------------- overrides
@@ -417,11 +433,16 @@ class Scene:
                 if key not in _CHECKS[section]:
                     raise SceneError(f"{section}.{key}", "unknown key")
                 raw[section][key] = value
+        # A quality preset fills the march keys the same source does not set itself;
+        # a later source (an override) wins over an earlier one.
+        _apply_quality(raw["march"], keep=set(raw["march"]))
         if isinstance(overrides, str):  # a lone string would be iterated per character
             overrides = [overrides]
         for text in overrides:
             section, key, value = _parse_override(text)
             raw[section][key] = value
+            if (section, key) == ("march", "quality"):
+                _apply_quality(raw["march"], keep=set())
         return cls._build(raw)
 
     @classmethod
@@ -448,6 +469,10 @@ class Scene:
         scene = cls(**parts)
         _check_camera(scene.camera)
         m = scene.march
+        if m.quality != "custom" and any(getattr(m, k) != v for k, v in preset_values(m.quality).items()):
+            # a march key set after the preset: the resolved scene says what really runs
+            scene = dataclasses.replace(scene, march=dataclasses.replace(m, quality="custom"))
+            m = scene.march
         if not isinstance(m.near, str) and not isinstance(m.far, str) and m.far <= m.near:
             raise SceneError("march.far", f"must be greater than march.near ({m.near!r}), got {m.far!r}")
         return scene

@@ -149,9 +149,10 @@ def check(scene: Scene, device=None, force: bool = False) -> Estimate:
             f"on a {est.kind}")
     if est.iterations > REFUSE_ITERATIONS and not force:
         raise WorkloadError(est.dominant,
-                            f"{_value(scene, est.dominant)} would take {text}, over the limit of "
-                            f"{REFUSE_ITERATIONS:.0e}; lower {est.dominant} or pass force=True")
+                            f"{_value(scene, est.dominant)} could take {text}, over the limit of "
+                            f"{REFUSE_ITERATIONS:.0e}; lower {est.dominant}, or force it "
+                            f"(--force; render(..., force=True))")
     if est.iterations > WARN_ITERATIONS:
-        warnings.warn(f"{est.dominant}: {_value(scene, est.dominant)} may take {text}",
+        warnings.warn(f"{est.dominant}: {_value(scene, est.dominant)} may take up to {text}",
                       RuntimeWarning, stacklevel=3)
     return est

@@ -139,7 +139,7 @@ class FakeRender:
         self.calls: list[tuple] = []
         self.exc: BaseException | None = None
 
-    def __call__(self, scene, device=None, progress=False) -> FakeResult:
+    def __call__(self, scene, device=None, progress=False, force=False) -> FakeResult:
         self.calls.append((scene, device, progress))
         if self.exc is not None:
             raise self.exc
@@ -189,3 +189,26 @@ def test_render_failure(tmp_path, monkeypatch, fake_render, capsys, exc, status,
     captured = capsys.readouterr()
     assert captured.err.splitlines() == [line] and captured.out == ""
     assert list(tmp_path.iterdir()) == []
+
+
+def test_hopeless_settings_refused_by_the_cli(tmp_path: Path) -> None:
+    """A legal scene estimated at hours of work: one line naming the key, status 2, no file."""
+    out = tmp_path / "big.png"
+    p = run_cli(["render", "-o", str(out), "--width", "3840", "--height", "2160",
+                 "--set", "march.method=fixed", "--set", "march.z_resolution=1000000000"], tmp_path)
+    assert p.returncode == 2, p.stderr
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("pyjulia4d: error: march.z_resolution: 1000000000 ")
+    assert "--force" in lines[0] and "Traceback" not in p.stderr
+    assert not out.exists()
+
+
+def test_precision_warning_is_one_line(tmp_path: Path) -> None:
+    """A warning (epsilon below float32's spacing) is one stderr line; the render still runs."""
+    out = tmp_path / "w.png"
+    p = run_cli(["render", "-o", str(out), "--width", "8", "--height", "6",
+                 "--set", "march.epsilon=1e-9"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    warn = [l for l in p.stderr.splitlines() if "warning" in l]
+    assert len(warn) == 1 and warn[0].startswith("pyjulia4d: warning: march.epsilon: 1e-09 is below")
+    assert "RuntimeWarning" not in p.stderr and out.exists()

@@ -45,9 +45,27 @@ def test_preset_meets_its_stated_error(truths, quality, oracle):
 
 def test_custom_leaves_the_scene_alone():
     s = Scene.default().with_overrides(["march.z_resolution=123"])
+    assert s.march.quality == "custom"
     assert apply_quality(s, "custom") is s
-    if hasattr(s.march, "quality"):          # march.quality defaults to "custom"
-        assert apply_quality(s) is s
+
+
+def test_quality_key_sets_the_march_and_explicit_keys_win():
+    s = Scene.from_dict({"march": {"quality": "final"}})
+    p = PRESETS["final"]
+    assert (s.march.quality, s.march.method, s.march.post_steps, s.march.epsilon) == \
+        ("final", p["method"], p["post_steps"], p["epsilon"])
+    # a key set in the same table as the quality wins, and the scene says it is custom now
+    s2 = Scene.from_dict({"march": {"quality": "final", "epsilon": 1e-3}})
+    assert s2.march.epsilon == 1e-3 and s2.march.post_steps == p["post_steps"]
+    assert s2.march.quality == "custom"
+    # an override after the file wins over the file; a later quality override wins over keys
+    s3 = Scene.from_dict({"march": {"method": "fixed", "z_resolution": 99}}, ["march.quality=draft"])
+    assert s3.march.method == PRESETS["draft"]["method"] and s3.march.quality == "draft"
+    s4 = Scene.from_dict({"march": {"quality": "draft"}}, ["march.post_steps=7"])
+    assert s4.march.post_steps == 7 and s4.march.quality == "custom"
+    # the resolved scene round-trips through TOML unchanged
+    assert Scene.from_dict(s.to_dict()) == s
+    assert Scene.from_dict(s2.to_dict()) == s2
 
 
 def test_presets_are_valid_overrides_and_ordered():
