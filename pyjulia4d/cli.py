@@ -62,12 +62,18 @@ def _render(args: argparse.Namespace) -> int:
         "pyjulia4d.scene": scene.to_toml(),
         "pyjulia4d.device": result.device_name,
         "pyjulia4d.render_seconds": "%.6f" % result.seconds,
+        "pyjulia4d.capped_pixels": str(result.capped),
+        "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in result.guards.items()),
     }
     write_image(out, result, header)
     w, h = scene.image.width, scene.image.height
+    # guards that fired and capped rays are part of the result: say so (never hidden)
+    fired = [f"{k} {v}" for k, v in result.guards.items() if v]
+    extra = f", {result.capped} capped" if result.capped else ""
+    extra += f"; guards fired: {', '.join(fired)}" if fired else ""
     print(
         f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}, "
-        f"{100 * result.hit_fraction:.1f}% of pixels hit"
+        f"{100 * result.hit_fraction:.1f}% of pixels hit{extra}"
     )
     return 0
 

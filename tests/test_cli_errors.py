@@ -127,6 +127,8 @@ class FakeResult:
         self.device_name = "fake device"
         self.seconds = 1.234
         self.hit_fraction = 0.412
+        self.capped = 0
+        self.guards = {"stalled": 0, "normal_fallback": 0}
 
     def exr_channels(self) -> dict[str, np.ndarray]:
         return {"R": self.color[..., 0], "A": self.alpha}

@@ -60,6 +60,15 @@ def test_cli_renders_exr_with_all_channels(tmp_path):
     back = Scene.from_toml(tmp_path / "back.toml")
     assert back.fractal.c == (-0.8, 0.4, 0.0, 0.0) and back.image.width == 40
     assert h["pyjulia4d.device"] and float(h["pyjulia4d.render_seconds"]) > 0
+    assert h["pyjulia4d.capped_pixels"] == "0" and "normal_fallback=" in h["pyjulia4d.guards"]
+
+
+def test_cli_reports_guards_that_fired(tmp_path):
+    """The eye inside the set: every pixel is a hit at the eye; the closing line counts it."""
+    p = cli("--width", "8", "--height", "6", "--set", "camera.position=0.05,0.1,-0.1,0",
+            "--set", "camera.target=0,0,1,0", "-o", "in.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip().endswith("100.0% of pixels hit; guards fired: eye_hit 48")
 
 
 def test_cli_default_scene_png(tmp_path):
