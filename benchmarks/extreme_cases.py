@@ -37,7 +37,7 @@ if str(ROOT) not in sys.path:
 from pyjulia4d import catalogue as cat  # noqa: E402
 from pyjulia4d.render import STATUS_HIT, render  # noqa: E402
 
-GUARDS = ("stalled", "normal_fallback", "jacobian_tiny", "eye_hit")
+GUARDS = ("ulp_step", "normal_fallback", "jacobian_tiny", "eye_hit")
 
 
 def leaks(r) -> int:

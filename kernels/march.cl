@@ -1,14 +1,15 @@
 /* march.cl: the march kernel, one ray per work-item.  The ray o + t d (|d| = 1)
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
- * iteration.  near/far < 0 mean "the sphere's entry/exit". */
+ * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
+ * guard flags (real.cl), 0 when none fired. */
 
 __kernel void march(__global const real4 *origins, __global const real4 *dirs,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
-                    __global int *status, __global int *samples)
+                    __global int *status, __global int *samples, __global int *flags)
 {
     size_t i = get_global_id(0);
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
@@ -26,6 +27,7 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
     real disc = radius * radius - dot(perp, perp);
     int st = STATUS_MISS;
     int n = 0;
+    int fl = 0;
     real t = INFINITY;
     if (disc >= (real)0) {
         real s = sqrt(disc);
@@ -34,10 +36,11 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
         if (near_set >= (real)0) near = near_set;
         if (far_set >= (real)0) far = far_set;
         if (far >= near)
-            t = march_ray(o, d, near, far, jp, z_resolution, post_steps, max_steps, &st, &n);
+            t = march_ray(o, d, near, far, jp, z_resolution, post_steps, max_steps, &st, &n, &fl);
     }
     depth[i] = t;
     point[i] = st == STATUS_HIT ? o + t * d : (real4)(NAN);
     status[i] = st;
     samples[i] = n;
+    flags[i] = fl;
 }

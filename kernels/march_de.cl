@@ -3,12 +3,21 @@
  * a hit when d < epsilon (which adds thickness to thin dendrites, seed 001 §3.3).
  * The march starts at the bounding sphere (seed 001 §3.4 avoids bad estimates far
  * away) and is capped at max_steps estimates; a ray that runs into the cap is
- * reported as STATUS_CAPPED, never left running. */
+ * reported as STATUS_CAPPED, never left running.
+ *
+ * Precision: where max(d, epsilon) is below half the spacing of t (epsilon under
+ * ulp(t) / 2, or d that small just outside the surface), t + step rounds back to t
+ * and the march could not advance.  The step is then raised to one ulp of t (the
+ * next representable t), so the effective epsilon becomes the spacing of t - seed
+ * 001 §4.2's epsilon as a function of distance, forced by the number format - and
+ * the march walks ulp by ulp until d < epsilon or the point is inside (d = 0).
+ * Flagged GUARD_ULP_STEP and counted on the host. */
 
 inline int hit_test(real4 p, julia_params jp) { return julia_distance(p, jp) < jp.epsilon; }
 
 inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
-                      int z_resolution, int post_steps, int max_steps, int *status, int *samples)
+                      int z_resolution, int post_steps, int max_steps, int *status, int *samples,
+                      int *flags)
 {
     real t = near;
     real t_prev = near;
@@ -30,10 +39,9 @@ inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
         }
         t_prev = t;
         t += fmax(dist, jp.epsilon);
-        if (t == t_prev) {          /* step below the spacing of t (epsilon < ulp(t) / 2): */
-            *samples = i + 1;       /* the march cannot advance; stop now, reported as    */
-            *status = STATUS_CAPPED;/* capped (counted; samples < max_steps tells them   */
-            return INFINITY;        /* apart from the step cap), not spun to max_steps    */
+        if (t == t_prev) {          /* the step rounded away: one ulp instead (see above) */
+            t = nextafter(t_prev, (real)INFINITY);
+            *flags |= GUARD_ULP_STEP;
         }
     }
     *samples = max_steps;

@@ -6,7 +6,8 @@
 inline int hit_test(real4 p, julia_params jp) { return julia_inside(p, jp); }
 
 inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
-                      int z_resolution, int post_steps, int max_steps, int *status, int *samples)
+                      int z_resolution, int post_steps, int max_steps, int *status, int *samples,
+                      int *flags)
 {
     real h = (far - near) / (real)z_resolution;
     for (int i = 0; i <= z_resolution; ++i) {

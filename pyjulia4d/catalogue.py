@@ -184,10 +184,10 @@ def _build() -> list[Case]:
                                    "fractal.max_iter=100"),
              "epsilon 1e-8 below float32 spacing at the hit distance (ulp(2.5) = 2.4e-7): "
              "t + d == t, the DE march cannot advance",
-             "terminates: a stalled march stops at once and is reported as capped "
-             "(counted), never a hang",
-             0.02, 1e-4, "float32 cannot step below ulp(t): the de march stalls short of "
-             "the surface and reports the pixels capped", small),
+             "terminates: where the step rounds away the march steps one ulp of t "
+             "(effective epsilon = ulp(t), counted as ulp_step), never a stall or a hang; "
+             "depth within 1e-5 of float64 (median one ulp)",
+             0.05, 1e-5, "", small, fixed_depth_tol=1e-3),
         Case("z_resolution_1", ("march.z_resolution=1",),
              "z_resolution 1: only the near and far samples",
              "fixed: almost nothing hit (first sample inside only); de unaffected",

@@ -21,6 +21,7 @@ REAL_MIN = np.finfo(np.float64).tiny
 # returned through the optional ``guard`` array here; RenderResult.guards counts them.
 GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
 GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
+GUARD_ULP_STEP = 4          # de: a step below the spacing of t raised to one ulp (march's flags)
 
 
 def _dot(a, b):
@@ -139,7 +140,7 @@ def post_step(o, d, t_hit, h0, steps, hit_test):
 # ---------------------------------------------------- march_fixed.cl / march_de.cl
 
 def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps):
-    """Fixed z-resolution scan (seed 000 §3) plus post-stepping; returns (t, status, samples)."""
+    """Fixed z-resolution scan (seed 000 §3) plus post-stepping; returns (t, status, samples, flags)."""
     n = len(o)
     h = (far - near) / z_resolution
     t = np.full(n, np.inf)
@@ -164,16 +165,19 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
         k = np.nonzero(refine)[0]
         t[k] = post_step(o[k], d[k], t[k], h[k], post_steps,
                          lambda p: julia_inside(p, c, max_iter, bailout))
-    return t, status, samples
+    return t, status, samples, np.zeros(n, np.int32)
 
 
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps):
-    """r_{n+1} = r_n + m max(d(r_n), eps), hit when d < eps (seed 001 §3.2 eq. 9)."""
+    """r_{n+1} = r_n + m max(d(r_n), eps), hit when d < eps (seed 001 §3.2 eq. 9); a step
+    that rounds away (t + step == t) becomes one ulp of t, flagged GUARD_ULP_STEP
+    (march_de.cl).  Returns (t, status, samples, flags)."""
     n = len(o)
     t = near.copy()
     t_prev = near.copy()
     status = np.full(n, STATUS_CAPPED, np.int32)
     samples = np.full(n, max_steps, np.int32)
+    flags = np.zeros(n, np.int32)
     active = np.ones(n, bool)
     for i in range(max_steps):
         idx = np.nonzero(active)[0]
@@ -196,20 +200,19 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         k = idx[~hit]
         t_prev[k] = t[k]
         t[k] = t[k] + np.maximum(dist[~hit], epsilon)
-        # the step fell below the spacing of t: stop, reported capped (march_de.cl)
         stall = k[t[k] == t_prev[k]]
-        status[stall] = STATUS_CAPPED
-        samples[stall] = i + 1
-        active[stall] = False
+        t[stall] = np.nextafter(t_prev[stall], np.inf)
+        flags[stall] |= GUARD_ULP_STEP
     t[status != STATUS_HIT] = np.inf
-    return t, status, samples
+    return t, status, samples, flags
 
 
 # --------------------------------------------------------------------- march.cl
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
-          z_resolution, post_steps, max_steps, method):
-    """Clip each ray to the bounding 4-ball, then march; returns (depth, point, status, samples)."""
+          z_resolution, post_steps, max_steps, method, flags=None):
+    """Clip each ray to the bounding 4-ball, then march; returns (depth, point, status, samples).
+    ``flags`` (int array, optional) gets the march's guard flags (march.cl's flags buffer)."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = _dot(o, d)
@@ -231,8 +234,10 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     k = np.nonzero(live)[0]
     if k.size:
         fn = march_fixed if method == "fixed" else march_de
-        depth[k], status[k], samples[k] = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
-                                             epsilon, z_resolution, post_steps, max_steps)
+        depth[k], status[k], samples[k], fl = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
+                                                 epsilon, z_resolution, post_steps, max_steps)
+        if flags is not None:
+            flags[k] |= fl
     depth[status != STATUS_HIT] = np.inf
     point = np.where((status == STATUS_HIT)[:, None], o + np.where(np.isfinite(depth), depth, 0)[:, None] * d, np.nan)
     return depth, point, status, samples
@@ -439,10 +444,10 @@ def render(scene: Scene) -> RenderResult:
     origins, dirs = generate_rays(frame, w, h)
     near = -1.0 if m.near == "auto" else float(m.near)
     far = -1.0 if m.far == "auto" else float(m.far)
+    guard = np.zeros(len(origins), np.int64)
     depth, point, status, samples = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
-                                          m.post_steps, m.max_steps, m.method)
-    guard = np.zeros(len(status), np.int64)
+                                          m.post_steps, m.max_steps, m.method, guard)
     if scene.normals.method == "jacobian":
         normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard)
     elif scene.normals.method == "gradient":
@@ -456,6 +461,6 @@ def render(scene: Scene) -> RenderResult:
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
                        samples=samples.reshape(h, w), device_name="numpy float64 reference",
-                       guards=count_guards(status, samples, depth, guard, m.max_steps))
+                       guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

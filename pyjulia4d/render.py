@@ -58,15 +58,16 @@ class RenderResult:
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
 
 
-def count_guards(status, samples, depth, guard, max_steps) -> dict[str, int]:
+def count_guards(status, depth, guard) -> dict[str, int]:
     """Pixels each numerical guard fired on (issue 4: nothing clamped without being counted).
-    ``guard`` holds the flags the normals kernels write into the normal's w (kernels/real.cl)."""
-    status, samples, guard = (np.asarray(a).ravel() for a in (status, samples, guard))
+    ``guard`` holds the flags (kernels/real.cl) of the march kernel's flags buffer ORed
+    with those the normals kernels write into the normal's w."""
+    status, guard = (np.asarray(a).ravel() for a in (status, guard))
     hit = status == STATUS_HIT
     guard = guard.astype(np.int64)
     return {
-        # de march stopped because t + step == t (march_de.cl), reported STATUS_CAPPED
-        "stalled": int(np.sum((status == STATUS_CAPPED) & (samples < max_steps))),
+        # de step below the spacing of t raised to one ulp (march_de.cl): effective epsilon = ulp(t)
+        "ulp_step": int(np.sum((guard & 4) != 0)),
         # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
         "normal_fallback": int(np.sum(hit & ((guard & 1) != 0))),
         # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
@@ -128,6 +129,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     point = cla.empty(queue, n, pr.vec_dtype)
     status = cla.empty(queue, n, np.int32)
     samples = cla.empty(queue, n, np.int32)
+    flags = cla.empty(queue, n, np.int32)
     normal = cla.empty(queue, n, pr.vec_dtype)
     rgba = cla.empty(queue, n, cl.cltypes.float4)
 
@@ -143,7 +145,8 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     march_args = (origins.data, dirs.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
                   pr.scalar(m.epsilon), pr.scalar(march_radius(scene)), pr.scalar(near),
                   pr.scalar(far), np.int32(m.z_resolution), np.int32(m.post_steps),
-                  np.int32(m.max_steps), depth.data, point.data, status.data, samples.data)
+                  np.int32(m.max_steps), depth.data, point.data, status.data, samples.data,
+                  flags.data)
     # rows in chunks, so a progress bar can move and no single launch runs for minutes
     rows = max(1, min(h, (1 << 16) // w))
     march_kernel = cl.Kernel(prg, "march")
@@ -181,7 +184,8 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         return a.get().view(pr.scalar).reshape(h, w, 4)[..., :k].astype(np.float32)
 
     col = rgba.get().view(np.float32).reshape(h, w, 4)
-    nflags = normal.get().view(pr.scalar).reshape(n, 4)[:, 3]  # guard flags (kernels/real.cl)
+    # guard flags (kernels/real.cl): the march's buffer and the normals' w
+    gflags = flags.get() | normal.get().view(pr.scalar).reshape(n, 4)[:, 3].astype(np.int32)
     st, sm = status.get(), samples.get()
     result = RenderResult(
         color=np.ascontiguousarray(col[..., :3]), alpha=np.ascontiguousarray(col[..., 3]),
@@ -189,7 +193,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         normal=vec(normal, 3), position=vec(point, 4),
         status=st.reshape(h, w), samples=sm.reshape(h, w),
         device_name=dev.name.strip(), kernel_seconds=kernel_seconds,
-        guards=count_guards(st, sm, depth.get(), nflags, m.max_steps))
+        guards=count_guards(st, depth.get(), gflags))
     result.seconds = time.perf_counter() - t_start
     return result
 

@@ -128,9 +128,10 @@ def check_numerics(scene: Scene) -> None:
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:
             warnings.warn(f"march.epsilon: {m.epsilon:g} is below half the float32 spacing of the "
-                          f"ray parameter ({ulp:.1e} at t = {t_far:.3g}): the de march will stall "
-                          f"short of the surface (pixels reported capped, counted as "
-                          f'guards["stalled"]); raise it or use render.float="double"',
+                          f"ray parameter ({ulp:.1e} at t = {t_far:.3g}): the de march will step by "
+                          f"that spacing instead where the estimate is smaller (effective "
+                          f'epsilon ~{ulp:.1e}, pixels counted as guards["ulp_step"]); raise it '
+                          f'or use render.float="double"',
                           RuntimeWarning, stacklevel=4)
     # the fixed scan counts i = 0 .. z_resolution and post-stepping n = 1 .. post_steps in
     # an OpenCL int: at 2^31 - 1 the loop counter would overflow instead of ending

@@ -128,7 +128,7 @@ class FakeResult:
         self.seconds = 1.234
         self.hit_fraction = 0.412
         self.capped = 0
-        self.guards = {"stalled": 0, "normal_fallback": 0}
+        self.guards = {"ulp_step": 0, "normal_fallback": 0}
 
     def exr_channels(self) -> dict[str, np.ndarray]:
         return {"R": self.color[..., 0], "A": self.alpha}

@@ -21,14 +21,19 @@ def run_march(s: Scene):
     near = -1.0 if m.near == "auto" else m.near
     far = -1.0 if m.far == "auto" else m.far
     depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
+    flags = R.out(n, np.int32)
     args = (f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), near, far,
             m.z_resolution, m.post_steps, m.max_steps)
     R("march", (n,), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
       R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(near), R.scalar(far),
       np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples)
+      depth, point, status, samples, flags)
     k = (depth.get().astype(float), R.get4(point), status.get(), samples.get())
-    r = ref.march(o, d, *args, m.method)
+    rflags = np.zeros(n, np.int32)
+    r = ref.march(o, d, *args, m.method, rflags)
+    # the guard flags (kernels/real.cl) agree wherever the statuses do
+    same = k[2] == r[2]
+    assert np.array_equal(flags.get()[same], rflags[same])
     return k, r
 
 
