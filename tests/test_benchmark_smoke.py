@@ -34,3 +34,19 @@ def test_quick_run_writes_sane_results(tmp_path):
     md = (tmp_path / "error_vs_time.md").read_text()
     assert "device:" in md and "commit:" in md and "| method | z_res |" in md
     assert (tmp_path / "error_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_extreme_cases_report_runs(tmp_path):
+    """benchmarks/extreme_cases.py on two catalogue cases, tiny, so the report cannot rot."""
+    spec = importlib.util.spec_from_file_location("extreme_cases", ROOT / "benchmarks" / "extreme_cases.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--only", "c_zero", "epsilon_below_ulp", "--scale", "1", "--repeats", "1",
+                     "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "extreme_cases.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert {(r["case"], r["method"]) for r in rows} == {(c, m) for c in ("c_zero", "epsilon_below_ulp")
+                                                       for m in ("fixed", "de")}
+    assert all(r["verdict"] == "ok" and r["nan_inf32"] == "0" and r["nan_inf64"] == "0" for r in rows)
+    md = (tmp_path / "extreme_cases.md").read_text()
+    assert "commit `" in md and "| epsilon_below_ulp | de |" in md and "ulp_step=" in md
