@@ -43,13 +43,12 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-import pyopencl as cl  # noqa: E402
 import pyopencl.array as cla  # noqa: E402
 
 from pyjulia4d import build, truth  # noqa: E402
 from pyjulia4d.camera import camera_frame  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.render import STATUS_HIT, Precision, queue_for, render  # noqa: E402
+from pyjulia4d.render import STATUS_HIT, Precision, launch_normals, queue_for, render  # noqa: E402
 from pyjulia4d.scene import Scene  # noqa: E402
 
 # name -> (overrides, description)
@@ -108,8 +107,9 @@ def git_head() -> str:
     try:
         head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
                               check=True).stdout.strip()
-        # the results folder is this script's own output: its changes are not the code's
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".",
+        # dirty = the code that runs differs from the commit (not README, not the results)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--",
+                                "pyjulia4d", "kernels", "benchmarks", "setup.cfg",
                                 ":(exclude)benchmarks/results"], cwd=ROOT,
                                capture_output=True, text=True, check=True).stdout.strip()
         return head + ("+dirty" if dirty else "")
@@ -135,25 +135,13 @@ class NormalKernels:
         q = self.queue
         w, h = scene.image.width, scene.image.height
         n = w * h
-        f, m = scene.fractal, scene.march
         fr = camera_frame(scene)
         pos = np.nan_to_num(res.position.reshape(n, 4)).astype(pr.scalar)
         point = cla.to_device(q, np.ascontiguousarray(pos).view(pr.vec_dtype).ravel())
         status = cla.to_device(q, np.ascontiguousarray(res.status.reshape(n), np.int32))
         depth = cla.to_device(q, np.ascontiguousarray(res.depth.reshape(n).astype(pr.scalar)))
         normal = cla.empty(q, n, pr.vec_dtype)
-        eye, fwd, right, up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
-        c = pr.v4(f.c)
-        if method == "jacobian":
-            cl.Kernel(prg, "normals_jacobian")(q, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
-                                               pr.scalar(f.bailout), right, up, fwd, normal.data)
-        elif method == "gradient":
-            step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
-            cl.Kernel(prg, "normals_gradient")(q, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
-                                               pr.scalar(f.bailout), pr.scalar(step), right, up, fwd, normal.data)
-        else:
-            cl.Kernel(prg, "normals_zbuffer")(q, (w, h), None, point.data, depth.data, status.data,
-                                              np.int32(w), np.int32(h), eye, right, up, fwd, normal.data)
+        launch_normals(q, prg, scene, method, fr, pr, point, depth, status, normal)
         q.finish()
         return normal.get().view(pr.scalar).reshape(h, w, 4)[..., :3].astype(np.float64)
 

@@ -160,13 +160,13 @@ def _build() -> list[Case]:
              "the bounding sphere ~1e4 away, where float32 spacing of t is ~1e-3",
              "terminates; float32 depth quantised to ulp(1e4) ~ 1e-3",
              0.1, 2e-3, "float32 depth resolution at t = 1e4 is ~1e-3 (ulp), the size of "
-             "the set's fine detail", cheap),
+             "the set's fine detail; render.float = \"double\" resolves it", cheap),
         Case("deep_zoom", tuple(_deep_zoom()),
              "field of view 1e-5 degrees onto a surface point: the frame is ~5e-7 wide, "
              "about two float32 ulps of the eye position and of t",
              "terminates; float32 rays and depths quantised to ~2e-7, the image is blocky",
              0.1, 1e-5, "float32 cannot resolve a 5e-7 frame at distance 3: pixels share "
-             "rays and depths (ulp(3) = 2.4e-7)", small),
+             "rays and depths (ulp(3) = 2.4e-7); render.float = \"double\" resolves it", small),
         Case("camera_inside", ("camera.position=0.05,0.1,-0.1,0", "camera.target=0,0,1,0",
                                "camera.up=0,1,0,0"),
              "the eye inside the set: near = 0, the first sample is inside, the hit point "

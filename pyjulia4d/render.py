@@ -105,6 +105,27 @@ def _float4(v3, w=0.0):
     return cl.cltypes.make_float4(*[float(x) for x in v3], float(w))
 
 
+def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
+                   point, depth, status, normal) -> None:
+    """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
+    device buffers; writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
+    f, m = scene.fractal, scene.march
+    w, h = scene.image.width, scene.image.height
+    n = w * h
+    c = pr.v4(f.c)
+    eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
+    if method == "jacobian":
+        cl.Kernel(prg, "normals_jacobian")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
+                                           pr.scalar(f.bailout), right, up, fwd, normal.data)
+    elif method == "gradient":
+        step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
+        cl.Kernel(prg, "normals_gradient")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
+                                           pr.scalar(f.bailout), pr.scalar(step), right, up, fwd, normal.data)
+    else:
+        cl.Kernel(prg, "normals_zbuffer")(queue, (w, h), None, point.data, depth.data, status.data,
+                                          np.int32(w), np.int32(h), eye, right, up, fwd, normal.data)
+
+
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL).
@@ -158,17 +179,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             queue.finish()
             bar.update(y1 - y0)
 
-    nm = scene.normals.method
-    if nm == "jacobian":
-        cl.Kernel(prg, "normals_jacobian")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
-                             pr.scalar(f.bailout), right, up, fwd, normal.data)
-    elif nm == "gradient":
-        step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
-        cl.Kernel(prg, "normals_gradient")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
-                             pr.scalar(f.bailout), pr.scalar(step), right, up, fwd, normal.data)
-    else:
-        cl.Kernel(prg, "normals_zbuffer")(queue, (w, h), None, point.data, depth.data, status.data,
-                            np.int32(w), np.int32(h), eye, right, up, fwd, normal.data)
+    launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status, normal)
 
     sh = scene.shading
     lp = light_position(scene)
