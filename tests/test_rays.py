@@ -11,8 +11,9 @@ from pyjulia4d.scene import Scene, SceneError
 @pytest.mark.parametrize("over", [[], ["camera.position=-2,1,5,8", "camera.fov=60"],
                                   ["camera.limbo=0,0.3,0,1", "camera.position=1,2,-3,0.5"],
                                   ["slice.normal=0.2,0,0.3,1", "slice.distance=0.3"]])
-def test_generate_rays_matches_reference(over):
-    s = Scene.default().with_overrides(over + ["image.width=37", "image.height=23"])
+@pytest.mark.parametrize("fl,tol", [("single", 2e-6), ("double", 1e-14)])
+def test_generate_rays_matches_reference(over, fl, tol):
+    s = Scene.default().with_overrides(over + ["image.width=37", "image.height=23", f"render.float={fl}"])
     R = Runner(build.scene_config(s))
     f = camera_frame(s)
     w, h = 37, 23
@@ -20,10 +21,11 @@ def test_generate_rays_matches_reference(over):
     R("generate_rays", (w, h), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
       R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), o, d)
     ro, rd = ref.generate_rays(f, w, h)
-    # float32 rounding of the frame and one normalise: a few ulp of a unit vector
-    np.testing.assert_allclose(R.get4(d), rd, atol=2e-6)
-    np.testing.assert_allclose(R.get4(o), ro, atol=2e-6 * np.abs(ro).max())
-    np.testing.assert_allclose(np.linalg.norm(R.get4(d), axis=1), 1, atol=1e-6)
+    # rounding of the frame to the kernel's precision and one normalise: a few ulp of a
+    # unit vector (float32: 2e-6; float64: 1e-14)
+    np.testing.assert_allclose(R.get4(d), rd, atol=tol)
+    np.testing.assert_allclose(R.get4(o), ro, atol=tol * np.abs(ro).max())
+    np.testing.assert_allclose(np.linalg.norm(R.get4(d), axis=1), 1, atol=tol / 2)
 
 
 def test_frame_is_orthonormal_and_default_drops_w():

@@ -12,8 +12,9 @@ from pyjulia4d.scene import Scene
 @pytest.mark.parametrize("over", [[], ["shading.light=2,3,-4"], ["shading.specular=0"],
                                   ["shading.light=-1,2,-3,0.5", "shading.shininess=5",
                                    "shading.light_color=1,0.5,0.2", "shading.background=0.1,0.2,0.3"]])
-def test_shade_matches_reference(over):
-    s = Scene.default().with_overrides(over)
+@pytest.mark.parametrize("fl", ["single", "double"])
+def test_shade_matches_reference(over, fl):
+    s = Scene.default().with_overrides(over + [f"render.float={fl}"])
     R = Runner(build.scene_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(5)
@@ -37,6 +38,7 @@ def test_shade_matches_reference(over):
     got = out.get().view(np.float32).reshape(n, 4)
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
                      sh.ambient, sh.diffuse, sh.specular, sh.shininess)
+    # the shading itself is float32 in both variants (colour needs no more; shade.cl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
     assert np.all(got[status != 1, 3] == 0) and np.all(got[status == 1, 3] == 1)
