@@ -170,14 +170,16 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
 
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps):
     """r_{n+1} = r_n + m max(d(r_n), eps), hit when d < eps (seed 001 §3.2 eq. 9); a step
-    that rounds away (t + step == t) becomes one ulp of t, flagged GUARD_ULP_STEP
-    (march_de.cl).  Returns (t, status, samples, flags)."""
+    that rounds away (t + step == t) becomes one ulp of t, flagged GUARD_ULP_STEP, and a
+    hit it reaches returns the point one ulp before, the last outside (march_de.cl).
+    Returns (t, status, samples, flags)."""
     n = len(o)
     t = near.copy()
     t_prev = near.copy()
     status = np.full(n, STATUS_CAPPED, np.int32)
     samples = np.full(n, max_steps, np.int32)
     flags = np.zeros(n, np.int32)
+    ulp_step = np.zeros(n, bool)    # the last step was one ulp: a hit returns t_prev (march_de.cl)
     active = np.ones(n, bool)
     for i in range(max_steps):
         idx = np.nonzero(active)[0]
@@ -193,14 +195,17 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         status[idx[hit]] = STATUS_HIT
         samples[idx[hit]] = i + 1
         active[idx[hit]] = False
+        back = idx[hit & ulp_step[idx]]
+        t[back] = t_prev[back]
         if post_steps > 0 and i > 0 and hit.any():
-            k = idx[hit]
+            k = idx[hit & ~ulp_step[idx]]
             t[k] = post_step(o[k], d[k], t[k], t[k] - t_prev[k], post_steps,
                              lambda p: julia_distance(p, c, max_iter, bailout) < epsilon)
         k = idx[~hit]
         t_prev[k] = t[k]
         t[k] = t[k] + np.maximum(dist[~hit], epsilon)
-        stall = k[t[k] == t_prev[k]]
+        ulp_step[k] = t[k] == t_prev[k]
+        stall = k[ulp_step[k]]
         t[stall] = np.nextafter(t_prev[stall], np.inf)
         flags[stall] |= GUARD_ULP_STEP
     t[status != STATUS_HIT] = np.inf
