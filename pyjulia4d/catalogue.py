@@ -186,7 +186,9 @@ def _build() -> list[Case]:
              "t + d == t, the DE march cannot advance",
              "terminates: where the step rounds away the march steps one ulp of t "
              "(effective epsilon = ulp(t), counted as ulp_step), never a stall or a hang; "
-             "depth within 1e-5 of float64 (median one ulp)",
+             "depth within 1e-5 of float64 (median one ulp); the hit is the max_iter-"
+             "truncated surface itself, rough at max_iter 100 (normals speckled, as in a "
+             "float64 fixed scan)",
              0.05, 1e-5, "", small, fixed_depth_tol=1e-3),
         Case("z_resolution_1", ("march.z_resolution=1",),
              "z_resolution 1: only the near and far samples",
