@@ -12,16 +12,11 @@ import time
 import numpy as np
 
 from .camera import Frame, camera_frame, light_position, march_radius
-from .render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, RenderResult, count_guards
+from .render import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_ULP_STEP, STATUS_CAPPED,
+                     STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
 from .scene import Scene
 
 REAL_MIN = np.finfo(np.float64).tiny
-
-# Guard flags (kernels/real.cl): written into the normal buffer's w by the kernels,
-# returned through the optional ``guard`` array here; RenderResult.guards counts them.
-GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
-GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
-GUARD_ULP_STEP = 4          # de: a step below the spacing of t raised to one ulp (march's flags)
 
 
 def _dot(a, b):

@@ -21,6 +21,10 @@ from .devices import has_fp64, select_device
 from .scene import Scene, SceneError
 
 STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
+# Guard flags (kernels/real.cl): the march's flags buffer and the normals' w component
+GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
+GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
+GUARD_ULP_STEP = 4          # de: a step below the spacing of t raised to one ulp
 
 
 @dataclass
@@ -67,11 +71,11 @@ def count_guards(status, depth, guard) -> dict[str, int]:
     guard = guard.astype(np.int64)
     return {
         # de step below the spacing of t raised to one ulp (march_de.cl): effective epsilon = ulp(t)
-        "ulp_step": int(np.sum((guard & 4) != 0)),
+        "ulp_step": int(np.sum((guard & GUARD_ULP_STEP) != 0)),
         # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
-        "normal_fallback": int(np.sum(hit & ((guard & 1) != 0))),
+        "normal_fallback": int(np.sum(hit & ((guard & GUARD_NORMAL_FALLBACK) != 0))),
         # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
-        "jacobian_tiny": int(np.sum(hit & ((guard & 2) != 0))),
+        "jacobian_tiny": int(np.sum(hit & ((guard & GUARD_JACOBIAN_TINY) != 0))),
         # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
         "eye_hit": int(np.sum(hit & (np.asarray(depth).ravel() == 0))),
     }

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, Mapping, Union
 
-from .quality import PRESETS, QUALITIES, preset_values
+from .quality import QUALITIES, preset_values
 
 if sys.version_info >= (3, 11):
     import tomllib

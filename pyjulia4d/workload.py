@@ -19,6 +19,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
+from .camera import camera_frame, march_radius
 from .scene import Scene, SceneError
 
 # Measured set-test throughput, iterations per second.  "CPU": PoCL on the 2-core
@@ -123,7 +124,6 @@ def check_numerics(scene: Scene) -> None:
                             f"bailout, above {REAL_MAX[scene.render.float]:.1e}); use at most "
                             f"{lim:.2g}{alt}")
     if m.method == "de" and scene.render.float == "single":
-        from .camera import camera_frame, march_radius
         t_far = float(sum(x * x for x in camera_frame(scene).position)) ** 0.5 + march_radius(scene)
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:
