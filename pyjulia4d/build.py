@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import pyopencl as cl
 
+from .devices import cannot_compile, compile_error
 from .resources import kernel_dir
 from .scene import Scene
 
@@ -71,6 +72,9 @@ def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
     prg = _programs.get(key)
     if prg is None:
         opts = [f"-D{d}" for d in config.defines]
+        dev = ctx.devices[0]
+        if compile_error(dev):  # a compiler that fails on everything: one line, not a build log
+            raise cannot_compile(dev)
         prg = cl.Program(ctx, source(config)).build(options=opts)
         _programs[key] = prg
     return prg

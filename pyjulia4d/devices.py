@@ -48,22 +48,57 @@ def has_fp64(device: cl.Device) -> bool:
         return False
 
 
+_PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *= 2.0f; }"
+_compiles: dict[int, str] = {}
+
+
+def compile_error(device: cl.Device) -> str:
+    """"" when ``device`` compiles OpenCL C, else the first line of its build error.
+
+    Checked once per device and process.  Seen: PyPI's PoCL 3.0 (LLVM 14) on a CPU its
+    LLVM does not know (AMD Zen 5) fails every build with "unknown target CPU
+    'generic'"; Debian's pocl-opencl-icd picks its kernel library by CPU features and
+    builds there."""
+    key = device.int_ptr
+    if key not in _compiles:
+        try:
+            ctx = cl.Context([device])
+            cl.Program(ctx, _PROBE_SOURCE).build()
+            _compiles[key] = ""
+        except (cl.Error, RuntimeError) as e:
+            lines = [ln.strip() for ln in str(e).splitlines() if "error" in ln.lower() and ln.strip()]
+            msg = next((ln for ln in lines if not ln.startswith("clBuildProgram")), "")
+            _compiles[key] = msg or (lines[0] if lines else type(e).__name__)
+    return _compiles[key]
+
+
+def cannot_compile(device: cl.Device) -> DeviceError:
+    """The one-line error for a device whose OpenCL compiler fails."""
+    return DeviceError(f"device '{device.name.strip()}' ({device.platform.name.strip()}) cannot "
+                       f"compile OpenCL C: {compile_error(device)}; pick another with --device "
+                       f"(a CPU unknown to PyPI's PoCL: install Debian's pocl-opencl-icd)")
+
+
 def describe_devices() -> str:
-    """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``."""
+    """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``, and
+    whether it compiles (a device that cannot is never picked by default)."""
     rows = _indexed()
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
-    return "\n".join(
-        f"{idx}  {p.name.strip()} | {d.name.strip()} | {device_type(d)}, "
-        f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}"
-        for idx, p, d in rows
-    )
+    out = []
+    for idx, p, d in rows:
+        err = compile_error(d)
+        out.append(f"{idx}  {p.name.strip()} | {d.name.strip()} | {device_type(d)}, "
+                   f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}"
+                   + (f", cannot compile: {err}" if err else ""))
+    return "\n".join(out)
 
 
 def select_device(spec: str | None = None) -> cl.Device:
     """Pick a device.
 
-    ``None``: the first GPU on any platform, else the first CPU device.
+    ``None``: the first GPU on any platform, else the first CPU device, skipping devices
+    that cannot compile (compile_error); DeviceError if none can.
     ``"P:D"``: platform and device indices as ``describe_devices`` prints them.
     ``"cpu"`` / ``"gpu"``: the first device of that type.
     Anything else: the first device whose platform name, platform vendor or
@@ -74,11 +109,11 @@ def select_device(spec: str | None = None) -> cl.Device:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
     hint = "(run 'python -m pyjulia4d devices' to list them)"
     if spec is None:
-        for want in ("GPU", "CPU"):
+        for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
             for _, _, d in rows:
-                if device_type(d) == want:
+                if device_type(d) == want and not compile_error(d):
                     return d
-        return rows[0][2]
+        raise cannot_compile(rows[0][2])
     s = spec.strip()
     if s.lower() in ("cpu", "gpu"):
         for _, _, d in rows:
