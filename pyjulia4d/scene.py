@@ -87,6 +87,7 @@ class March:
     method: str = "de"
     z_resolution: int = 250
     post_steps: int = 4
+    refine: str = "itp"
     epsilon: float = 1e-3
     max_steps: int = 4096
     near: Union[float, Auto] = "auto"
@@ -270,6 +271,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "method": _choice("fixed", "de"),
         "z_resolution": _integer(1),
         "post_steps": _integer(0),
+        "refine": _choice("itp", "bisect"),
         "epsilon": _real(_gt0, "> 0"),
         "max_steps": _integer(1),
         "near": _or_string("auto", _real(_ge0, ">= 0"), "a number >= 0"),
