@@ -15,6 +15,33 @@ inline int julia_inside(real4 p, julia_params jp)
     return dot(q, q) <= jp.bailout2;
 }
 
+/* The level function of the truncated set (refine.cl): F = |q_N|^2 / bailout^2 - 1 at
+ * N = max_iter, <= 0 exactly when the point is inside (*inside, the same test as
+ * julia_inside).  With bailout >= the escape radius every |q_n| > bailout stays so, so
+ * the set is {F <= 0} and its surface the level set F = 0 of a polynomial in the
+ * point (seed 002_6b6c8e6b1cd19649.txt).  An orbit that escapes at n < N is not iterated
+ * on (it would overflow); |q_N|^2 is extrapolated as (|q_n|^2)^(2^(N-n)), the growth of
+ * q^2 for large q, and capped at 1e30: only the interpolation uses the value. */
+inline real julia_level(real4 p, julia_params jp, int *inside)
+{
+    real4 q = p;
+    real m2 = dot(q, q);
+    int n = 0;
+    for (; n < jp.max_iter && m2 <= jp.bailout2; ++n) {
+        q = julia_f(q, jp.c);
+        m2 = dot(q, q);
+    }
+    *inside = m2 <= jp.bailout2;
+    if (*inside)
+        return m2 / jp.bailout2 - (real)1;
+    int k = jp.max_iter - n;
+    real l = log(m2 / jp.bailout2);
+    if (k > 60)
+        return (real)1e30;
+    real e = ldexp(l, k);
+    return e > (real)69 ? (real)1e30 : expm1(e);
+}
+
 /* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (seed 001 §3.1, eq. 8)
  * evaluated at the last iterate, whether or not it escaped.  The derivative is
  * carried squared, so the loop needs no sqrt: |q'_{n+1}|^2 = 4 |q_n|^2 |q'_n|^2, and

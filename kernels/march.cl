@@ -2,14 +2,16 @@
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
- * guard flags (real.cl), 0 when none fired. */
+ * guard flags (real.cl), 0 when none fired; bracket the width of the certified
+ * bracket behind each hit's depth (refine.cl), +inf where nothing was hit. */
 
 __kernel void march(__global const real4 *origins, __global const real4 *dirs,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
-                    __global int *status, __global int *samples, __global int *flags)
+                    __global int *status, __global int *samples, __global int *flags,
+                    __global real *bracket)
 {
     size_t i = get_global_id(0);
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
@@ -29,6 +31,7 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
     int n = 0;
     int fl = 0;
     real t = INFINITY;
+    real width = INFINITY;
     if (disc >= (real)0) {
         real s = sqrt(disc);
         real near = fmax(-b - s, (real)0);
@@ -36,11 +39,12 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
         if (near_set >= (real)0) near = near_set;
         if (far_set >= (real)0) far = far_set;
         if (far >= near)
-            t = march_ray(o, d, near, far, jp, z_resolution, post_steps, max_steps, &st, &n, &fl);
+            t = march_ray(o, d, near, far, jp, z_resolution, post_steps, max_steps, &st, &n, &fl, &width);
     }
     depth[i] = t;
     point[i] = st == STATUS_HIT ? o + t * d : (real4)(NAN);
     status[i] = st;
     samples[i] = n;
     flags[i] = fl;
+    bracket[i] = st == STATUS_HIT ? width : INFINITY;
 }

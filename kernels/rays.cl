@@ -2,18 +2,21 @@
  * The host builds the orthonormal frame (forward, right, up; right from the 4D cross
  * product with the limbo vector); pixel (x, y) looks along
  *     normalize(forward + u right + v up),  u, v in [-tan(fov/2) aspect, ..] x [.., tan(fov/2)],
- * with y = 0 at the top row.  Every ray starts at the camera position. */
+ * with y = 0 at the top row.  Every ray starts at the camera position.  A launch covers
+ * one tile of the image (render.py renders any size in tiles of bounded memory). */
 
 __kernel void generate_rays(const real4 position, const real4 forward, const real4 right,
                             const real4 up, const real tan_half_fov, const int width,
-                            const int height, __global real4 *origins, __global real4 *dirs)
+                            const int height, const int x0, const int y0,
+                            __global real4 *origins, __global real4 *dirs)
 {
-    int x = get_global_id(0);
-    int y = get_global_id(1);
+    /* one tile of tw x th pixels (the launch size) whose top-left pixel is (x0, y0) */
+    int x = x0 + get_global_id(0);
+    int y = y0 + get_global_id(1);
     real aspect = (real)width / (real)height;
     real u = ((real)2 * ((real)x + (real)0.5) / (real)width - (real)1) * tan_half_fov * aspect;
     real v = ((real)1 - (real)2 * ((real)y + (real)0.5) / (real)height) * tan_half_fov;
-    size_t i = (size_t)y * width + x;
+    size_t i = get_global_id(1) * get_global_size(0) + get_global_id(0);
     origins[i] = position;
     dirs[i] = normalize(forward + u * right + v * up);
 }

@@ -37,9 +37,9 @@ def scene_config(scene: Scene) -> KernelConfig:
     m = scene.march
     pieces = list(iteration_pieces(scene))
     defines = list(precision_defines(scene))
-    if m.post_steps > 0:
-        pieces.append("post_step")
-        defines.append("POST_STEP")
+    pieces.append("refine")
+    if m.refine == "itp":
+        defines.append("REFINE_ITP")
     pieces += [f"march_{m.method}", "march", "rays", f"normals_{scene.normals.method}", "shade"]
     if scene.shading.specular > 0:
         defines.append("SPECULAR")

@@ -12,7 +12,8 @@ import time
 import numpy as np
 
 from .camera import Frame, camera_frame, light_position, march_radius
-from .render import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_ULP_STEP, STATUS_CAPPED,
+from .render import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
+                     STATUS_CAPPED,
                      STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
 from .scene import Scene
 
@@ -82,6 +83,31 @@ def julia_inside(p, c, max_iter, bailout):
     return out & (_dot(q, q) <= b2)
 
 
+def julia_level(p, c, max_iter, bailout):
+    """F = |q_N|^2 / bailout^2 - 1 (N = max_iter), <= 0 exactly where julia_inside; an orbit
+    escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(2^(N-n)) - 1, capped at 1e30
+    (iterate.cl; seed 002).  Returns (F, inside)."""
+    q = np.array(p, dtype=np.float64)
+    c = np.asarray(c, np.float64)
+    b2 = bailout * bailout
+    m2 = _dot(q, q)
+    n = np.zeros(m2.shape, np.int64)
+    live = np.ones(m2.shape, bool)
+    for _ in range(max_iter):
+        live &= m2 <= b2
+        if not live.any():
+            break
+        q[live] = julia_f(q[live], c)
+        m2[live] = _dot(q[live], q[live])
+        n[live] += 1
+    inside = m2 <= b2
+    k = max_iter - n
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        e = np.ldexp(np.log(m2 / b2), np.minimum(k, 60).astype(np.int32))
+        out = np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
+    return np.where(inside, m2 / b2 - 1.0, out), inside
+
+
 def julia_distance_formula(p, c, max_iter, bailout):
     """d = |q_n| ln|q_n| / (2|q_n'|) (seed 001_01b4b6353b5280e3.txt eq. 8) at the last
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
@@ -117,28 +143,73 @@ def julia_distance(p, c, max_iter, bailout):
     return np.where(escaped, d, 0.0)
 
 
-# ---------------------------------------------------------------- post_step.cl
+# ------------------------------------------------------------------- refine.cl
 
-def post_step(o, d, t_hit, h0, steps, hit_test):
-    """Seed 000 §7.1 eq. 11 on a batch: halve the step, back while hitting, on while not."""
-    t = np.array(t_hit, np.float64)
-    h = np.array(h0, np.float64)
-    hit = np.ones(t.shape, bool)
-    for n in range(1, steps + 1):
-        h = h * 0.5
-        t = np.where(hit, t - h, t + h)
-        if n < steps:
-            hit = hit_test(o + t[:, None] * d)
-    return t
+def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None):
+    """Narrow certified brackets [a (outside), b (inside)] on rays o + t d with ``steps``
+    set tests: ITP on the level function julia_level (``itp``) or bisection (seed 000
+    §7.1 eq. 11-12, every point classified); both stop where the bracket cannot be split.
+    Both guarantee width <= (b - a) / 2^steps, ITP with at most one more set test.
+    Returns (a, b - a): the outside end is the depth, the crossing lies within the width
+    behind it (refine.cl).  ``tests`` (int array, optional) gets the set tests each ray took
+    (ITP's two end-point level evaluations not counted)."""
+    a = np.array(a, np.float64)
+    b = np.array(b, np.float64)
+    pt = lambda k, t: o[k] + t[:, None] * d[k]
+    if itp:
+        k = np.arange(len(a))
+        fa, _ = julia_level(pt(k, a), c, max_iter, bailout)
+        fb, _ = julia_level(pt(k, b), c, max_iter, bailout)
+        ya, yb = -np.maximum(fa, REAL_MIN), -np.minimum(fb, 0.0)
+        w0 = b - a
+        eps = np.ldexp(w0, -(steps + 1))
+        k1 = 0.2 / np.where(w0 > 0, w0, 1.0)
+    live = np.ones(len(a), bool)
+    for j in range(steps + 1 if itp else steps):
+        if itp:
+            live &= b - a > 2 * eps
+        xh = 0.5 * (a + b)
+        live &= (xh > a) & (xh < b)
+        k = np.nonzero(live)[0]
+        if k.size == 0:
+            break
+        if tests is not None:
+            tests[k] += 1
+        if itp:
+            ak, bk, yak, ybk, xhk = a[k], b[k], ya[k], yb[k], xh[k]
+            r = np.ldexp(eps[k], steps + 1 - j) - 0.5 * (bk - ak)
+            delta = k1[k] * (bk - ak) ** 2
+            with np.errstate(invalid="ignore", divide="ignore"):
+                xf = np.where(ybk != yak, (ybk * ak - yak * bk) / (ybk - yak), xhk)
+            sigma = np.where(xhk >= xf, 1.0, -1.0)
+            xt = np.where(delta <= np.abs(xhk - xf), xf + sigma * delta, xhk)
+            x = np.where(np.abs(xt - xhk) <= r, xt, xhk - sigma * r)
+            x = np.where((x > ak) & (x < bk), x, xhk)
+            f, ins = julia_level(pt(k, x), c, max_iter, bailout)
+            y = -f
+            b[k] = np.where(ins, x, bk)
+            yb[k] = np.where(ins, np.maximum(y, 0.0), ybk)
+            a[k] = np.where(ins, ak, x)
+            ya[k] = np.where(ins, yak, np.minimum(y, -REAL_MIN))
+        else:
+            x = xh[k]
+            ins = julia_inside(pt(k, x), c, max_iter, bailout)
+            b[k] = np.where(ins, x, b[k])
+            a[k] = np.where(ins, a[k], x)
+    return a, b - a
 
 
 # ---------------------------------------------------- march_fixed.cl / march_de.cl
 
-def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps):
-    """Fixed z-resolution scan (seed 000 §3) plus post-stepping; returns (t, status, samples, flags)."""
+def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
+                itp=True):
+    """Fixed z-resolution scan (seed 000 §3): the first inside sample and the one before it
+    are the certified bracket, refined by refine_bracket; a hit at the first sample is near
+    itself, width 0.  Returns (t, status, samples, flags, width)."""
     n = len(o)
     h = (far - near) / z_resolution
     t = np.full(n, np.inf)
+    width = np.full(n, np.inf)
     status = np.full(n, STATUS_MISS, np.int32)
     samples = np.full(n, z_resolution + 1, np.int32)
     first = np.zeros(n, bool)
@@ -155,64 +226,74 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
         samples[got] = i + 1
         first[got] = i == 0
         active[got] = False
-    refine = (status == STATUS_HIT) & ~first
-    if post_steps > 0 and refine.any():
-        k = np.nonzero(refine)[0]
-        t[k] = post_step(o[k], d[k], t[k], h[k], post_steps,
-                         lambda p: julia_inside(p, c, max_iter, bailout))
-    return t, status, samples, np.zeros(n, np.int32)
+    width[first] = 0.0
+    k = np.nonzero((status == STATUS_HIT) & ~first)[0]
+    if k.size:
+        # the kernel's t_prev is near + (i - 1) h, computed as such (not t - h)
+        t_prev = near[k] + (samples[k] - 2) * h[k]
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev, t[k], post_steps, c, max_iter, bailout, itp)
+    return t, status, samples, np.zeros(n, np.int32), width
 
 
-def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps):
-    """r_{n+1} = r_n + m max(d(r_n), eps), hit when d < eps (seed 001 §3.2 eq. 9); a step
-    that rounds away (t + step == t) becomes one ulp of t, flagged GUARD_ULP_STEP, and a
-    hit it reaches returns the point one ulp before, the last outside (march_de.cl).
-    Returns (t, status, samples, flags)."""
+def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
+             itp=True):
+    """r_{n+1} = r_n + max(d(r_n), eps) (seed 001 §3.2 eq. 9) until a point is inside (its
+    orbit never escaped); with the previous point, the certified bracket refined by
+    refine_bracket.  A step that rounds away (t + step == t) becomes one ulp of t
+    (GUARD_ULP_STEP); a ray that came within epsilon by the estimate and never got inside
+    is a miss flagged GUARD_SHELL_MISS (march_de.cl).  Returns (t, status, samples, flags, width)."""
     n = len(o)
     t = near.copy()
     t_prev = near.copy()
+    width = np.full(n, np.inf)
     status = np.full(n, STATUS_CAPPED, np.int32)
     samples = np.full(n, max_steps, np.int32)
     flags = np.zeros(n, np.int32)
-    ulp_step = np.zeros(n, bool)    # the last step was one ulp: a hit returns t_prev (march_de.cl)
+    shell = np.zeros(n, bool)
     active = np.ones(n, bool)
+    bracketed = np.zeros(n, bool)
     for i in range(max_steps):
         idx = np.nonzero(active)[0]
         if idx.size == 0:
             break
         out = t[idx] > far[idx]
-        status[idx[out]] = STATUS_MISS
-        samples[idx[out]] = i
-        active[idx[out]] = False
+        gone = idx[out]
+        status[gone] = STATUS_MISS
+        samples[gone] = i
+        flags[gone[shell[gone]]] |= GUARD_SHELL_MISS
+        active[gone] = False
         idx = idx[~out]
-        dist = julia_distance(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout)
-        hit = dist < epsilon
-        status[idx[hit]] = STATUS_HIT
-        samples[idx[hit]] = i + 1
-        active[idx[hit]] = False
-        back = idx[hit & ulp_step[idx]]
-        t[back] = t_prev[back]
-        if post_steps > 0 and i > 0 and hit.any():
-            k = idx[hit & ~ulp_step[idx]]
-            t[k] = post_step(o[k], d[k], t[k], t[k] - t_prev[k], post_steps,
-                             lambda p: julia_distance(p, c, max_iter, bailout) < epsilon)
+        dist, escaped = julia_distance_formula(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout)
+        hit = ~escaped
+        got = idx[hit]
+        status[got] = STATUS_HIT
+        samples[got] = i + 1
+        active[got] = False
+        if i == 0:
+            width[got] = 0.0
+        else:
+            bracketed[got] = True
         k = idx[~hit]
+        shell[k] |= dist[~hit] < epsilon
         t_prev[k] = t[k]
         t[k] = t[k] + np.maximum(dist[~hit], epsilon)
-        ulp_step[k] = t[k] == t_prev[k]
-        stall = k[ulp_step[k]]
+        stall = k[t[k] == t_prev[k]]
         t[stall] = np.nextafter(t_prev[stall], np.inf)
         flags[stall] |= GUARD_ULP_STEP
+    k = np.nonzero(bracketed)[0]
+    if k.size:
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp)
     t[status != STATUS_HIT] = np.inf
-    return t, status, samples, flags
+    return t, status, samples, flags, width
 
 
 # --------------------------------------------------------------------- march.cl
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
-          z_resolution, post_steps, max_steps, method, flags=None):
+          z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None):
     """Clip each ray to the bounding 4-ball, then march; returns (depth, point, status, samples).
-    ``flags`` (int array, optional) gets the march's guard flags (march.cl's flags buffer)."""
+    ``flags`` (int array, optional) gets the march's guard flags (march.cl's flags buffer),
+    ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere)."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = _dot(o, d)
@@ -234,10 +315,14 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     k = np.nonzero(live)[0]
     if k.size:
         fn = march_fixed if method == "fixed" else march_de
-        depth[k], status[k], samples[k], fl = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
-                                                 epsilon, z_resolution, post_steps, max_steps)
+        depth[k], status[k], samples[k], fl, wd = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
+                                                     epsilon, z_resolution, post_steps, max_steps,
+                                                     refine == "itp")
         if flags is not None:
             flags[k] |= fl
+        if bracket is not None:
+            bracket[:] = np.inf
+            bracket[k] = np.where(status[k] == STATUS_HIT, wd, np.inf)
     depth[status != STATUS_HIT] = np.inf
     point = np.where((status == STATUS_HIT)[:, None], o + np.where(np.isfinite(depth), depth, 0)[:, None] * d, np.nan)
     return depth, point, status, samples
@@ -245,15 +330,19 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
 
 # ---------------------------------------------------------------------- rays.cl
 
-def generate_rays(frame: Frame, width: int, height: int):
-    """Pinhole 4D camera (seed 000 §4): returns (origins, dirs), row-major, row 0 on top."""
-    y, x = np.mgrid[0:height, 0:width]
+def generate_rays(frame: Frame, width: int, height: int, x0: int = 0, y0: int = 0,
+                  tile_w: int | None = None, tile_h: int | None = None):
+    """Pinhole 4D camera (seed 000 §4): returns (origins, dirs), row-major, row 0 on top,
+    for the tile of tile_w x tile_h pixels at (x0, y0) (default: the whole image)."""
+    tw = width - x0 if tile_w is None else tile_w
+    th = height - y0 if tile_h is None else tile_h
+    y, x = np.mgrid[y0:y0 + th, x0:x0 + tw]
     aspect = width / height
     u = (2 * (x.ravel() + 0.5) / width - 1) * frame.tan_half_fov * aspect
     v = (1 - 2 * (y.ravel() + 0.5) / height) * frame.tan_half_fov
     d = frame.forward + u[:, None] * frame.right + v[:, None] * frame.up
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    return np.tile(frame.position, (width * height, 1)), d
+    return np.tile(frame.position, (tw * th, 1)), d
 
 
 # --------------------------------------------------------- normals_*.cl
@@ -445,9 +534,10 @@ def render(scene: Scene) -> RenderResult:
     near = -1.0 if m.near == "auto" else float(m.near)
     far = -1.0 if m.far == "auto" else float(m.far)
     guard = np.zeros(len(origins), np.int64)
+    bracket = np.full(len(origins), np.inf)
     depth, point, status, samples = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
-                                          m.post_steps, m.max_steps, m.method, guard)
+                                          m.post_steps, m.max_steps, m.method, guard, m.refine, bracket)
     if scene.normals.method == "jacobian":
         normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard)
     elif scene.normals.method == "gradient":
@@ -460,7 +550,8 @@ def render(scene: Scene) -> RenderResult:
     res = RenderResult(color=rgba[:, :3].reshape(h, w, 3), alpha=rgba[:, 3].reshape(h, w),
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
-                       samples=samples.reshape(h, w), device_name="numpy float64 reference",
+                       samples=samples.reshape(h, w), bracket=bracket.reshape(h, w),
+                       device_name="numpy float64 reference",
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

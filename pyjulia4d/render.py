@@ -6,6 +6,7 @@ twin of this function.
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass, field
@@ -25,6 +26,7 @@ STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
 GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
 GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
 GUARD_ULP_STEP = 4          # de: a step below the spacing of t raised to one ulp
+GUARD_SHELL_MISS = 8        # de: within epsilon by the estimate, never inside: a miss
 
 
 @dataclass
@@ -37,6 +39,7 @@ class RenderResult:
     position: np.ndarray   # (H, W, 4) float32, the 4D hit point; NaN on a miss
     status: np.ndarray     # (H, W) int32, STATUS_* per pixel
     samples: np.ndarray    # (H, W) int32, set tests (fixed) or estimates (de) before the hit
+    bracket: np.ndarray = None  # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
     device_name: str = ""
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
     kernel_seconds: float = 0.0  # the kernels alone
@@ -45,6 +48,17 @@ class RenderResult:
     @property
     def hit_fraction(self) -> float:
         return float(np.mean(self.status == STATUS_HIT))
+
+    def bracket_stats(self) -> dict[str, float]:
+        """p50 / p99 / max of the certified bracket width over the pixels hit (refine.cl):
+        each hit's surface crossing lies within its width behind its depth.  NaN when
+        nothing was hit."""
+        hit = self.status == STATUS_HIT
+        b = np.asarray(self.bracket, np.float64)[hit] if self.bracket is not None else np.empty(0)
+        if b.size == 0:
+            return {"p50": math.nan, "p99": math.nan, "max": math.nan}
+        return {"p50": float(np.percentile(b, 50)), "p99": float(np.percentile(b, 99)),
+                "max": float(b.max())}
 
     @property
     def capped(self) -> int:
@@ -55,6 +69,8 @@ class RenderResult:
         f = np.float32
         ch = {"R": self.color[..., 0], "G": self.color[..., 1], "B": self.color[..., 2],
               "A": self.alpha, "Z": self.depth}
+        if self.bracket is not None:
+            ch["Z.bracket"] = self.bracket
         for k, name in enumerate("XYZ"):
             ch[f"N.{name}"] = self.normal[..., k]
         for k, name in enumerate("XYZW"):
@@ -63,7 +79,7 @@ class RenderResult:
 
 
 def count_guards(status, depth, guard) -> dict[str, int]:
-    """Pixels each numerical guard fired on (issue 4: nothing clamped without being counted).
+    """Pixels each numerical guard fired on (nothing clamped without being counted).
     ``guard`` holds the flags (kernels/real.cl) of the march kernel's flags buffer ORed
     with those the normals kernels write into the normal's w."""
     status, guard = (np.asarray(a).ravel() for a in (status, guard))
@@ -76,6 +92,8 @@ def count_guards(status, depth, guard) -> dict[str, int]:
         "normal_fallback": int(np.sum(hit & ((guard & GUARD_NORMAL_FALLBACK) != 0))),
         # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
         "jacobian_tiny": int(np.sum(hit & ((guard & GUARD_JACOBIAN_TINY) != 0))),
+        # de: within epsilon of the set by the estimate, yet no point inside: a miss (march_de.cl)
+        "shell_miss": int(np.sum((guard & GUARD_SHELL_MISS) != 0)),
         # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
         "eye_hit": int(np.sum(hit & (np.asarray(depth).ravel() == 0))),
     }
@@ -110,11 +128,12 @@ def _float4(v3, w=0.0):
 
 
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
-                   point, depth, status, normal) -> None:
+                   point, depth, status, normal, size: tuple[int, int] | None = None) -> None:
     """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
-    device buffers; writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
+    device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
+    image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
     f, m = scene.fractal, scene.march
-    w, h = scene.image.width, scene.image.height
+    w, h = size or (scene.image.width, scene.image.height)
     n = w * h
     c = pr.v4(f.c)
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
@@ -130,13 +149,26 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
                                           np.int32(w), np.int32(h), eye, right, up, fwd, normal.data)
 
 
+# Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
+# which difference neighbours): device memory stays under ~110 MB single / ~190 MB double
+# at any image size, and no launch runs for minutes.
+TILE = 1024
+
+
+def tiles(width: int, height: int, tile: int = TILE):
+    """(x0, y0, w, h) of the image's tiles, row by row."""
+    for y0 in range(0, height, tile):
+        for x0 in range(0, width, tile):
+            yield x0, y0, min(tile, width - x0), min(tile, height - y0)
+
+
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
-           force: bool = False) -> RenderResult:
-    """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL).
+           force: bool = False, tile: int = TILE) -> RenderResult:
+    """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work)."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
-    workload.check(scene, dev, force=force)  # before any kernel: hopeless or overflowing settings
+    workload.check(scene, dev, force=force)  # before any kernel: hopeless, overflowing or too large
     double = scene.render.float == "double"
     if double and not has_fp64(dev):
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
@@ -144,71 +176,94 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     ctx, queue = queue_for(dev)
     prg = build.program(ctx, build.scene_config(scene))
     pr = Precision(double)
-    w, h = scene.image.width, scene.image.height
-    n = w * h
-    f, m = scene.fractal, scene.march
+    W, H = scene.image.width, scene.image.height
+    f, m, sh = scene.fractal, scene.march, scene.shading
+    halo = 1 if scene.normals.method == "zbuffer" else 0
 
-    origins = cla.empty(queue, n, pr.vec_dtype)
-    dirs = cla.empty(queue, n, pr.vec_dtype)
-    depth = cla.empty(queue, n, pr.scalar)
-    point = cla.empty(queue, n, pr.vec_dtype)
-    status = cla.empty(queue, n, np.int32)
-    samples = cla.empty(queue, n, np.int32)
-    flags = cla.empty(queue, n, np.int32)
-    normal = cla.empty(queue, n, pr.vec_dtype)
-    rgba = cla.empty(queue, n, cl.cltypes.float4)
+    # the whole image on the host, float32 (workload.check refuses what would not fit)
+    color = np.empty((H, W, 3), np.float32)
+    alpha = np.empty((H, W), np.float32)
+    depth_img = np.empty((H, W), np.float32)
+    bracket_img = np.empty((H, W), np.float32)
+    normal_img = np.empty((H, W, 3), np.float32)
+    position = np.empty((H, W, 4), np.float32)
+    status_img = np.empty((H, W), np.int32)
+    samples_img = np.empty((H, W), np.int32)
+    guard_img = np.empty((H, W), np.int32)
 
-    queue.finish()
-    t_kernels = time.perf_counter()
+    # device buffers for the largest tile, reused
+    tw_max, th_max = min(tile, W) + 2 * halo, min(tile, H) + 2 * halo
+    nmax = tw_max * th_max
+    origins, dirs, point, normal = (cla.empty(queue, nmax, pr.vec_dtype) for _ in range(4))
+    depth, bracket = (cla.empty(queue, nmax, pr.scalar) for _ in range(2))
+    status, samples, flags = (cla.empty(queue, nmax, np.int32) for _ in range(3))
+    rgba = cla.empty(queue, nmax, cl.cltypes.float4)
+
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
-    cl.Kernel(prg, "generate_rays")(queue, (w, h), None, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
-                      np.int32(w), np.int32(h), origins.data, dirs.data)
-
     c = pr.v4(f.c)
     near = -1.0 if m.near == "auto" else float(m.near)
     far = -1.0 if m.far == "auto" else float(m.far)
-    march_args = (origins.data, dirs.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
-                  pr.scalar(m.epsilon), pr.scalar(march_radius(scene)), pr.scalar(near),
-                  pr.scalar(far), np.int32(m.z_resolution), np.int32(m.post_steps),
-                  np.int32(m.max_steps), depth.data, point.data, status.data, samples.data,
-                  flags.data)
-    # rows in chunks, so a progress bar can move and no single launch runs for minutes
-    rows = max(1, min(h, (1 << 16) // w))
-    march_kernel = cl.Kernel(prg, "march")
-    with tqdm(total=h, unit="row", file=sys.stderr, delay=1.0, leave=False,
-              disable=not progress, desc="march") as bar:
-        for y0 in range(0, h, rows):
-            y1 = min(h, y0 + rows)
-            march_kernel(queue, ((y1 - y0) * w,), None, *march_args, global_offset=(y0 * w,))
-            queue.finish()
-            bar.update(y1 - y0)
-
-    launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status, normal)
-
-    sh = scene.shading
+    march_const = (c, np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(m.epsilon),
+                   pr.scalar(march_radius(scene)), pr.scalar(near), pr.scalar(far),
+                   np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
     lp = light_position(scene)
     light = pr.v4(lp if lp is not None else frame.position)
-    cl.Kernel(prg, "shade")(queue, (n,), None, status.data, normal.data, point.data, eye, right, up, fwd, light,
-              _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
-              np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-              np.float32(sh.shininess), rgba.data)
+    rays_k, march_k, shade_k = (cl.Kernel(prg, k) for k in ("generate_rays", "march", "shade"))
+
     queue.finish()
-    kernel_seconds = time.perf_counter() - t_kernels
+    t_kernels = time.perf_counter()
+    kernel_seconds = 0.0
+    with tqdm(total=W * H, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
+              disable=not progress, desc="render") as bar:
+        for x0, y0, tw, th in tiles(W, H, tile):
+            t0 = time.perf_counter()
+            # the tile with its halo, clipped to the image
+            ax0, ay0 = max(0, x0 - halo), max(0, y0 - halo)
+            ax1, ay1 = min(W, x0 + tw + halo), min(H, y0 + th + halo)
+            aw, ah = ax1 - ax0, ay1 - ay0
+            n = aw * ah
+            rays_k(queue, (aw, ah), None, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
+                   np.int32(W), np.int32(H), np.int32(ax0), np.int32(ay0), origins.data, dirs.data)
+            march_k(queue, (n,), None, origins.data, dirs.data, *march_const, depth.data, point.data,
+                    status.data, samples.data, flags.data, bracket.data)
+            launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status,
+                           normal, size=(aw, ah))
+            shade_k(queue, (n,), None, status.data, normal.data, point.data, eye, right, up, fwd, light,
+                    _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
+                    np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
+                    np.float32(sh.shininess), rgba.data)
+            queue.finish()
+            kernel_seconds += time.perf_counter() - t0
 
-    def vec(a, k):
-        return a.get().view(pr.scalar).reshape(h, w, 4)[..., :k].astype(np.float32)
+            # the tile's own pixels, without the halo
+            ys, xs = slice(y0 - ay0, y0 - ay0 + th), slice(x0 - ax0, x0 - ax0 + tw)
+            dst = (slice(y0, y0 + th), slice(x0, x0 + tw))
 
-    col = rgba.get().view(np.float32).reshape(h, w, 4)
-    # guard flags (kernels/real.cl): the march's buffer and the normals' w
-    gflags = flags.get() | normal.get().view(pr.scalar).reshape(n, 4)[:, 3].astype(np.int32)
-    st, sm = status.get(), samples.get()
+            def get(buf, k=None, dtype=None):
+                a = buf.get()[:n]
+                if k is not None:
+                    a = a.view(pr.scalar).reshape(n, 4)[:, :k]
+                    return a.reshape(ah, aw, k)[ys, xs]
+                return a.reshape(ah, aw)[ys, xs]
+
+            col = rgba.get()[:n].view(np.float32).reshape(ah, aw, 4)[ys, xs]
+            color[dst] = col[..., :3]
+            alpha[dst] = col[..., 3]
+            depth_img[dst] = get(depth)
+            bracket_img[dst] = get(bracket)
+            nrm = get(normal, 4)
+            normal_img[dst] = nrm[..., :3]
+            position[dst] = get(point, 4)
+            status_img[dst] = get(status)
+            samples_img[dst] = get(samples)
+            # guard flags (kernels/real.cl): the march's buffer and the normals' w
+            guard_img[dst] = get(flags) | nrm[..., 3].astype(np.int32)
+            bar.update(tw * th)
+
     result = RenderResult(
-        color=np.ascontiguousarray(col[..., :3]), alpha=np.ascontiguousarray(col[..., 3]),
-        depth=depth.get().reshape(h, w).astype(np.float32),
-        normal=vec(normal, 3), position=vec(point, 4),
-        status=st.reshape(h, w), samples=sm.reshape(h, w),
+        color=color, alpha=alpha, depth=depth_img, normal=normal_img, position=position,
+        status=status_img, samples=samples_img, bracket=bracket_img,
         device_name=dev.name.strip(), kernel_seconds=kernel_seconds,
-        guards=count_guards(st, depth.get(), gflags))
+        guards=count_guards(status_img, depth_img, guard_img))
     result.seconds = time.perf_counter() - t_start
     return result
-

@@ -1,5 +1,5 @@
-"""Refuse hopeless settings before any kernel runs (issue 4, "Hopeless settings"),
-and refuse settings whose arithmetic the chosen precision cannot hold.
+"""Refuse hopeless settings before any kernel runs, and refuse settings whose
+arithmetic the chosen precision, or whose image the memory, cannot hold.
 
 ``estimate(scene)`` bounds the work from above, in iterations of the set test
 (one q -> q^2 + c step with its bailout check):
@@ -16,6 +16,7 @@ force=True)`` skips the refusal.  render() calls it right after picking the devi
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from dataclasses import dataclass
 
@@ -140,10 +141,40 @@ def check_numerics(scene: Scene) -> None:
             raise WorkloadError(key, f"must be below {2**31 - 2} (the kernel's int loop counter), got {v}")
 
 
+# Host memory per pixel: the result's float32 arrays (colour 12, alpha 4, depth 4, bracket 4,
+# normal 12, position 16, status 4, samples 4, guards 4 = 64 bytes) plus the copies the
+# PNG/EXR writers make (up to ~52 bytes).  The device holds one tile at a time (render.TILE).
+HOST_BYTES_PER_PIXEL = 128
+HOST_MEMORY_SHARE = 0.5     # of the physical memory
+
+
+def physical_memory() -> int:
+    """Bytes of physical memory (0 where the platform does not say)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 0
+
+
+def check_memory(scene: Scene) -> None:
+    """Refuse an image whose result arrays would not fit in memory (always; not skipped by
+    force: it would fail, not merely take long).  Any size that fits renders, tile by tile."""
+    w, h = scene.image.width, scene.image.height
+    need = float(w) * h * HOST_BYTES_PER_PIXEL
+    total = physical_memory()
+    if total and need > HOST_MEMORY_SHARE * total:
+        key = "image.width" if w >= h else "image.height"
+        most = int(HOST_MEMORY_SHARE * total / HOST_BYTES_PER_PIXEL)
+        raise WorkloadError(key, f"{w}x{h} = {float(w) * h:.3g} pixels needs ~{need / 2**30:.3g} GiB "
+                                 f"of memory for the image ({HOST_BYTES_PER_PIXEL} bytes per pixel), over "
+                                 f"half of this machine's {total / 2**30:.3g} GiB; at most ~{most:.3g} pixels")
+
+
 def check(scene: Scene, device=None, force: bool = False) -> Estimate:
-    """Before any kernel runs: refuse what the precision cannot hold, refuse work above
+    """Before any kernel runs: refuse what the precision or the memory cannot hold, refuse work above
     REFUSE_ITERATIONS (unless ``force``), warn above WARN_ITERATIONS.  Returns the estimate."""
     check_numerics(scene)
+    check_memory(scene)
     est = estimate(scene, device)
     text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
             f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "

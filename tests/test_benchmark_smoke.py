@@ -28,9 +28,10 @@ def test_quick_run_writes_sane_results(tmp_path):
         for m in bench.NORMAL_METHODS:
             assert 0 <= float(r[f"normal_err_{m}_median"]) <= 180
         assert r["device"] and r["commit"] and r["date"]
-    # post-stepping makes the fixed scan's depth more accurate (seed 000 eq. 12)
-    sphere = {(r["method"], r["post_steps"]): float(r["depth_err_p99"]) for r in rows if r["scene"] == "sphere"}
-    assert sphere[("fixed", "10")] < sphere[("fixed", "0")] / 100
+    # post-stepping makes the fixed scan's depth more accurate (seed 000 eq. 12); on the
+    # real-c scene (on the c = 0 ball the bounding sphere is the surface: no bracket to narrow)
+    real = {(r["method"], r["post_steps"]): float(r["depth_err_median"]) for r in rows if r["scene"] == "real"}
+    assert real[("fixed", "10")] < real[("fixed", "0")] / 100
     md = (tmp_path / "error_vs_time.md").read_text()
     assert "device:" in md and "commit:" in md and "| method | z_res |" in md
     assert (tmp_path / "error_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -51,7 +51,11 @@ def check_outputs(res, s):
     assert np.all(np.isfinite(res.color)) and np.all(np.isfinite(res.alpha))
     assert np.all(np.isfinite(res.position[hit])) and np.all(np.isnan(res.position[~hit]))
     g = res.guards
-    assert set(g) == {"ulp_step", "normal_fallback", "jacobian_tiny", "eye_hit"}
+    assert set(g) == {"ulp_step", "normal_fallback", "jacobian_tiny", "eye_hit", "shell_miss"}
+    # every hit's depth is certified: a bracket of finite width >= 0 behind it, +inf elsewhere
+    assert np.all(np.isfinite(res.bracket[hit])) and np.all(res.bracket[hit] >= 0)
+    assert np.all(np.isposinf(res.bracket[~hit]))
+    assert g["shell_miss"] == 0 or m.method == "de"
     assert g["eye_hit"] == int(np.sum(hit & (res.depth == 0)))
     assert all(0 <= v <= st.size for v in g.values())
 

@@ -21,56 +21,77 @@ def run_march(s: Scene):
     near = -1.0 if m.near == "auto" else m.near
     far = -1.0 if m.far == "auto" else m.far
     depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
-    flags = R.out(n, np.int32)
+    flags, bracket = R.out(n, np.int32), R.out(n)
     args = (f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), near, far,
             m.z_resolution, m.post_steps, m.max_steps)
     R("march", (n,), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
       R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(near), R.scalar(far),
       np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples, flags)
-    k = (depth.get().astype(float), R.get4(point), status.get(), samples.get())
+      depth, point, status, samples, flags, bracket)
+    k = (depth.get().astype(float), R.get4(point), status.get(), samples.get(),
+         bracket.get().astype(float))
     rflags = np.zeros(n, np.int32)
-    r = ref.march(o, d, *args, m.method, rflags)
+    rbracket = np.zeros(n)
+    r = ref.march(o, d, *args, m.method, rflags, m.refine, rbracket) + (rbracket,)
     # the guard flags (kernels/real.cl) agree wherever the statuses do
     same = k[2] == r[2]
     assert np.array_equal(flags.get()[same], rflags[same])
     return k, r
 
 
+BISECT = "march.refine=bisect"
 CASES = [
     ["march.method=fixed", "march.z_resolution=120", "march.post_steps=0"],
+    ["march.method=fixed", "march.z_resolution=60", "march.post_steps=10", BISECT],
     ["march.method=fixed", "march.z_resolution=60", "march.post_steps=10"],
     ["march.method=de", "march.post_steps=0"],
-    ["march.method=de", "march.post_steps=6", "fractal.c=0.4,0.5,0,0", "fractal.max_iter=8"],
-    ["march.method=fixed", "march.z_resolution=80", "march.post_steps=4", "render.float=double"],
-    ["march.method=de", "march.post_steps=4", "render.float=double", "camera.position=-2,1,5,8"],
+    ["march.method=de", "march.post_steps=6", "fractal.c=0.4,0.5,0,0", "fractal.max_iter=8", BISECT],
+    ["march.method=de", "march.post_steps=12", "fractal.c=0.4,0.5,0,0", "fractal.max_iter=20",
+     "march.epsilon=1e-5"],
+    ["march.method=fixed", "march.z_resolution=80", "march.post_steps=4", "render.float=double", BISECT],
+    ["march.method=fixed", "march.z_resolution=80", "march.post_steps=8", "render.float=double"],
+    ["march.method=de", "march.post_steps=4", "render.float=double", "camera.position=-2,1,5,8", BISECT],
+    ["march.method=de", "march.post_steps=10", "render.float=double", "camera.position=-2,1,5,8"],
 ]
 
 
 @pytest.mark.parametrize("over", CASES)
 def test_march_matches_reference(over):
     s = Scene.default().with_overrides(over)
-    (kd, kp, ks, kn), (rd, rp, rs, rn) = run_march(s)
+    (kd, kp, ks, kn, kb), (rd, rp, rs, rn, rb) = run_march(s)
     double = s.render.float == "double"
     # float32 can flip the classification of a sample that grazes the surface, which moves
     # that ray's first hit to a neighbouring sample: allowed on at most 1% of rays (none
-    # in double).  Every other ray must agree to rounding of t = near + i h (and of the
-    # bisection), 1e-5 in single.
+    # in double).
     assert np.mean(ks != rs) <= (0 if double else 0.01)
     both = (ks == 1) & (rs == 1)
     assert both.sum() > 0.02 * W * H
+    # every hit's bracket is certified in both: [depth, depth + width], both ends classified
+    # by the set test, so two renders of one ray must give overlapping brackets.  Float32
+    # places t to ~2e-7 t and can classify a point within that of the surface either way.
+    tol = 1e-12 if double else 1e-6
+    slack = tol * (1 + np.maximum(kd[both], rd[both]))
+    lo, hi = np.maximum(kd[both], rd[both]), np.minimum(kd[both] + kb[both], rd[both] + rb[both])
+    assert np.mean(lo > hi + slack) <= (0 if double else 0.01)
     dz = np.abs(kd[both] - rd[both])
-    tol = 1e-9 if double else 1e-5
-    assert np.mean(dz > tol) <= (0 if double else 0.01)
-    assert np.median(dz) < tol
+    if s.march.refine == "bisect":
+        # bisection takes the same decisions in both: equal to rounding of t = near + i h
+        assert np.mean(dz > 10 * tol) <= (0 if double else 0.01)
+        np.testing.assert_allclose(kb[both][dz <= 10 * tol], rb[both][dz <= 10 * tol],
+                                   atol=20 * tol)
+    else:
+        # ITP's interpolation differs with rounding: equal within the wider bracket
+        assert np.mean(dz > np.maximum(kb[both], rb[both]) + slack) <= (0 if double else 0.01)
+    assert np.median(dz) < 10 * tol + np.median(np.maximum(kb[both], rb[both]))
     np.testing.assert_allclose(kp[both][dz <= tol], rp[both][dz <= tol], atol=4 * tol)
     assert np.all(np.isinf(kd[ks != 1])) and np.all(np.isnan(kp[ks != 1]))
+    assert np.all(np.isinf(kb[ks != 1])) and np.all(kb[ks == 1] >= 0)
     assert np.mean(kn != rn) <= (0 if double else 0.01)
 
 
 def test_rays_missing_the_bounding_sphere_do_no_work():
     s = Scene.default().with_overrides(["camera.fov=120"])
-    (kd, kp, ks, kn), _ = run_march(s)
+    (kd, kp, ks, kn, kb), _ = run_march(s)
     o, d = ref.generate_rays(camera_frame(s), W, H)
     b = np.sum(o * d, 1)
     miss = b * b - (np.sum(o * o, 1) - march_radius(s) ** 2) < -1e-6
@@ -79,17 +100,47 @@ def test_rays_missing_the_bounding_sphere_do_no_work():
 
 def test_step_cap_is_reported_not_hung():
     s = Scene.default().with_overrides(["march.method=de", "march.max_steps=3", "march.epsilon=1e-6"])
-    (kd, kp, ks, kn), (rd, rp, rs, rn) = run_march(s)
+    (kd, kp, ks, kn, kb), (rd, rp, rs, rn, rb) = run_march(s)
     assert np.any(ks == 2) and np.all(kn <= 3)
     assert np.array_equal(ks == 2, rs == 2)
 
 
-def test_post_step_halves_the_bracket():
-    # seed 000 eq. 12: n post-steps shrink the uncertainty from h to h / 2^n
-    o = np.zeros((1, 4))
-    d = np.array([[1.0, 0, 0, 0]])
-    surface = 0.3
-    hit_test = lambda p: p[:, 0] >= surface
-    for n in range(1, 12):
-        t = ref.post_step(o, d, np.array([0.5]), np.array([0.25]), n, hit_test)
-        assert abs(t[0] - surface) <= 0.25 / 2 ** n + 1e-15
+def test_post_steps_halve_the_bracket():
+    # seed 000 eq. 12: n post-steps shrink the bracket from h to h / 2^n; ITP reaches the
+    # same bound (or better) with no more set tests
+    s = Scene.default().with_overrides(["fractal.c=0,0,0,0", "fractal.max_iter=3"])
+    f = s.fractal
+    o = np.array([[0.0, 0, 0, 0], [0.1, 0.2, 0, 0]]) - 3 * np.array([1.0, 0, 0, 0])
+    d = np.tile([1.0, 0, 0, 0], (2, 1))
+    for itp in (False, True):
+        for n in range(0, 16):
+            a, w = ref.refine_bracket(o, d, np.array([1.0, 1.0]), np.array([2.6, 2.6]), n,
+                                      f.c, f.max_iter, f.bailout, itp)
+            assert np.all(w <= 1.6 / 2 ** n + 1e-15)
+            # certified: a outside, a + w inside
+            assert not ref.julia_inside(o + a[:, None] * d, f.c, f.max_iter, f.bailout).any()
+            assert ref.julia_inside(o + (a + w)[:, None] * d, f.c, f.max_iter, f.bailout).all()
+
+
+def test_itp_needs_fewer_set_tests_than_bisection():
+    # the level function is smooth along the ray: ITP reaches bisection's 20-step bracket
+    # in far fewer tests (counted by the early exit: remaining steps unused)
+    s = Scene.default().with_overrides(["fractal.c=-0.2,0.8,0,0"])
+    f = s.fractal
+    o, d = ref.generate_rays(camera_frame(s), 24, 18)
+    t, _, st, _ = ref.march(o, d, f.c, f.max_iter, f.bailout, 1e-3, march_radius(s), -1, -1, 250, 0, 4096,
+                          "fixed")
+    hit = st == 1
+    o, d, t = o[hit], d[hit], t[hit]
+    h = 0.02
+    a0, b0 = t - h, t
+    out = ~ref.julia_inside(o + a0[:, None] * d, f.c, f.max_iter, f.bailout)
+    o, d, a0, b0 = o[out], d[out], a0[out], b0[out]
+    for steps in (10, 20):
+        n_bis, n_itp = np.zeros(len(o), int), np.zeros(len(o), int)
+        _, w_bis = ref.refine_bracket(o, d, a0, b0, steps, f.c, f.max_iter, f.bailout, False, n_bis)
+        _, w_itp = ref.refine_bracket(o, d, a0, b0, steps, f.c, f.max_iter, f.bailout, True, n_itp)
+        assert np.all(w_itp <= h / 2 ** steps * (1 + 1e-9)) and np.all(w_bis <= h / 2 ** steps * (1 + 1e-9))
+        assert np.all(n_itp <= steps + 1) and np.all(n_bis == steps)
+        # measured: median 4 tests for 10 steps, 5 for 20 (c = -0.2+0.8i, max_iter 12)
+        assert np.median(n_itp) <= steps / 2

@@ -19,7 +19,7 @@ def test_generate_rays_matches_reference(over, fl, tol):
     w, h = 37, 23
     o, d = R.out4(w * h), R.out4(w * h)
     R("generate_rays", (w, h), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
-      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), o, d)
+      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), np.int32(0), np.int32(0), o, d)
     ro, rd = ref.generate_rays(f, w, h)
     # rounding of the frame to the kernel's precision and one normalise: a few ulp of a
     # unit vector (float32: 2e-6; float64: 1e-14)
@@ -66,3 +66,19 @@ def test_slice_camera_rays_stay_in_hyperplane():
 def test_degenerate_camera_names_the_key(over, key):
     with pytest.raises(SceneError, match=f"^{key}"):
         camera_frame(Scene.default().with_overrides(over))
+
+
+def test_tile_of_rays_matches_the_whole_image():
+    # render.py renders in tiles: the tile at (x0, y0) is the same rays as that part of the image
+    s = Scene.default().with_overrides(["image.width=37", "image.height=23"])
+    R = Runner(build.scene_config(s))
+    f = camera_frame(s)
+    w, h, x0, y0, tw, th = 37, 23, 11, 5, 9, 7
+    o, d = R.out4(tw * th), R.out4(tw * th)
+    R("generate_rays", (tw, th), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
+      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), np.int32(x0), np.int32(y0), o, d)
+    _, rd = ref.generate_rays(f, w, h)
+    want = rd.reshape(h, w, 4)[y0:y0 + th, x0:x0 + tw].reshape(-1, 4)
+    np.testing.assert_allclose(R.get4(d), want, atol=2e-6)
+    _, rt = ref.generate_rays(f, w, h, x0, y0, tw, th)
+    np.testing.assert_array_equal(rt, want)

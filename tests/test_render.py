@@ -48,7 +48,10 @@ def test_cli_renders_exr_with_all_channels(tmp_path):
     assert p.stdout.count("\n") == 1 and "% of pixels hit" in p.stdout
     f = OpenEXR.File(str(tmp_path / "out.exr"), separate_channels=True)
     ch = {k: v.pixels for k, v in f.channels().items()}
-    assert set(ch) == {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"}
+    assert set(ch) == {"R", "G", "B", "A", "Z", "Z.bracket", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"}
+    hit = ch["A"] == 1
+    assert np.all(np.isfinite(ch["Z.bracket"][hit])) and np.all(ch["Z.bracket"][hit] >= 0)
+    assert np.all(np.isposinf(ch["Z.bracket"][~hit]))
     assert all(v.dtype == np.float32 and v.shape == (30, 40) for v in ch.values())
     hit = ch["A"] == 1
     assert hit.any() and (~hit).any()
