@@ -81,3 +81,25 @@ def test_cli_default_scene_png(tmp_path):
     assert im.mode == "RGBA" and im.size == (32, 24)
     a = np.asarray(im)[..., 3]
     assert set(np.unique(a)) <= {0, 255} and (a == 255).any()
+
+
+@pytest.mark.parametrize("normals", ["jacobian", "zbuffer"])
+def test_tiles_give_the_same_image(normals):
+    # any size renders in tiles of bounded device memory; the Z-buffer normals difference
+    # neighbours across tile edges through a one-pixel halo, so the tiling is invisible
+    s = Scene.default().with_overrides(["image.width=53", "image.height=41", f"normals.method={normals}"])
+    whole = render(s)
+    tiled = render(s, tile=16)
+    for k in ("depth", "bracket", "status", "samples", "normal", "color", "alpha"):
+        np.testing.assert_array_equal(getattr(tiled, k), getattr(whole, k), err_msg=k)
+    assert tiled.guards == whole.guards
+
+
+def test_image_too_large_for_memory_refused_before_rendering():
+    from pyjulia4d import workload
+    from pyjulia4d.scene import SceneError
+
+    for w, h in [(1_000_000_000, 1), (100_000, 100_000), (46341, 46341), (65536, 65536)]:
+        s = Scene.default().with_overrides([f"image.width={w}", f"image.height={h}"])
+        with pytest.raises(SceneError, match=r"^image\.(width|height): .* pixels needs ~.* GiB"):
+            workload.check(s, force=True)
