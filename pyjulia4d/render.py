@@ -60,6 +60,33 @@ class RenderResult:
         return {"p50": float(np.percentile(b, 50)), "p99": float(np.percentile(b, 99)),
                 "max": float(b.max())}
 
+    def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
+        """What a render says about itself: (header entries for PNG/EXR, the tail of the
+        closing line).  Capped rays, the guards that fired and the certified depth bracket
+        (p50/p99/max) are never hidden; with ``stated_p99`` (the bound a quality preset
+        states) the line says whether this render's bracket p99 is within it."""
+        b = self.bracket_stats()
+        bracket = " ".join(f"{k}={v:.3g}" for k, v in b.items())
+        header = {
+            "pyjulia4d.device": self.device_name,
+            "pyjulia4d.render_seconds": "%.6f" % self.seconds,
+            "pyjulia4d.capped_pixels": str(self.capped),
+            "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in self.guards.items()),
+            "pyjulia4d.depth_bracket": bracket,
+        }
+        fired = [f"{k} {v}" for k, v in self.guards.items() if v]
+        tail = f", {self.capped} capped" if self.capped else ""
+        tail += f"; guards fired: {', '.join(fired)}" if fired else ""
+        if not math.isnan(b["p99"]):
+            tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}"
+            if stated_p99 is not None:
+                ok = b["p99"] <= stated_p99
+                tail += (f" (within the preset's stated {stated_p99:.0e})" if ok else
+                         f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer "
+                         f"preset or more march.post_steps)")
+                header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
+        return header, tail
+
     @property
     def capped(self) -> int:
         """Pixels whose march ran into the step cap (counted, never hidden)."""

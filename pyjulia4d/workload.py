@@ -4,8 +4,9 @@ arithmetic the chosen precision, or whose image the memory, cannot hold.
 ``estimate(scene)`` bounds the work from above, in iterations of the set test
 (one q -> q^2 + c step with its bailout check):
 
-    fixed:  pixels x (z_resolution + 1 + post_steps) x max_iter
-    de:     pixels x (max_steps + post_steps) x max_iter
+    fixed:  pixels x (z_resolution + 1 + refine) x max_iter
+    de:     pixels x (max_steps + refine) x max_iter
+    refine: post_steps (bisect) or post_steps + 3 (itp: one extra test, two end levels)
     normals: + pixels x max_iter x (4 jacobian columns | 6 gradient estimates | 0 zbuffer)
 
 and turns it into hours with a measured throughput.  ``check(scene)`` raises a
@@ -77,11 +78,13 @@ def estimate(scene: Scene, device=None) -> Estimate:
     (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
     f, m = scene.fractal, scene.march
     pixels = scene.image.width * scene.image.height
+    # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (refine.cl)
+    refine = m.post_steps + 3 if m.refine == "itp" else m.post_steps
     if m.method == "fixed":
-        per_ray = m.z_resolution + 1 + m.post_steps
+        per_ray = m.z_resolution + 1 + refine
         march_key = "march.z_resolution"
     else:
-        per_ray = m.max_steps + m.post_steps
+        per_ray = m.max_steps + refine
         march_key = "march.max_steps"
     its = float(pixels) * per_ray * f.max_iter
     its += float(pixels) * f.max_iter * NORMAL_COST.get(scene.normals.method, 6)

@@ -233,7 +233,7 @@ def test_hopeless_refused_instantly():
     assert "\n" not in msg and msg.startswith("march.z_resolution: 1000000000 ")
     assert "iterations" in msg and " h " in msg
     est = workload.estimate(s)
-    assert est.iterations == pytest.approx(3840 * 2160 * (1e9 + 1 + 4) * 12 + 3840 * 2160 * 12 * 4)
+    assert est.iterations == pytest.approx(3840 * 2160 * (1e9 + 1 + 4 + 3) * 12 + 3840 * 2160 * 12 * 4)
     assert est.dominant == "march.z_resolution"
     with pytest.warns(RuntimeWarning, match=r"^march\.z_resolution: "):
         assert workload.check(s, force=True).hours > 1   # force skips the refusal (nothing rendered)
