@@ -28,6 +28,14 @@ def cross4(a, b, c) -> np.ndarray:
     ])
 
 
+def unit(v) -> np.ndarray:
+    """v / |v| for a finite, non-zero v, divided by its largest component first: |v|
+    neither overflows (1e300 components) nor underflows (1e-300 ones) on the way."""
+    v = np.asarray(v, float)
+    v = v / np.max(np.abs(v))
+    return v / np.linalg.norm(v)
+
+
 def slice_rotation(normal) -> np.ndarray:
     """The rotation R with R e_w = n/|n| that turns in the plane of e_w and n only.
 
@@ -37,8 +45,7 @@ def slice_rotation(normal) -> np.ndarray:
     solves for w, this map is an isometry: the section is seen undistorted and a
     normal with zero w-component is allowed.
     """
-    n = np.asarray(normal, float)
-    n = n / np.linalg.norm(n)
+    n = unit(normal)
     e = np.array([0.0, 0.0, 0.0, 1.0])
     cos = float(n @ e)
     if 1.0 + cos < 1e-12:  # n = -e_w: flip w only; x, y, z (the view) are unchanged
@@ -62,7 +69,7 @@ def _unit(v: np.ndarray, key: str, what: str) -> np.ndarray:
     n = float(np.linalg.norm(v))
     if not n > 1e-9 or not math.isfinite(n):
         raise SceneError(key, what)
-    return v / n
+    return unit(v)
 
 
 def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
@@ -70,8 +77,7 @@ def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
     r = slice_rotation(scene.slice.normal)
     v = r @ np.asarray(p, float)
     if not direction:
-        n = np.asarray(scene.slice.normal, float)
-        v = v + scene.slice.distance * n / np.linalg.norm(n)
+        v = v + scene.slice.distance * unit(scene.slice.normal)
     return v
 
 
@@ -83,9 +89,10 @@ def camera_frame(scene: Scene) -> Frame:
     cam = scene.camera
     pos = to_world(scene, cam.position)
     fwd = _unit(to_world(scene, cam.target) - pos, "camera.target", "equals camera.position")
-    limbo = to_world(scene, cam.limbo, direction=True)
+    # directions are normalised before use: any non-zero length is valid (scene.py)
+    limbo = to_world(scene, unit(cam.limbo), direction=True)
     limbo = _unit(limbo - (limbo @ fwd) * fwd, "camera.limbo", "parallel to the view direction")
-    up = to_world(scene, cam.up, direction=True)
+    up = to_world(scene, unit(cam.up), direction=True)
     up = up - (up @ fwd) * fwd - (up @ limbo) * limbo
     up = _unit(up, "camera.up", "parallel to the view direction or to camera.limbo")
     right = cross4(fwd, up, limbo)

@@ -25,9 +25,6 @@ Vec3 = tuple[float, float, float]
 Vec4 = tuple[float, float, float, float]
 Auto = Literal["auto"]
 
-_INT_MAX = 2**31 - 1  # ints end up as OpenCL `int` kernel arguments
-
-
 class SceneError(ValueError):
     """Invalid scene input; ``str(e)`` is ``"<dotted key>: <reason>"``.
 
@@ -132,109 +129,167 @@ class Render:
 
 
 # ---------------------------------------------------------------- checkers
-# A checker takes (dotted key, raw value) and returns the normalised value.
+# A checker is called as check(dotted key, raw value) and returns the normalised value;
+# ``valid`` is its valid range in words, as README's "Scene keys" table shows it.
+#
+# Why these ranges: every value must reach the float32 kernels finite, with room for
+# the arithmetic done on it there (squares of positions, products of shading weights).
+# Positions and distances up to 1e6 (a camera 1e4 away is the catalogue's far case),
+# so points stay below ~3e6 and their squares below 1e13; near/far up to 1e7 covers
+# any ray through that region.  |c| components up to 1e3: beyond |c| = 2 the set is
+# already dust.  Shading weights and colours up to 1e3 keep colour sums below ~1e10.
+# Integers are OpenCL ints; max_iter and post_steps are capped where more cannot
+# change a float64 render (60 post-steps already bisect below float64's spacing).
 
-Checker = Callable[[str, Any], Any]
+_INT_MAX = 2**31 - 1  # ints end up as OpenCL `int` kernel arguments
+COORD = 1e6           # bound of positions, directions' components and slice.distance
+MAX_SCENE_BYTES = 1 << 20  # scene files larger than this are refused unread
 
 
-def _number(key: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise SceneError(key, f"expected a number, got {v!r}")
+def _fmt(x: float) -> str:
+    """A bound as README writes it: 1e6, 1e-3, 179.9, 0, 2147483647."""
+    if isinstance(x, int):
+        return str(x)
+    if x != 0 and not 1e-2 <= abs(x) < 1e3:
+        mantissa, exponent = f"{x:.14e}".split("e")
+        return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+    return f"{x:g}"
+
+
+def _show(v: Any, limit: int = 60) -> str:
+    """repr(v) for an error message: one line, at most ``limit`` characters."""
     try:
-        x = float(v)
-    except OverflowError:
-        x = math.inf
-    if not math.isfinite(x):
-        raise SceneError(key, "not a finite number")
-    return x
+        s = repr(v)
+    except ValueError:  # an int of more than 4300 digits
+        s = f"<an integer of ~{int(v.bit_length() * math.log10(2)) + 1} digits>"
+    except RecursionError:  # a deeply nested list
+        s = f"<a deeply nested {type(v).__name__}>"
+    return s if len(s) <= limit else s[: limit - 3] + "..."
 
 
-def _real(pred: Callable[[float], bool] | None = None, desc: str = "") -> Checker:
-    def check(key: str, v: Any) -> float:
-        x = _number(key, v)
-        if pred is not None and not pred(x):
-            raise SceneError(key, f"must be {desc}, got {x!r}")
-        return x
-
-    return check
+def _show_key(key: str) -> str:
+    """A user-given key or path as it goes into a message: itself when plain, else repr."""
+    return key if key and key.isprintable() and len(key) <= 80 else _show(key, 80)
 
 
-def _integer(minimum: int) -> Checker:
-    def check(key: str, v: Any) -> int:
+@dataclass(frozen=True)
+class _Range:
+    """lo <= x <= hi (lo < x with ``lo_open``)."""
+
+    lo: float
+    hi: float
+    lo_open: bool = False
+
+    def __contains__(self, x: float) -> bool:
+        return (self.lo < x if self.lo_open else self.lo <= x) and x <= self.hi
+
+    def __str__(self) -> str:
+        return f"{'(' if self.lo_open else '['}{_fmt(self.lo)}, {_fmt(self.hi)}]"
+
+
+class _Real:
+    """A finite number in a range; ints are taken as floats, -0.0 becomes 0.0."""
+
+    verbatim = False  # an override's VALUE is parsed as numbers, not kept as text
+
+    def __init__(self, lo: float, hi: float, lo_open: bool = False) -> None:
+        self.range = _Range(lo, hi, lo_open)
+        self.valid = str(self.range)
+
+    def __call__(self, key: str, v: Any) -> float:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise SceneError(key, f"expected a number, got {_show(v)}")
+        if isinstance(v, float) and not math.isfinite(v):
+            raise SceneError(key, "not a finite number")
+        if v not in self.range:  # an int compares exactly, however large
+            raise SceneError(key, f"must be in {self.range}, got {_show(v)}")
+        return float(v) + 0.0
+
+
+class _Integer:
+    """An integer (not a float, not a bool) in a range."""
+
+    verbatim = False
+
+    def __init__(self, lo: int, hi: int) -> None:
+        self.range = _Range(lo, hi)
+        self.valid = f"integer in {self.range}"
+
+    def __call__(self, key: str, v: Any) -> int:
         if isinstance(v, bool) or not isinstance(v, int):
-            raise SceneError(key, f"expected an integer, got {v!r}")
-        if v < minimum:
-            raise SceneError(key, f"must be >= {minimum}, got {v}")
-        if v > _INT_MAX:
-            raise SceneError(key, f"must be <= {_INT_MAX}, got {v}")
+            raise SceneError(key, f"expected an integer, got {_show(v)}")
+        if v not in self.range:
+            raise SceneError(key, f"must be in {self.range}, got {_show(v)}")
         return v
 
-    return check
 
+class _Choice:
+    """One of a few words."""
 
-_TEXT_CHECKERS: set[Checker] = set()  # their override VALUE is kept verbatim
+    verbatim = True  # an override's VALUE is the word itself
 
+    def __init__(self, *options: str) -> None:
+        self.options = options
+        quoted = [f'"{o}"' for o in options]
+        self.valid = quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
 
-def _choice(*options: str) -> Checker:
-    def check(key: str, v: Any) -> str:
-        if not isinstance(v, str) or v not in options:
-            raise SceneError(key, f"expected one of {', '.join(map(repr, options))}, got {v!r}")
+    def __call__(self, key: str, v: Any) -> str:
+        if not isinstance(v, str) or v not in self.options:
+            raise SceneError(key, f"expected one of {', '.join(map(repr, self.options))}, got {_show(v)}")
         return v
 
-    _TEXT_CHECKERS.add(check)
-    return check
 
+class _Vector:
+    """A fixed-length list of numbers, each in [lo, hi]; a 3-vector where 4 are allowed
+    gets w = 0.  ``nonzero``: a direction, any length but 0 (it is normalised by its
+    largest component first, so tiny and huge lengths are both exact)."""
 
-def _vector(
-    lengths: tuple[int, ...],
-    nonzero: bool = False,
-    nonnegative: bool = False,
-) -> Checker:
-    """Fixed-length float vector; a 3-vector where 4 are allowed gets w = 0."""
-    want = " or ".join(map(str, lengths))
+    verbatim = False
 
-    def check(key: str, v: Any) -> tuple[float, ...]:
+    def __init__(self, lengths: tuple[int, ...], lo: float, hi: float, nonzero: bool = False) -> None:
+        self.lengths = lengths
+        self.element = _Real(lo, hi)
+        self.want = " or ".join(map(str, lengths))
+        self.valid = f"{self.want} numbers in {self.element.range}" + (", not all 0" if nonzero else "")
+        self.nonzero = nonzero
+
+    def __call__(self, key: str, v: Any) -> tuple[float, ...]:
         if not isinstance(v, (list, tuple)):
-            raise SceneError(key, f"expected a list of {want} numbers, got {v!r}")
-        if len(v) not in lengths:
-            raise SceneError(key, f"expected a list of {want} numbers, got {len(v)}")
+            raise SceneError(key, f"expected a list of {self.want} numbers, got {_show(v)}")
+        if len(v) not in self.lengths:
+            raise SceneError(key, f"expected a list of {self.want} numbers, got {len(v)}")
         xs = []
         for i, item in enumerate(v):
             try:
-                xs.append(_number(key, item))
+                xs.append(self.element(key, item))
             except SceneError as e:
                 raise SceneError(key, f"element {i}: {e.reason}") from None
-        if len(xs) == 3 and 4 in lengths:
+        if len(xs) == 3 and 4 in self.lengths:
             xs.append(0.0)
-        if nonzero and math.hypot(*xs) < 1e-12:
+        if self.nonzero and not any(xs):
             raise SceneError(key, "zero-length vector")
-        if nonnegative and min(xs) < 0:
-            raise SceneError(key, f"components must be >= 0, got {tuple(xs)}")
         return tuple(xs)
 
-    return check
 
+class _OrWord:
+    """The literal string ``word``, else what ``inner`` accepts."""
 
-def _or_string(word: str, inner: Checker, what: str) -> Checker:
-    """Accept the literal string ``word``, else defer to ``inner``."""
+    verbatim = False
 
-    def check(key: str, v: Any) -> Any:
+    def __init__(self, word: str, inner: Any) -> None:
+        self.word = word
+        self.inner = inner
+        self.valid = f'"{word}" or {inner.valid}'
+
+    def __call__(self, key: str, v: Any) -> Any:
         if isinstance(v, str):
-            if v == word:
+            if v == self.word:
                 return v
-            raise SceneError(key, f'expected "{word}" or {what}, got {v!r}')
-        return inner(key, v)
-
-    return check
+            raise SceneError(key, f"expected {self.valid}, got {_show(v)}")
+        return self.inner(key, v)
 
 
-def _gt0(x: float) -> bool:
-    return x > 0
-
-
-def _ge0(x: float) -> bool:
-    return x >= 0
-
+Checker = Callable[[str, Any], Any]
 
 _SECTIONS: dict[str, type] = {
     "fractal": Fractal,
@@ -247,58 +302,67 @@ _SECTIONS: dict[str, type] = {
     "render": Render,
 }
 
+# Every key's check and valid range, in one place (README's table is tested against it).
 _CHECKS: dict[str, dict[str, Checker]] = {
     "fractal": {
-        "algebra": _choice("quaternion"),
-        "function": _choice("sqr"),
-        "c": _vector((4,)),
-        "max_iter": _integer(1),
-        "bailout": _real(_gt0, "> 0"),
+        "algebra": _Choice("quaternion"),
+        "function": _Choice("sqr"),
+        "c": _Vector((4,), -1e3, 1e3),
+        "max_iter": _Integer(1, 1_000_000),
+        # above ~9.6e8 single precision is refused at render time (workload.py)
+        "bailout": _Real(1e-3, 1e76),
     },
     "camera": {
-        "position": _vector((3, 4)),
-        "target": _vector((3, 4)),
-        "up": _vector((3, 4), nonzero=True),
-        "limbo": _vector((3, 4), nonzero=True),
-        "fov": _real(lambda x: 0 < x < 180, "between 0 and 180 degrees (exclusive)"),
+        "position": _Vector((3, 4), -COORD, COORD),
+        "target": _Vector((3, 4), -COORD, COORD),
+        "up": _Vector((3, 4), -COORD, COORD, nonzero=True),
+        "limbo": _Vector((3, 4), -COORD, COORD, nonzero=True),
+        "fov": _Real(1e-6, 179.9),
     },
     "slice": {
-        "normal": _vector((4,), nonzero=True),
-        "distance": _real(),
+        "normal": _Vector((4,), -COORD, COORD, nonzero=True),
+        "distance": _Real(-COORD, COORD),
     },
     "march": {
-        "quality": _choice(*QUALITIES),
-        "method": _choice("fixed", "de"),
-        "z_resolution": _integer(1),
-        "post_steps": _integer(0),
-        "refine": _choice("itp", "bisect"),
-        "epsilon": _real(_gt0, "> 0"),
-        "max_steps": _integer(1),
-        "near": _or_string("auto", _real(_ge0, ">= 0"), "a number >= 0"),
-        "far": _or_string("auto", _real(_gt0, "> 0"), "a number > 0"),
+        "quality": _Choice(*QUALITIES),
+        "method": _Choice("fixed", "de"),
+        # the kernel's int loop counter: from 2^31 - 2 on refused at render time (workload.py)
+        "z_resolution": _Integer(1, _INT_MAX),
+        "post_steps": _Integer(0, 1000),
+        "refine": _Choice("itp", "bisect"),
+        "epsilon": _Real(1e-12, 1.0),
+        "max_steps": _Integer(1, _INT_MAX),
+        "near": _OrWord("auto", _Real(0.0, 1e7)),
+        "far": _OrWord("auto", _Real(0.0, 1e7, lo_open=True)),
     },
     "normals": {
-        "method": _choice("jacobian", "gradient", "zbuffer"),
-        "step": _or_string("auto", _real(_gt0, "> 0"), "a number > 0"),
+        "method": _Choice("jacobian", "gradient", "zbuffer"),
+        "step": _OrWord("auto", _Real(1e-12, 1.0)),
     },
     "shading": {
-        "color": _vector((3,), nonnegative=True),
-        "background": _vector((3,), nonnegative=True),
-        "ambient": _real(_ge0, ">= 0"),
-        "diffuse": _real(_ge0, ">= 0"),
-        "specular": _real(_ge0, ">= 0"),
-        "shininess": _real(_gt0, "> 0"),
-        "light": _or_string("eye", _vector((3, 4)), "a list of 3 or 4 numbers"),
-        "light_color": _vector((3,), nonnegative=True),
+        "color": _Vector((3,), 0.0, 1e3),
+        "background": _Vector((3,), 0.0, 1e3),
+        "ambient": _Real(0.0, 1e3),
+        "diffuse": _Real(0.0, 1e3),
+        "specular": _Real(0.0, 1e3),
+        "shininess": _Real(1e-3, 1e4),
+        "light": _OrWord("eye", _Vector((3, 4), -COORD, COORD)),
+        "light_color": _Vector((3,), 0.0, 1e3),
     },
     "image": {
-        "width": _integer(1),
-        "height": _integer(1),
+        "width": _Integer(1, _INT_MAX),
+        "height": _Integer(1, _INT_MAX),
     },
     "render": {
-        "float": _choice("single", "double"),
+        "float": _Choice("single", "double"),
     },
 }
+
+
+def valid_range(dotted: str) -> str:
+    """The valid range of a scene key in words, e.g. ``valid_range("march.epsilon")``."""
+    section, _, key = dotted.partition(".")
+    return _CHECKS[section][key].valid
 
 
 def _apply_quality(march: dict[str, Any], keep: set[str]) -> None:
@@ -315,27 +379,44 @@ def _apply_quality(march: dict[str, Any], keep: set[str]) -> None:
 
 
 def _scalar(text: str) -> Any:
+    """An int, else a float, else the text itself.  Only ASCII is read as a number:
+    Python's int() and float() would also take other scripts' digits."""
     s = text.strip()
-    for conv in (int, float):
-        try:
-            return conv(s)
-        except ValueError:
-            pass
+    if s.lstrip("+-").isdigit() and len(s) > 4000:  # int() refuses over 4300 digits; float() -> inf
+        return s
+    if s.isascii():
+        for conv in (int, float):
+            try:
+                return conv(s)
+            except ValueError:
+                pass
     return s
+
+
+def override_key(text: str) -> str:
+    """The dotted key of an override ``"section.key=VALUE"`` (stripped; not checked)."""
+    return text.partition("=")[0].strip()
 
 
 def _parse_override(text: str) -> tuple[str, str, Any]:
     """``"section.key=VALUE"`` -> (section, key, value typed for that key)."""
-    if not isinstance(text, str) or "=" not in text:
-        raise SceneError(str(text), "malformed override, expected SECTION.KEY=VALUE")
-    dotted, _, raw = text.partition("=")
-    dotted = dotted.strip()
+    if not isinstance(text, str):
+        raise SceneError("--set", f"expected SECTION.KEY=VALUE, got {_show(text)}")
+    if "=" not in text:
+        shown = text.strip()
+        if shown and _show_key(shown) == shown:
+            raise SceneError(shown, "malformed override, expected SECTION.KEY=VALUE")
+        raise SceneError("--set", f"malformed override {_show(text)}, expected SECTION.KEY=VALUE")
+    dotted = override_key(text)
+    raw = text.partition("=")[2]
+    if not dotted:
+        raise SceneError("--set", f"missing key in {_show(text)}, expected SECTION.KEY=VALUE")
     section, _, key = dotted.partition(".")
     if section not in _CHECKS or key not in _CHECKS[section]:
-        raise SceneError(dotted, "unknown key")
-    if _CHECKS[section][key] in _TEXT_CHECKERS:
-        return section, key, raw.strip()
+        raise SceneError(_show_key(dotted), "unknown key")
     s = raw.strip()
+    if _CHECKS[section][key].verbatim:
+        return section, key, s
     if s.startswith("[") and s.endswith("]"):
         return section, key, [_scalar(p) for p in s[1:-1].split(",")]
     if "," in s:
@@ -383,9 +464,18 @@ def _norm(v: Iterable[float]) -> float:
     return math.hypot(*v)
 
 
-def _unit(v: list[float]) -> list[float]:
+def _unit(v: Iterable[float]) -> list[float]:
+    """v / |v|, scaled by its largest component first: no overflow or underflow."""
+    v = list(v)
+    m = max(abs(x) for x in v)
+    v = [x / m for x in v]
     n = _norm(v)
     return [x / n for x in v]
+
+
+# camera.target closer to camera.position than this times max(1, |position|, |target|)
+# leaves the view direction to rounding (camera.py refuses an absolute 1e-9)
+_MIN_VIEW_DISTANCE = 1e-8
 
 
 def _check_camera(cam: Camera) -> None:
@@ -393,12 +483,17 @@ def _check_camera(cam: Camera) -> None:
     they must be linearly independent.  Same order and messages as camera.py."""
     if cam.target == cam.position:
         raise SceneError("camera.target", "equals camera.position")
-    fwd = _unit(_sub(cam.target, cam.position))
-    limbo = _reject(list(cam.limbo), [fwd])
-    if _norm(limbo) < 1e-6 * _norm(cam.limbo):
+    view = _sub(cam.target, cam.position)
+    least = _MIN_VIEW_DISTANCE * max(1.0, _norm(cam.position), _norm(cam.target))
+    if _norm(view) < least:
+        raise SceneError("camera.target", f"within {least:.1e} of camera.position (the view "
+                         "direction would be lost in rounding)")
+    fwd = _unit(view)
+    limbo = _reject(_unit(cam.limbo), [fwd])
+    if _norm(limbo) < 1e-6:
         raise SceneError("camera.limbo", "parallel to the view direction")
-    up = _reject(list(cam.up), [fwd, _unit(limbo)])
-    if _norm(up) < 1e-6 * _norm(cam.up):
+    up = _reject(_unit(cam.up), [fwd, _unit(limbo)])
+    if _norm(up) < 1e-6:
         raise SceneError("camera.up", "parallel to the view direction or to camera.limbo")
 
 
@@ -424,16 +519,16 @@ class Scene:
     def from_dict(cls, data: Mapping[str, Any], overrides: Iterable[str] = ()) -> Scene:
         """Validate ``{section: {key: value}}`` (missing keys get defaults), then apply overrides."""
         if not isinstance(data, Mapping):
-            raise SceneError("scene", f"expected a table, got {data!r}")
+            raise SceneError("scene", f"expected a table, got {_show(data)}")
         raw: dict[str, dict[str, Any]] = {name: {} for name in _CHECKS}
         for section, table in data.items():
             if section not in _CHECKS:
-                raise SceneError(str(section), "unknown key")
+                raise SceneError(_show_key(str(section)), "unknown key")
             if not isinstance(table, Mapping):
-                raise SceneError(section, f"expected a table, got {table!r}")
+                raise SceneError(section, f"expected a table, got {_show(table)}")
             for key, value in table.items():
                 if key not in _CHECKS[section]:
-                    raise SceneError(f"{section}.{key}", "unknown key")
+                    raise SceneError(_show_key(f"{section}.{key}"), "unknown key")
                 raw[section][key] = value
         # A quality preset fills the march keys the same source does not set itself;
         # a later source (an override) wins over an earlier one.
@@ -449,17 +544,27 @@ class Scene:
 
     @classmethod
     def from_toml(cls, path: str | Path, overrides: Iterable[str] = ()) -> Scene:
-        """Read a TOML scene file, then apply overrides."""
+        """Read a TOML scene file (at most MAX_SCENE_BYTES), then apply overrides."""
+        where = _show_key(str(path))
         try:
+            # a bounded read: /dev/zero or a stray multi-gigabyte file is refused, not loaded
             with open(path, "rb") as f:
-                data = tomllib.load(f)
-        except OSError as e:
-            raise SceneError(str(path), f"cannot read: {e.strerror or e}") from None
-        except tomllib.TOMLDecodeError as e:
-            raise SceneError(str(path), f"invalid TOML: {e}") from None
+                data = f.read(MAX_SCENE_BYTES + 1)
+        except (OSError, ValueError) as e:  # ValueError: a NUL in the path
+            raise SceneError(where, f"cannot read: {getattr(e, 'strerror', None) or e}") from None
+        if len(data) > MAX_SCENE_BYTES:
+            raise SceneError(where, f"larger than {MAX_SCENE_BYTES // 2**20} MiB, not a scene file")
+        try:
+            table = tomllib.loads(data.decode("utf-8"))
         except UnicodeDecodeError as e:
-            raise SceneError(str(path), f"invalid TOML: not UTF-8 ({e.reason})") from None
-        return cls.from_dict(data, overrides)
+            raise SceneError(where, f"invalid TOML: not UTF-8 ({e.reason})") from None
+        except RecursionError:
+            raise SceneError(where, "invalid TOML: nested too deeply") from None
+        except tomllib.TOMLDecodeError as e:
+            raise SceneError(where, f"invalid TOML: {' '.join(str(e).split())}") from None
+        except ValueError:  # int() of an integer of over 4300 digits
+            raise SceneError(where, "invalid TOML: a number too long to read") from None
+        return cls.from_dict(table, overrides)
 
     @classmethod
     def _build(cls, raw: Mapping[str, Mapping[str, Any]]) -> Scene:

@@ -3,11 +3,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import sys
+from pathlib import Path
 
+import numpy as np
 import pytest
 
-from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError
+from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError, valid_range
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -256,3 +259,149 @@ def test_error_single_argument_form() -> None:
     e = SceneError("camera.up: parallel to the view direction")
     assert (e.key, e.reason) == ("camera.up", "parallel to the view direction")
     assert str(SceneError("a.b", "c")) == "a.b: c"
+
+
+def _readme_key_rows() -> dict[str, list[str]]:
+    """README's "Scene keys" table: key -> its cells, backticks and escapes removed."""
+    readme = Path(__file__).resolve().parent.parent / "README.md"
+    if not readme.exists():
+        pytest.skip("README.md is not beside the tests (installed package)")
+    text = readme.read_text(encoding="utf-8")
+    table = text[text.index("| key | default | valid range | meaning |"):]
+    rows = {}
+    for line in table.splitlines()[2:]:
+        if not line.startswith("|"):
+            break
+        cells = [c.strip().replace("`", "").replace("\\|", "|")
+                 for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+        rows[cells[0]] = cells[1:]
+    return rows
+
+
+def test_readme_valid_ranges_match_the_checkers() -> None:
+    """The README's valid-range column is the checkers' own description, for every key."""
+    rows = _readme_key_rows()
+    keys = [f"{s}.{k}" for s, table in _CHECKS.items() for k in table]
+    assert sorted(rows) == sorted(keys)
+    for key in keys:
+        assert rows[key][1] == valid_range(key), key
+
+
+# ------------------------------------------------------------------ valid ranges
+
+def _edges():
+    """(dotted key, its lowest and highest valid value, a value just outside each) for
+    every numeric key; vectors get every component at the edge."""
+    for section, table in _CHECKS.items():
+        for key, check in table.items():
+            inner = getattr(check, "inner", check)  # "auto" or a number
+            element = getattr(inner, "element", None)  # a vector's components
+            rng = getattr(element or inner, "range", None)
+            if rng is None:
+                continue
+            n = max(inner.lengths) if element else 0
+            integer = isinstance(rng.lo, int)
+            lo = rng.lo + 1e-9 if rng.lo_open else rng.lo
+            below = rng.lo - 1 if integer else rng.lo - max(1.0, abs(rng.lo)) * 1e-9
+            above = rng.hi + 1 if integer else rng.hi * (1 + 1e-9)
+            for inside, outside in ((lo, below), (rng.hi, above)):
+                yield f"{section}.{key}", [inside] * n if n else inside, [outside] * n if n else outside
+
+
+@pytest.mark.parametrize("key,inside,outside", list(_edges()))
+def test_range_edges(key: str, inside, outside) -> None:
+    section, _, name = key.partition(".")
+    camera = {"position": [1.8, 1.6, -2.2, 0], "target": [0, 0, 0, 0], "up": [0, 1, 0, 0], "limbo": [0, 0, 0, 1]}
+    # a camera vector with every component at an edge needs the others out of its way
+    if name in ("position", "target"):
+        camera.update(position=[0, 0, 0, 0], target=[0, 0, 0, 0], up=[1, -1, 0, 0], limbo=[0, 0, 1, -1])
+        camera["target" if name == "position" else "position"] = [1, 0, 0, 0] if inside[0] == 0 else [0, 0, 0, 0]
+    elif name in ("up", "limbo"):
+        camera.update(position=[0, 0, 0, 0], target=[1, -1, 0, 0], up=[0, 0, 1, -1], limbo=[0, 0, 1, -1])
+    data = {"camera": camera} if section == "camera" else {}
+    data.setdefault(section, {})[name] = inside
+    Scene.from_dict(data)  # the edge itself is valid
+    data[section][name] = outside
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict(data)
+    assert info.value.key == key and "must be in " in info.value.reason
+
+
+def test_every_catalogue_case_is_valid() -> None:
+    from pyjulia4d import catalogue
+    for case in catalogue.catalogue():
+        for method in catalogue.METHODS:
+            catalogue.scene(case, method, "double")
+
+
+@pytest.mark.parametrize("text,message", [
+    ("slice.normal=1e300,1e300,1e300,1e300", "slice.normal: element 0: must be in [-1e6, 1e6], got 1e+300"),
+    ("camera.position=1e300,0,0", "camera.position: element 0: must be in [-1e6, 1e6], got 1e+300"),
+    ("shading.specular=1e308", "shading.specular: must be in [0, 1e3], got 1e+308"),
+    ("shading.shininess=1e308", "shading.shininess: must be in [1e-3, 1e4], got 1e+308"),
+    ("march.near=1e308", "march.near: must be in [0, 1e7], got 1e+308"),
+    ("fractal.c=0,0,0,1001", "fractal.c: element 3: must be in [-1e3, 1e3], got 1001"),
+    ("fractal.bailout=1e80", "fractal.bailout: must be in [1e-3, 1e76], got 1e+80"),
+    ("camera.fov=179.95", "camera.fov: must be in [1e-6, 179.9], got 179.95"),
+    ("march.post_steps=1001", "march.post_steps: must be in [0, 1000], got 1001"),
+    ("fractal.max_iter=1000001", "fractal.max_iter: must be in [1, 1000000], got 1000001"),
+    ("march.far=0", "march.far: must be in (0, 1e7], got 0"),
+    ("fractal.max_iter=١٢", "fractal.max_iter: expected an integer, got '١٢'"),
+    ("march.epsilon=1e400", "march.epsilon: not a finite number"),
+    ("fractal.max_iter=" + "9" * 5000, "fractal.max_iter: expected an integer, got '" + "9" * 56 + "..."),
+    ("=", "--set: missing key in '=', expected SECTION.KEY=VALUE"),
+    ("", "--set: malformed override '', expected SECTION.KEY=VALUE"),
+    ("fractal.c\n=1", "fractal.c: expected a list of 4 numbers, got 1"),
+    ("a\nb=1", "'a\\nb': unknown key"),
+    ("camera.target=1.8,1.6,-2.2,1e-9", "camera.target: within 3.3e-08 of camera.position (the view direction would be lost in rounding)"),
+])
+def test_out_of_range_messages(text: str, message: str) -> None:
+    with pytest.raises(SceneError) as info:
+        Scene.default().with_overrides([text])
+    assert str(info.value) == message
+
+
+def test_huge_integers_in_a_scene() -> None:
+    with pytest.raises(SceneError, match=r"^march\.epsilon: must be in \[1e-12, 1\], got 10000+\.\.\.$"):
+        Scene.from_dict({"march": {"epsilon": 10**400}})
+    with pytest.raises(SceneError, match=r"^march\.epsilon: must be in \[1e-12, 1\], got <an integer of ~5001 digits>$"):
+        Scene.from_dict({"march": {"epsilon": 10**5000}})
+    with pytest.raises(SceneError, match=r"^image\.width: must be in \[1, 2147483647\], got 1000"):
+        Scene.from_dict({"image": {"width": 10**40}})
+
+
+def test_negative_zero_is_zero() -> None:
+    s = Scene.from_dict({"march": {"near": -0.0}, "fractal": {"c": [-0.0, 0.8, 0, 0]}})
+    assert math.copysign(1.0, s.march.near) == 1.0 and math.copysign(1.0, s.fractal.c[0]) == 1.0
+
+
+@pytest.mark.parametrize("scale", [1e-300, 5e-324, 1e-12, 1.0, 1e6])
+def test_directions_of_any_length(scale: float) -> None:
+    """up, limbo and slice.normal are directions: normalised by their largest component,
+    so tiny and large lengths give the frame of the unit vector."""
+    from pyjulia4d.camera import camera_frame, slice_rotation
+    base = Scene.default().with_overrides(["slice.normal=0.2,0,0.3,1"])
+    s = base.replace(**{"camera.up": [0, scale, 0, 0], "camera.limbo": [0, 0, 0, scale],
+                        "slice.normal": [0.2 * scale, 0, 0.3 * scale, scale] if scale > 1e-300 else [0, 0, 0, scale]})
+    f, g = camera_frame(s), camera_frame(base if scale > 1e-300 else Scene.default())
+    for a, b in ((f.forward, g.forward), (f.up, g.up), (f.right, g.right), (f.position, g.position)):
+        assert np.all(np.isfinite(a)) and np.allclose(a, b, atol=1e-12)
+    assert np.all(np.isfinite(slice_rotation([scale, scale, scale, scale])))
+
+
+def test_deep_toml_and_big_files(tmp_path) -> None:
+    path = tmp_path / "s.toml"
+    path.write_text("[fractal]\nc = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(SceneError, match=r": invalid TOML: nested too deeply$"):
+        Scene.from_toml(path)
+    path.write_text("[fractal]\nc = [" + "[" * 300 + "]" * 300 + ", 0, 0, 0]\n")  # parses; shown short
+    with pytest.raises(SceneError, match=r"^fractal\.c: element 0: expected a number, got \[\[\["):
+        Scene.from_toml(path)
+    path.write_text("[fractal]\nmax_iter = " + "1" * 5000 + "\n")
+    with pytest.raises(SceneError, match=r": invalid TOML: a number too long to read$"):
+        Scene.from_toml(path)
+    path.write_bytes(b"#" * (1 << 20) + b"\n")
+    with pytest.raises(SceneError, match=r": larger than 1 MiB, not a scene file$"):
+        Scene.from_toml(path)
+    path.write_bytes(b"#" * ((1 << 20) - 1) + b"\n")  # exactly 1 MiB is fine
+    assert Scene.from_toml(path) == Scene.default()
