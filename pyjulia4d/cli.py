@@ -1,20 +1,47 @@
-"""Command line: ``python -m pyjulia4d render|devices``."""
+"""Command line: ``python -m pyjulia4d render|devices``.
+
+Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
+status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
+each after removing any temporary file."""
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Iterator, NoReturn, Sequence
 
 from .output import check_output_path, write_image
-from .scene import Scene
+from .scene import Scene, SceneError, override_key
 
 PROG = "python -m pyjulia4d"
 
 
+class UsageError(Exception):
+    """A command line argparse cannot parse; its message is argparse's."""
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP, raised in the main thread so that clean-up runs as for Ctrl-C
+    (a BaseException, like KeyboardInterrupt: ``except Exception`` must not catch it)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (no usage text) and status 2 from main()."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog=PROG, description="Ray trace 3D views of 4D quaternion Julia sets.")
+    ap = _Parser(prog=PROG, description="Ray trace 3D views of 4D quaternion Julia sets.")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser("render", help="render a scene to .png or .exr")
@@ -42,17 +69,20 @@ def select_device(spec: str | None) -> Any:
 
 def _render(args: argparse.Namespace) -> int:
     overrides = list(args.overrides)
-    if args.width is not None:
-        overrides.append(f"image.width={args.width}")
-    if args.height is not None:
-        overrides.append(f"image.height={args.height}")
+    for flag, dotted in (("--width", "image.width"), ("--height", "image.height")):
+        value = getattr(args, flag[2:])
+        if value is None:
+            continue
+        if any(override_key(o) == dotted for o in overrides):
+            raise SceneError(dotted, f"given twice, by {flag} and by --set {dotted}; use one")
+        overrides.append(f"{dotted}={value}")
     if args.scene is None:
         scene = Scene.default().with_overrides(overrides)
         default_out = "julia.png"
     else:
         scene = Scene.from_toml(args.scene, overrides)
         default_out = Path(args.scene).stem + ".png"
-    out = check_output_path(args.output or default_out)
+    out = check_output_path(default_out if args.output is None else args.output)
     device = select_device(args.device)
 
     from .render import render  # heavy (kernel build); only once the input is known good
@@ -82,24 +112,72 @@ def _one_line(e: BaseException) -> str:
     return " ".join(str(e).splitlines()) or type(e).__name__
 
 
+def _say(line: str) -> None:
+    try:
+        print(line, file=sys.stderr)
+    except OSError:  # the terminal is gone (SIGHUP): nothing left to tell
+        pass
+
+
 def _warn_one_line(message, category, filename, lineno, file=None, line=None) -> None:
-    print(f"pyjulia4d: warning: {_one_line(Warning(message))}", file=sys.stderr)
+    _say(f"pyjulia4d: warning: {_one_line(Warning(message))}")
+
+
+_SIGNALS = tuple(getattr(signal, s) for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s))
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    # a second SIGTERM/SIGHUP during the clean-up the first one starts would cut it short
+    for s in _SIGNALS:
+        signal.signal(s, signal.SIG_IGN)
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _signals_raise() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise Terminated inside the block.  Only where their action
+    is the default one (``nohup`` sets SIGHUP to ignore: that stays), and only in the
+    main thread (the only one that can set handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {s: signal.getsignal(s) for s in _SIGNALS}
+    for s, h in old.items():
+        if h == signal.SIG_DFL:
+            signal.signal(s, _raise_terminated)
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit status (2 on bad input, 130 on Ctrl-C)."""
-    args = _parser().parse_args(argv)
+    """Entry point; returns the exit status (2 on bad input, 130 on Ctrl-C, 128 + the
+    signal number on SIGTERM or SIGHUP)."""
+    try:
+        args = _parser().parse_args(argv)
+    except UsageError as e:
+        _say(f"pyjulia4d: error: {_one_line(e)} (see --help)")
+        return 2
+    shown = warnings.showwarning
     warnings.showwarning = _warn_one_line  # workload and precision warnings: one line each
     try:
-        if args.command == "devices":
-            from .devices import describe_devices
+        with _signals_raise():
+            if args.command == "devices":
+                from .devices import describe_devices
 
-            print(describe_devices())
-            return 0
-        return _render(args)
+                print(describe_devices())
+                return 0
+            return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
-        print(f"pyjulia4d: error: {_one_line(e)}", file=sys.stderr)
+        _say(f"pyjulia4d: error: {_one_line(e)}")
         return 2
     except KeyboardInterrupt:
-        print("pyjulia4d: interrupted", file=sys.stderr)
+        _say("pyjulia4d: interrupted")
         return 130
+    except Terminated as e:
+        _say(f"pyjulia4d: terminated by {signal.Signals(e.signum).name}")
+        return 128 + e.signum
+    finally:
+        warnings.showwarning = shown

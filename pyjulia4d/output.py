@@ -1,10 +1,16 @@
 """Image writers (PNG, EXR).  Every writer is atomic: a temp file in the target
 directory is renamed over the output, so a failed or interrupted write leaves
-nothing at the output path."""
+nothing at the output path.
+
+The temp file is ``.<stem>.<random><ext>`` beside the output, its stem shortened so
+that the name fits the file system's name limit; it is removed on any exception,
+KeyboardInterrupt and the CLI's SIGTERM/SIGHUP exception included."""
 from __future__ import annotations
 
 import contextlib
 import os
+import signal
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any, Iterator, Mapping
@@ -12,6 +18,14 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 
 FORMATS = (".png", ".exr")
+
+# Room left for tempfile's random part of a name (8 characters in CPython today).
+_RANDOM_CHARS = 16
+# Where pathconf() cannot tell: the usual Linux limits.
+_NAME_MAX, _PATH_MAX = 255, 4096
+# Held while a temp file is created or removed, so that no signal's exception can
+# fall between creating a file and knowing its name (which would leave it behind).
+_HELD = {getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s)}
 
 
 class OutputError(ValueError):
@@ -22,20 +36,96 @@ def _suffix(path: str | Path) -> str:
     return Path(path).suffix.lower()
 
 
+def _shown(path: str) -> str:
+    """The path as a message shows it: itself when printable, else its repr."""
+    return path if path and path.isprintable() else repr(path)
+
+
+def _limit(directory: str | Path, name: str, fallback: int) -> int:
+    try:
+        value = os.pathconf(directory, name)
+    except (OSError, ValueError):
+        return fallback
+    return value if value > 0 else fallback  # -1: no limit, keep the usual one
+
+
+def _temp_affixes(p: Path, name_max: int) -> tuple[str, str]:
+    """(prefix, suffix) of the temp file for ``p``: ``.<stem>.`` and its extension, the
+    stem cut so that prefix + random part + suffix fits in ``name_max`` bytes."""
+    room = max(0, name_max - len(os.fsencode(p.suffix)) - 2 - _RANDOM_CHARS)
+    stem = p.stem[:room]
+    while len(os.fsencode(stem)) > room:  # multi-byte characters: cut by bytes
+        stem = stem[:-1]
+    return f".{stem}.", p.suffix
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Defer SIGINT, SIGTERM and SIGHUP to the end of the block (where supported)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def check_output_path(path: str | Path) -> Path:
-    """Fail before rendering if ``path`` cannot take the image."""
-    p = Path(path)
+    """Fail before rendering if ``path`` cannot take the image: its format, its
+    directory, the length of its name and path (the temp file's too), and a temp
+    file really created (and removed) beside it."""
+    raw = os.fspath(path)
+    shown = _shown(raw)
+    if not raw:
+        raise OutputError(f"{shown}: empty output path")
+    p = Path(raw)
     ext = _suffix(p)
     if ext not in FORMATS:
-        shown = ext or "(none)"
-        raise OutputError(f"{p}: unsupported output format '{shown}' (use .png or .exr)")
+        got = ext or "(none)"
+        raise OutputError(f"{shown}: unsupported output format '{_shown(got)}' (use .png or .exr)")
+    if raw.endswith(("/", os.sep)):
+        raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent
-    if not parent.is_dir():
-        raise OutputError(f"{p}: directory '{parent}' does not exist")
-    if p.is_dir():
-        raise OutputError(f"{p}: is a directory")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{p}: directory '{parent}' is not writable")
+    try:
+        st = os.stat(parent)
+    except FileNotFoundError:
+        raise OutputError(f"{shown}: directory '{_shown(str(parent))}' does not exist") from None
+    except (OSError, ValueError) as e:
+        raise OutputError(f"{shown}: directory '{_shown(str(parent))}': "
+                          f"{getattr(e, 'strerror', None) or e}") from None
+    if not stat.S_ISDIR(st.st_mode):
+        raise OutputError(f"{shown}: '{_shown(str(parent))}' is not a directory")
+    name_max = _limit(parent, "PC_NAME_MAX", _NAME_MAX)
+    path_max = _limit(parent, "PC_PATH_MAX", _PATH_MAX)  # counts the terminating NUL
+    name = len(os.fsencode(p.name))
+    if name > name_max:
+        raise OutputError(f"{shown}: file name too long ({name} bytes; this file system "
+                          f"allows {name_max})")
+    prefix, suffix = _temp_affixes(p, name_max)
+    longest = max(len(os.fsencode(raw)),
+                  len(os.fsencode(os.path.join(parent, prefix + suffix))) + _RANDOM_CHARS)
+    if longest >= path_max:
+        raise OutputError(f"{shown}: path too long ({longest} bytes with the temporary "
+                          f"file's name; the limit is {path_max - 1})")
+    try:
+        if stat.S_ISDIR(os.stat(p).st_mode):
+            raise OutputError(f"{shown}: is a directory")
+    except FileNotFoundError:
+        pass
+    except OSError as e:
+        raise OutputError(f"{shown}: {e.strerror or e}") from None
+    try:
+        # the only exact test of "can a file be made here" (permissions, read-only
+        # mounts, /proc, ACLs, root) is to make one
+        with _signals_held():
+            fd, tmp = tempfile.mkstemp(dir=parent, prefix=prefix, suffix=suffix)
+            os.close(fd)
+            os.unlink(tmp)
+    except OSError as e:
+        raise OutputError(f"{shown}: cannot create a file in '{_shown(str(parent))}': "
+                          f"{e.strerror or e}") from None
     return p
 
 
@@ -50,16 +140,20 @@ def _file_mode() -> int:
 def _atomic(path: str | Path) -> Iterator[Path]:
     """Yield a temp path beside ``path``; move it onto ``path`` only on success."""
     p = Path(path)
-    with tempfile.NamedTemporaryFile(
-        dir=p.parent, prefix=f".{p.stem}.", suffix=p.suffix, delete=False
-    ) as f:
-        tmp = Path(f.name)
+    prefix, suffix = _temp_affixes(p, _limit(p.parent, "PC_NAME_MAX", _NAME_MAX))
+    tmp: Path | None = None
     try:
+        with _signals_held():  # a signal arriving here is raised once tmp is known
+            fd, name = tempfile.mkstemp(dir=p.parent, prefix=prefix, suffix=suffix)
+            os.close(fd)
+            tmp = Path(name)
         yield tmp
-        os.chmod(tmp, _file_mode())  # NamedTemporaryFile creates 0600
+        os.chmod(tmp, _file_mode())  # mkstemp creates 0600
         os.replace(tmp, p)
-    except BaseException:  # KeyboardInterrupt too: never leave the temp file behind
-        tmp.unlink(missing_ok=True)
+    except BaseException:  # KeyboardInterrupt and SIGTERM/SIGHUP too: never leave it behind
+        if tmp is not None:
+            with _signals_held():  # a second signal must not cut the clean-up short
+                tmp.unlink(missing_ok=True)
         raise
 
 

@@ -52,6 +52,18 @@ BAD_ARGS = {
     "malformed": (["--set", "fractal.c"], "fractal.c: malformed override, expected SECTION.KEY=VALUE"),
     "bad-ext": (["-o", "out.jpg"], "out.jpg: unsupported output format '.jpg' (use .png or .exr)"),
     "no-dir": (["-o", "nowhere/out.png"], "nowhere/out.png: directory 'nowhere' does not exist"),
+    "huge-normal": (["--set", "slice.normal=1e300,1e300,1e300,1e300"],
+                    "slice.normal: element 0: must be in [-1e6, 1e6], got 1e+300"),
+    "huge-specular": (["--set", "shading.specular=1e308"], "shading.specular: must be in [0, 1e3], got 1e+308"),
+    "width-twice": (["--width", "8", "--set", "image.width=9"],
+                    "image.width: given twice, by --width and by --set image.width; use one"),
+    "height-twice": (["--set", "image.height = 6", "--height", "6"],
+                     "image.height: given twice, by --height and by --set image.height; use one"),
+    "name-too-long": (["-o", "n" * 300 + ".png"],
+                      "n" * 300 + ".png: file name too long (304 bytes; this file system allows 255)"),
+    "empty-set": (["--set", "="], "--set: missing key in '=', expected SECTION.KEY=VALUE"),
+    "unknown-flag": (["--bogus"], "unrecognized arguments: --bogus (see --help)"),
+    "missing-value": (["--width"], "argument --width: expected one argument (see --help)"),
 }
 
 
@@ -106,6 +118,15 @@ def test_unknown_device(tmp_path: Path) -> None:
 def test_usage_error_exits_2(tmp_path: Path) -> None:
     p = run_cli(["render", "--bogus"], tmp_path)
     assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert p.stderr == "pyjulia4d: error: unrecognized arguments: --bogus (see --help)\n"
+
+
+def test_scene_file_too_large(tmp_path: Path) -> None:
+    """/dev/zero is read no further than the size bound: one line, status 2."""
+    p = run_cli(["render", "/dev/zero"], tmp_path)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr == "pyjulia4d: error: /dev/zero: larger than 1 MiB, not a scene file\n"
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_devices_command(tmp_path: Path) -> None:

@@ -1,6 +1,8 @@
 """PNG/EXR writers: content, metadata, atomicity."""
 from __future__ import annotations
 
+import os
+import signal
 from dataclasses import dataclass
 
 import numpy as np
@@ -114,3 +116,120 @@ def test_failed_write_keeps_previous_file(tmp_path, monkeypatch) -> None:
         write_image(path, FakeResult(*_color_alpha()), {})
     assert path.read_bytes() == b"old"
     assert [p.name for p in tmp_path.iterdir()] == ["out.png"]
+
+
+# ------------------------------------------------------------ names, paths, signals
+
+def _names(directory) -> list[str]:
+    return sorted(p.name for p in directory.iterdir())
+
+
+@pytest.mark.parametrize("stem", ["n" * 251, "é" * 125, "n" * 240 + ".tar"])
+def test_longest_names_are_written(tmp_path, stem: str) -> None:
+    """A name of up to NAME_MAX bytes is written: the temp name's stem is shortened to fit."""
+    path = tmp_path / (stem + ".png")
+    assert len(os.fsencode(path.name)) <= 255
+    write_image(path, FakeResult(*_color_alpha()), {})
+    assert _names(tmp_path) == [path.name]
+
+
+@pytest.mark.parametrize("name", ["n" * 252 + ".png", "n" * 296 + ".exr", "é" * 126 + ".png"])
+def test_too_long_name_refused(tmp_path, name: str) -> None:
+    with pytest.raises(OutputError, match=r": file name too long \(\d+ bytes; this file system allows 255\)$"):
+        check_output_path(tmp_path / name)
+    assert _names(tmp_path) == []
+
+
+def test_temp_name_fits(tmp_path) -> None:
+    p = tmp_path / ("x" * 251 + ".exr")
+    prefix, suffix = output._temp_affixes(p, 255)
+    assert len(os.fsencode(prefix + suffix)) + output._RANDOM_CHARS <= 255
+    assert prefix.startswith(".xxx") and suffix == ".exr"
+    prefix, _ = output._temp_affixes(tmp_path / ("é" * 125 + ".png"), 255)
+    assert prefix.startswith(".é") and len(os.fsencode(prefix)) + 4 + output._RANDOM_CHARS <= 255
+
+
+def test_too_long_path_refused(tmp_path, monkeypatch) -> None:
+    """A directory reachable by a path of ~4000 bytes, an output whose path (or its temp
+    file's) passes PATH_MAX: refused up front, not after the render."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "d").mkdir()
+    parent = "d/.." + "/d/.." * 799  # 3999 bytes, resolves to "."
+    with pytest.raises(OutputError, match=r": path too long \(\d+ bytes with the temporary file's name; the limit is 4095\)$"):
+        check_output_path(parent + "/" + "n" * 100 + ".png")
+    with pytest.raises(OutputError, match=r": directory '.*': File name too long$"):
+        check_output_path(parent + "/d/.." * 30 + "/x.png")
+    assert _names(tmp_path) == ["d"]
+
+
+def test_unusable_directories(tmp_path) -> None:
+    (tmp_path / "f").write_text("")
+    with pytest.raises(OutputError, match=r"f/x\.png: '.*f' is not a directory$"):
+        check_output_path(tmp_path / "f" / "x.png")
+    with pytest.raises(OutputError, match=r"^'': empty output path$"):
+        check_output_path("")
+    with pytest.raises(OutputError, match=r"names a directory \(trailing '/'\)$"):
+        check_output_path(f"{tmp_path}/x.png/")
+    if os.path.isdir("/proc/self"):  # a directory no one can create files in, root included
+        with pytest.raises(OutputError, match=r"^/proc/x\.png: cannot create a file in '/proc': "):
+            check_output_path("/proc/x.png")
+    if os.geteuid() != 0:  # root writes into read-only directories
+        ro = tmp_path / "ro"
+        ro.mkdir(mode=0o555)
+        with pytest.raises(OutputError, match=r"cannot create a file in .*: Permission denied$"):
+            check_output_path(ro / "x.png")
+    assert _names(tmp_path) == ["f"] + (["ro"] if os.geteuid() != 0 else [])
+
+
+class _Signalled(BaseException):
+    pass
+
+
+@pytest.mark.parametrize("fmt", ["png", "exr"])
+def test_signal_during_write_leaves_nothing(tmp_path, monkeypatch, fmt: str) -> None:
+    """A signal whose handler raises (as the CLI's SIGTERM/SIGHUP one does) while the temp
+    file is being written: the temp file is removed, the output never appears."""
+    def handler(signum, frame):
+        raise _Signalled(signum)
+
+    def write_then_signal(real):
+        def wrapped(*args, **kwargs):
+            real(*args, **kwargs)  # the temp file exists and holds data now
+            signal.raise_signal(signal.SIGTERM)
+        return wrapped
+
+    if fmt == "png":
+        monkeypatch.setattr(Image.Image, "save", write_then_signal(Image.Image.save))
+    else:
+        monkeypatch.setattr(OpenEXR.File, "write", write_then_signal(OpenEXR.File.write))
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        with pytest.raises(_Signalled):
+            write_image(tmp_path / f"out.{fmt}", FakeResult(*_color_alpha()), {})
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert _names(tmp_path) == []
+
+
+@pytest.mark.parametrize("call", [1, 2], ids=["probe", "write"])
+def test_signal_while_creating_the_temp_file_is_deferred(tmp_path, monkeypatch, call: int) -> None:
+    """A signal that arrives while a temp file is created (check_output_path's probe, then
+    the write's own) is raised only once its name is known, so it is removed."""
+    real = output.tempfile.mkstemp
+    calls = []
+
+    def mkstemp_then_signal(*args, **kwargs):
+        made = real(*args, **kwargs)
+        calls.append(made)
+        if len(calls) == call:
+            signal.raise_signal(signal.SIGTERM)  # held: raised when the block ends
+        return made
+
+    monkeypatch.setattr(output.tempfile, "mkstemp", mkstemp_then_signal)
+    old = signal.signal(signal.SIGTERM, lambda s, f: (_ for _ in ()).throw(_Signalled(s)))
+    try:
+        with pytest.raises(_Signalled):
+            write_image(tmp_path / "out.png", FakeResult(*_color_alpha()), {})
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert len(calls) == call and _names(tmp_path) == []
