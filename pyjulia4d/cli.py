@@ -113,8 +113,12 @@ def _one_line(e: BaseException) -> str:
 
 
 def _say(line: str) -> None:
+    """One line on stderr, whatever its encoding, even with the terminal gone."""
     try:
-        print(line, file=sys.stderr)
+        try:
+            print(line, file=sys.stderr)
+        except UnicodeEncodeError:  # e.g. an argument's undecodable bytes on an ASCII stderr
+            print(line.encode("ascii", "backslashreplace").decode("ascii"), file=sys.stderr)
     except OSError:  # the terminal is gone (SIGHUP): nothing left to tell
         pass
 

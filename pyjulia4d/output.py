@@ -41,6 +41,12 @@ def _shown(path: str) -> str:
     return path if path and path.isprintable() else repr(path)
 
 
+def _quoted(path: str | Path) -> str:
+    """The path in quotes: 'dir', or its repr when not printable."""
+    path = str(path)
+    return f"'{path}'" if path and path.isprintable() else repr(path)
+
+
 def _limit(directory: str | Path, name: str, fallback: int) -> int:
     try:
         value = os.pathconf(directory, name)
@@ -83,20 +89,20 @@ def check_output_path(path: str | Path) -> Path:
     p = Path(raw)
     ext = _suffix(p)
     if ext not in FORMATS:
-        got = ext or "(none)"
-        raise OutputError(f"{shown}: unsupported output format '{_shown(got)}' (use .png or .exr)")
+        got = _quoted(ext) if ext else "'(none)'"
+        raise OutputError(f"{shown}: unsupported output format {got} (use .png or .exr)")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent
     try:
         st = os.stat(parent)
     except FileNotFoundError:
-        raise OutputError(f"{shown}: directory '{_shown(str(parent))}' does not exist") from None
+        raise OutputError(f"{shown}: directory {_quoted(parent)} does not exist") from None
     except (OSError, ValueError) as e:
-        raise OutputError(f"{shown}: directory '{_shown(str(parent))}': "
+        raise OutputError(f"{shown}: directory {_quoted(parent)}: "
                           f"{getattr(e, 'strerror', None) or e}") from None
     if not stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: '{_shown(str(parent))}' is not a directory")
+        raise OutputError(f"{shown}: {_quoted(parent)} is not a directory")
     name_max = _limit(parent, "PC_NAME_MAX", _NAME_MAX)
     path_max = _limit(parent, "PC_PATH_MAX", _PATH_MAX)  # counts the terminating NUL
     name = len(os.fsencode(p.name))
@@ -110,12 +116,13 @@ def check_output_path(path: str | Path) -> Path:
         raise OutputError(f"{shown}: path too long ({longest} bytes with the temporary "
                           f"file's name; the limit is {path_max - 1})")
     try:
-        if stat.S_ISDIR(os.stat(p).st_mode):
-            raise OutputError(f"{shown}: is a directory")
+        is_dir = stat.S_ISDIR(os.stat(p).st_mode)
     except FileNotFoundError:
-        pass
-    except OSError as e:
-        raise OutputError(f"{shown}: {e.strerror or e}") from None
+        is_dir = False
+    except (OSError, ValueError) as e:  # ValueError: a NUL in the name
+        raise OutputError(f"{shown}: {getattr(e, 'strerror', None) or e}") from None
+    if is_dir:
+        raise OutputError(f"{shown}: is a directory")
     try:
         # the only exact test of "can a file be made here" (permissions, read-only
         # mounts, /proc, ACLs, root) is to make one
@@ -124,7 +131,7 @@ def check_output_path(path: str | Path) -> Path:
             os.close(fd)
             os.unlink(tmp)
     except OSError as e:
-        raise OutputError(f"{shown}: cannot create a file in '{_shown(str(parent))}': "
+        raise OutputError(f"{shown}: cannot create a file in {_quoted(parent)}: "
                           f"{e.strerror or e}") from None
     return p
 
