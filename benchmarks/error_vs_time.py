@@ -1,28 +1,45 @@
-"""Error against run time for every marching setting (issue 3).
+"""Error against run time for every marching setting, and what the certified bracket
+says about it.
 
-For each scene, ground truth comes from ``pyjulia4d.truth`` (analytic for c = 0,
-the float64 2D oracle for real c, the converged double-precision fixed scan for
-any other c; never the setting under test).  Then for a grid of
+For each scene, ground truth comes from ``pyjulia4d.truth`` (analytic for c = 0; for
+real c the float64 2D oracle and for any other c the converged double-precision fixed
+scan, each combined per pixel with a double-precision distance-estimate search at
+epsilon 1e-10 - the earlier float64-verified crossing wins; never a float32 setting under
+test).  Then for a grid of
 
-* fixed marching: z_resolution 35 .. 256,000 (log-spaced) x post_steps 0, 5, 10, 20
-  (the finest z-resolutions with fewer post-step values: at z = 64,000 the step is
-  already below float32's depth resolution after a few halvings);
-* distance-estimate marching: epsilon 1e-2 .. 1e-6, with 0, 10 and 20 post-steps,
+* distance-estimate marching: epsilon 1e-2 .. 1e-6 x post_steps 0, 2, 4, 6, 10, 20 with
+  ITP refinement (march.refine = itp, the default), epsilon 1e-7 (below float32's
+  spacing of t ~ 5: every smallest step becomes one ulp) with 10 and 20, and a few
+  settings with bisection (march.refine = bisect, seed 000's post-stepping);
+* fixed marching: z_resolution 35 .. 16,000 (log-spaced) x post_steps 0, 4, 10, 20 with
+  ITP, a few with bisection, and z = 256,000 without post-steps on the Fig. 5 scene only
+  (seed 000's claim),
 
-it renders the scene (float32 kernels, the default) and records the median wall
-time over repeats - kernels alone and the whole render, separately; each program is
-built and each kernel run once on a cheap warm-up render of the same size first, so
-neither OpenCL compilation nor PoCL's first-launch specialisation is timed - the
-depth error over pixels that both hit (mean, median, p99, max; scene units and
-pixels' worth of depth = error / (depth * 2 tan(fov/2) / height)), the silhouette
-error (fraction of pixels hit by exactly one of render and truth) and the normal
-error in degrees for the jacobian, gradient and zbuffer normal kernels, each run on
-the same march output.
+it renders the scene (float32 kernels, the default) and records the median wall time
+over repeats - kernels alone and the whole render, separately; each program is built
+and each kernel run once on a cheap warm-up render of the same size first, so neither
+OpenCL compilation nor PoCL's first-launch specialisation is timed - the depth error
+over pixels that both hit (mean, median, p99, max; scene units and pixels' worth of
+depth = error / (depth * 2 tan(fov/2) / height)), the silhouette error (fraction of
+pixels hit by exactly one of render and truth), the render's own certified bracket
+(RenderResult.bracket_stats: p50 / p99 / max over its hits) and, per pixel, whether the
+truth lies where the bracket says - in [depth, depth + bracket] up to float32 slack
+(SLACK_ULPS spacings of depth): ``stepped_over`` counts pixels whose truth lies in
+front of the depth (a thin part the march stepped over before its first crossing, which
+the bracket does not cover), ``after_bracket`` those whose truth lies behind the
+bracket's inside end (the float64 truth calls the render's float32 inside point
+outside).  Normal errors in degrees for the jacobian, gradient and zbuffer normal
+kernels, each run on the same march output.
+
+A second phase times ITP against bisection interleaved (alternating renders of the two
+at equal post_steps, so both see the same machine load) and counts the set tests each
+refinement takes with a float32 twin of kernels/refine.cl (``refine_tests``) started
+from the march's own brackets.
 
 Writes to --out (default benchmarks/results/): error_vs_time.csv, error_vs_time.md,
-error_vs_time.png, seed_claim.md and truth.md (the ground-truth convergence record).
+error_vs_time.png, seed_claim.md and truth.json (the ground-truth convergence record).
 
-    python benchmarks/error_vs_time.py            # full run
+    python benchmarks/error_vs_time.py            # full run (~20 min on 2 CPU cores)
     python benchmarks/error_vs_time.py --quick    # CI smoke run: 2 scenes, 4 settings
 """
 from __future__ import annotations
@@ -46,12 +63,17 @@ if str(ROOT) not in sys.path:
 import pyopencl.array as cla  # noqa: E402
 
 from pyjulia4d import build, truth  # noqa: E402
+from pyjulia4d import reference as ref  # noqa: E402
 from pyjulia4d.camera import camera_frame  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
 from pyjulia4d.render import STATUS_HIT, Precision, launch_normals, queue_for, render  # noqa: E402
 from pyjulia4d.scene import Scene  # noqa: E402
 
-# name -> (overrides, description)
+# name -> (overrides, description).  The first nine: seed 000's figures, POV-Ray's example
+# and the two exact oracles, all max_iter 8-12 with w = 0 cameras.  The rest: max_iter 20
+# and 50, c near the boundary of the connectedness locus (critical orbit bounded) or just
+# outside it (dust: the critical orbit escapes, at the iteration given), 4D cameras
+# (w != 0 or a tilted limbo vector) and a tilted slice.
 SCENES = {
     "fig1": (["fractal.c=-0.7,-0.2,0,0"], "seed 000 Fig. 1, c = -0.7-0.2i"),
     "fig5": (["fractal.c=-0.803762,-0.40615,0,0", "fractal.max_iter=8"],
@@ -65,41 +87,101 @@ SCENES = {
                "POV-Ray example <-0.083, 0, -0.83, -0.025>, max_iter 8"),
     "sphere": (["fractal.c=0,0,0,0"], "c = 0 (the ball; analytic truth)"),
     "real": (["fractal.c=-1,0,0,0"], "real c = -1 (basilica turned about the real axis; 2D oracle)"),
+    # --- the reported case and its kind
+    "fig8_i20_w": (["fractal.c=0.4,0.5,0,0", "fractal.max_iter=20", "camera.position=-2,1,5,0.8"],
+                   "c = 0.4+0.5i (dust, escapes at 7), max_iter 20, camera (-2, 1, 5, 0.8)"),
+    "bnd_i20_w": (["fractal.c=0.28,0.53,0,0", "fractal.max_iter=20", "camera.position=-2,1,5,0.8"],
+                  "c = 0.28+0.53i (boundary, inside), max_iter 20, camera (-2, 1, 5, 0.8)"),
+    "cusp_i20_limbo": (["fractal.c=-0.75,0.11,0,0", "fractal.max_iter=20", "camera.limbo=0,0.3,0,1"],
+                       "c = -0.75+0.11i (boundary, escapes at 29), max_iter 20, limbo (0, 0.3, 0, 1)"),
+    "dust_i20_limbo": (["fractal.c=-0.8,0.2,0,0", "fractal.max_iter=20", "camera.limbo=0.2,0,0.3,1"],
+                       "c = -0.8+0.2i (dust, escapes at 15), max_iter 20, limbo (0.2, 0, 0.3, 1)"),
+    "slice_i20": (["fractal.c=-0.2,0.6,0.2,0", "fractal.max_iter=20", "slice.normal=0.3,0,0.2,1",
+                   "slice.distance=0.1"],
+                  "c = -0.2+0.6i+0.2j, max_iter 20, slice normal (0.3, 0, 0.2, 1), distance 0.1"),
+    "cusp_i50_w": (["fractal.c=-0.75,0.11,0,0", "fractal.max_iter=50", "camera.position=-2,1,5,0.8"],
+                   "c = -0.75+0.11i (dust at max_iter 50), camera (-2, 1, 5, 0.8)"),
+    "bnd_i50_limbo": (["fractal.c=0.3,0.55,0,0", "fractal.max_iter=50", "camera.position=1.8,1.6,-2.2,0.5",
+                       "camera.limbo=0.2,0,0.3,1"],
+                      "c = 0.3+0.55i (boundary, inside), max_iter 50, camera w 0.5, limbo (0.2, 0, 0.3, 1)"),
+    "real_i50_w": (["fractal.c=-1,0,0,0", "fractal.max_iter=50", "camera.position=-2,1,5,0.8"],
+                   "real c = -1, max_iter 50, camera (-2, 1, 5, 0.8) (2D oracle)"),
 }
+OLD_SCENES = ["fig1", "fig5", "fig6", "fig8_i8", "fig8_i12", "fig9", "povray", "sphere", "real"]
 QUICK_SCENES = ["sphere", "real"]
 
-Z_RES = [35, 70, 250, 1000, 4000, 16000, 64000, 256000]
-POSTS = [0, 5, 10, 20]
-EPSILONS = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6]
-DE_POSTS = [0, 10, 20]
+DE_EPS = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
+DE_POSTS = [0, 2, 4, 6, 10, 20]
+DE_EXTRA = [(1e-7, 10), (1e-7, 20)]                         # below float32's spacing of t: ulp steps
+DE_BISECT = [(1e-4, 6), (1e-4, 10), (1e-5, 6), (1e-5, 10), (1e-5, 20), (1e-6, 10), (1e-6, 20)]
+Z_RES = [35, 70, 250, 1000, 4000, 16000]
+FIXED_POSTS = [0, 4, 10, 20]
+FIXED_BISECT = [(250, 10), (250, 20), (1000, 10), (4000, 10)]
+ONLY = {("fixed", 256000, 0, "itp"): ["fig5"]}              # seed 000's claim: one scene is enough
+# ITP against bisection, interleaved: (method, z_resolution, epsilon, post_steps)
+ITP_PAIRS = [("de", 250, 1e-5, 6), ("de", 250, 1e-5, 10), ("de", 250, 1e-5, 20), ("fixed", 250, 1e-3, 10),
+             ("fixed", 1000, 1e-3, 20)]
+ITP_REPEATS = 5
 SIL_MAX = 0.005   # a setting is usable (on the Pareto front) if it gets <= 0.5 % of the silhouette wrong
+SLACK_ULPS = 8    # float32 slack of the bracket check, in spacings of float32 at the depth (~2e-6 at depth 3)
 NORMAL_METHODS = ("jacobian", "gradient", "zbuffer")
+
+
+def setting(method, z, post, eps, refine="itp") -> dict:
+    return dict(method=method, z_resolution=z, post_steps=post, epsilon=eps, refine=refine)
 
 
 def grid(quick: bool) -> list[dict]:
     if quick:
-        return [dict(method="fixed", z_resolution=35, post_steps=0, epsilon=1e-3),
-                dict(method="fixed", z_resolution=250, post_steps=10, epsilon=1e-3),
-                dict(method="de", z_resolution=250, post_steps=0, epsilon=1e-3),
-                dict(method="de", z_resolution=250, post_steps=10, epsilon=1e-3)]
+        return [setting("fixed", 35, 0, 1e-3), setting("fixed", 250, 10, 1e-3),
+                setting("de", 250, 0, 1e-3), setting("de", 250, 10, 1e-3)]
     out = []
-    for z in Z_RES:
-        posts = POSTS if z <= 16000 else ([0, 5] if z <= 64000 else [0])
-        for p in posts:
-            out.append(dict(method="fixed", z_resolution=z, post_steps=p, epsilon=1e-3))
     for p in DE_POSTS:
-        for e in EPSILONS:
-            out.append(dict(method="de", z_resolution=250, post_steps=p, epsilon=e))
+        for e in DE_EPS:
+            out.append(setting("de", 250, p, e))
+    out += [setting("de", 250, p, e) for e, p in DE_EXTRA]
+    out += [setting("de", 250, p, e, "bisect") for e, p in DE_BISECT]
+    for z in Z_RES:
+        for p in FIXED_POSTS:
+            out.append(setting("fixed", z, p, 1e-3))
+    out += [setting("fixed", z, p, 1e-3, "bisect") for z, p in FIXED_BISECT]
+    out += [setting(m, z, p, 1e-3, r) for (m, z, p, r) in ONLY]
+    # every preset's own setting is measured on every scene
+    from pyjulia4d.quality import PRESETS
+    keys = {setting_key(s) for s in out}
+    for q, pr in PRESETS.items():
+        s = setting(pr["method"], pr["z_resolution"], pr["post_steps"], pr["epsilon"], pr.get("refine", "itp"))
+        if setting_key(s) not in keys:
+            out.append(s)
+            keys.add(setting_key(s))
     return out
 
 
+def runs_on(s: dict, scene: str) -> bool:
+    key = (s["method"], s["z_resolution"], s["post_steps"], s["refine"])
+    return key not in ONLY or scene in ONLY[key]
+
+
+def setting_key(s: dict) -> tuple:
+    return (s["method"], s["z_resolution"] if s["method"] == "fixed" else 0, s["post_steps"],
+            float(s["epsilon"]) if s["method"] == "de" else 0.0, s["refine"])
+
+
+def label(s: dict) -> str:
+    r = "" if s["refine"] == "itp" else " bisect"
+    if s["method"] == "fixed":
+        return f"fixed z={s['z_resolution']} post={s['post_steps']}{r}"
+    return f"de eps={float(s['epsilon']):g} post={s['post_steps']}{r}"
+
+
 def curve_name(s: dict) -> str:
-    return f"{s['method']} post={s['post_steps']}"
+    return f"{s['method']} post={s['post_steps']}" + ("" if s["refine"] == "itp" else " bisect")
 
 
 def setting_overrides(s: dict) -> list[str]:
     return [f"march.method={s['method']}", f"march.z_resolution={s['z_resolution']}",
-            f"march.post_steps={s['post_steps']}", f"march.epsilon={s['epsilon']}"]
+            f"march.post_steps={s['post_steps']}", f"march.epsilon={s['epsilon']}",
+            f"march.refine={s['refine']}"]
 
 
 def git_head() -> str:
@@ -162,14 +244,34 @@ def angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def measure(scene: Scene, res, tr: truth.Truth, normals: dict[str, np.ndarray]) -> dict:
     hit = res.status == STATUS_HIT
     both = hit & tr.hit
-    err = np.abs(res.depth.astype(np.float64)[both] - tr.depth[both])
+    dep = res.depth.astype(np.float64)[both]
+    signed = dep - tr.depth[both]                    # > 0: the render is behind the truth
+    err = np.abs(signed)
     px = tr.depth[both] * 2.0 * math.tan(math.radians(scene.camera.fov) / 2.0) / scene.image.height
     row = {"n_both": int(both.sum()), "hit_fraction": float(hit.mean()), "capped": res.capped,
-           "silhouette_err": float(np.mean(hit != tr.hit))}
+           "silhouette_err": float(np.mean(hit != tr.hit)),
+           "sil_missed": int(np.sum(~hit & tr.hit)), "sil_extra": int(np.sum(hit & ~tr.hit))}
     for k, v in zip(("mean", "median", "p99", "max"), _stats(err)):
         row[f"depth_err_{k}"] = v
     for k, v in zip(("mean", "median", "p99", "max"), _stats(err / px)):
         row[f"depth_err_px_{k}"] = v
+    bs = res.bracket_stats()
+    row.update(bracket_p50=bs["p50"], bracket_p99=bs["p99"], bracket_max=bs["max"])
+    # the certified bracket against the truth: the crossing should lie in [depth, depth + bracket]
+    br = res.bracket.astype(np.float64)[both]
+    slack = SLACK_ULPS * truth._ulp32(dep)
+    over = signed > slack                             # truth in front of the depth: stepped over
+    after = -signed > br + slack                      # truth behind the bracket's inside end
+    row["stepped_over"] = int(over.sum())
+    row["stepped_over_frac"] = float(over.mean()) if both.any() else 0.0
+    row["stepped_over_max"] = float(signed[over].max()) if over.any() else 0.0
+    row["stepped_over_median"] = float(np.median(signed[over])) if over.any() else 0.0
+    row["after_bracket"] = int(after.sum())
+    row["after_bracket_max"] = float((-signed - br)[after].max()) if after.any() else 0.0
+    inb = ~over & ~after
+    row["err_in_bracket_p99"] = float(np.percentile(err[inb], 99)) if inb.any() else math.nan
+    for g in ("shell_miss", "ulp_step"):
+        row[g] = int(res.guards.get(g, 0))
     for mth, nrm in normals.items():
         a = angle_deg(nrm[both], tr.normal[both])
         row[f"normal_err_{mth}_median"] = float(np.median(a)) if a.size else math.nan
@@ -202,14 +304,122 @@ def pareto(rows: list[dict], xkey="kernel_s", ykey="depth_err_p99") -> set[int]:
     return front
 
 
+# ------------------------------------------------------------ ITP vs bisection
+
+def refine_tests(scene: Scene, r0, steps: int, itp: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Set tests each hit ray's refinement takes, by a float32 twin of kernels/refine.cl
+    (bracket arithmetic in float32 like the kernel, so both stop where the bracket cannot
+    be split; the level function and the set test in float64 at the float32 points) started
+    from ``r0``'s brackets (a render with post_steps 0: [depth, depth + bracket] is the
+    march's certified bracket).  Returns (tests per ray, final width per ray); ITP's two
+    end-point level evaluations are not in the count (they cost one set test each)."""
+    f32 = np.float32
+    f = scene.fractal
+    o, d = ref.generate_rays(camera_frame(scene), scene.image.width, scene.image.height)
+    hit = (r0.status.ravel() == STATUS_HIT) & (r0.bracket.ravel() > 0)
+    a = r0.depth.ravel()[hit].astype(f32)
+    b = (a + r0.bracket.ravel()[hit].astype(f32)).astype(f32)
+    o32, d32 = o[hit].astype(f32), d[hit].astype(f32)
+
+    def point(k, x):
+        return (o32[k] + x[:, None] * d32[k]).astype(np.float64)
+
+    n = len(a)
+    tests = np.zeros(n, np.int64)
+    if itp:
+        k = np.arange(n)
+        fa, _ = ref.julia_level(point(k, a), f.c, f.max_iter, f.bailout)
+        fb, _ = ref.julia_level(point(k, b), f.c, f.max_iter, f.bailout)
+        tiny = f32(np.finfo(f32).tiny)
+        ya = -np.maximum(fa.astype(f32), tiny)
+        yb = -np.minimum(fb.astype(f32), f32(0))
+        w0 = b - a
+        eps = np.ldexp(w0, -(steps + 1)).astype(f32)
+        k1 = (f32(0.2) / w0).astype(f32)
+    live = np.ones(n, bool)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for j in range(steps + 1 if itp else steps):
+            if itp:
+                live &= (b - a) > f32(2) * eps
+            xh = (f32(0.5) * (a + b)).astype(f32)
+            live &= (xh > a) & (xh < b)
+            k = np.nonzero(live)[0]
+            if k.size == 0:
+                break
+            tests[k] += 1
+            if itp:
+                ak, bk, yak, ybk, xhk = a[k], b[k], ya[k], yb[k], xh[k]
+                r = (np.ldexp(eps[k], steps + 1 - j) - f32(0.5) * (bk - ak)).astype(f32)
+                delta = (k1[k] * (bk - ak) * (bk - ak)).astype(f32)
+                xf = np.where(ybk != yak, (ybk * ak - yak * bk) / (ybk - yak), xhk).astype(f32)
+                sigma = np.where(xhk >= xf, f32(1), f32(-1))
+                xt = np.where(delta <= np.abs(xhk - xf), xf + sigma * delta, xhk).astype(f32)
+                x = np.where(np.abs(xt - xhk) <= r, xt, xhk - sigma * r).astype(f32)
+                x = np.where((x > ak) & (x < bk), x, xhk).astype(f32)
+                fx, ins = ref.julia_level(point(k, x), f.c, f.max_iter, f.bailout)
+                y = -fx.astype(f32)
+                b[k] = np.where(ins, x, bk)
+                yb[k] = np.where(ins, np.maximum(y, f32(0)), ybk)
+                a[k] = np.where(ins, ak, x)
+                ya[k] = np.where(ins, yak, np.minimum(y, -tiny))
+            else:
+                x = xh[k]
+                ins = ref.julia_inside(point(k, x), f.c, f.max_iter, f.bailout)
+                b[k] = np.where(ins, x, b[k])
+                a[k] = np.where(ins, a[k], x)
+    return tests, (b - a).astype(np.float64)
+
+
+def itp_phase(name: str, base: Scene, dev, tr: truth.Truth, repeats: int = ITP_REPEATS) -> list[dict]:
+    """ITP against bisection at equal post_steps (the same guaranteed bracket h / 2^post):
+    kernel times from renders of the two alternated ``repeats`` times each (medians), set
+    tests from ``refine_tests`` on the march's own brackets, the brackets each reports."""
+    out = []
+    for (m, z, e, post) in ITP_PAIRS:
+        sc = {r: base.with_overrides(setting_overrides(setting(m, z, post, e, r))) for r in ("itp", "bisect")}
+        for x in sc.values():
+            render(x.with_overrides(["march.z_resolution=2", "march.epsilon=0.5", "march.max_steps=4"]), device=dev)
+            render(x, device=dev)
+        ks = {"itp": [], "bisect": []}
+        res = {}
+        for i in range(repeats):
+            for r in (("itp", "bisect") if i % 2 == 0 else ("bisect", "itp")):
+                res[r] = render(sc[r], device=dev)
+                ks[r].append(res[r].kernel_seconds)
+        r0 = render(base.with_overrides(setting_overrides(setting(m, z, 0, e, "itp"))), device=dev)
+        row = dict(scene=name, label=label(setting(m, z, post, e)), method=m, post_steps=post,
+                   z_resolution=z, epsilon=e, rays=int(np.sum((r0.status == STATUS_HIT) & (r0.bracket > 0))),
+                   march_samples_mean=float(np.mean(r0.samples[r0.status == STATUS_HIT])) if r0.hit_fraction else 0.0)
+        for r in ("itp", "bisect"):
+            tests, width = refine_tests(base, r0, post, r == "itp")
+            st = res[r].bracket_stats()
+            hit = (res[r].status == STATUS_HIT) & tr.hit
+            err = np.abs(res[r].depth.astype(np.float64)[hit] - tr.depth[hit])
+            row.update({f"{r}_kernel_s": float(np.median(ks[r])), f"{r}_tests_mean": float(np.mean(tests)) if tests.size else 0.0,
+                        f"{r}_tests_max": int(tests.max()) if tests.size else 0,
+                        f"{r}_bracket_p50": st["p50"], f"{r}_bracket_p99": st["p99"],
+                        f"{r}_twin_width_p99": float(np.percentile(width, 99)) if width.size else math.nan,
+                        f"{r}_err_p99": float(np.percentile(err, 99)) if err.size else math.nan})
+        row["kernel_ratio"] = row["itp_kernel_s"] / max(row["bisect_kernel_s"], 1e-12)
+        out.append(row)
+    return out
+
+
 # ------------------------------------------------------------------ output
 
-COLUMNS = ["scene", "method", "z_resolution", "post_steps", "epsilon", "curve", "kernel_s", "render_s",
-           "repeats", "hit_fraction", "capped", "n_both", "silhouette_err",
+COLUMNS = ["scene", "method", "z_resolution", "post_steps", "epsilon", "refine", "curve", "kernel_s", "render_s",
+           "repeats", "hit_fraction", "capped", "n_both", "silhouette_err", "sil_missed", "sil_extra",
            "depth_err_mean", "depth_err_median", "depth_err_p99", "depth_err_max",
-           "depth_err_px_mean", "depth_err_px_median", "depth_err_px_p99", "depth_err_px_max"] + \
+           "depth_err_px_mean", "depth_err_px_median", "depth_err_px_p99", "depth_err_px_max",
+           "bracket_p50", "bracket_p99", "bracket_max", "stepped_over", "stepped_over_frac", "stepped_over_median",
+           "stepped_over_max", "after_bracket", "after_bracket_max", "err_in_bracket_p99", "shell_miss", "ulp_step"] + \
           [f"normal_err_{m}_{s}" for m in NORMAL_METHODS for s in ("median", "p95")] + \
           ["pareto", "device", "date", "commit", "width", "height"]
+ITP_COLUMNS = ["scene", "label", "method", "z_resolution", "epsilon", "post_steps", "rays", "march_samples_mean",
+               "itp_kernel_s", "bisect_kernel_s", "kernel_ratio", "itp_tests_mean", "bisect_tests_mean",
+               "itp_tests_max", "bisect_tests_max", "itp_bracket_p50", "bisect_bracket_p50",
+               "itp_bracket_p99", "bisect_bracket_p99", "itp_twin_width_p99", "bisect_twin_width_p99",
+               "itp_err_p99", "bisect_err_p99"]
 
 
 def fmt(v) -> str:
@@ -220,71 +430,172 @@ def fmt(v) -> str:
     return str(v)
 
 
-def write_csv(path: Path, rows: list[dict]) -> None:
+def write_csv(path: Path, rows: list[dict], columns=None) -> None:
     with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
+        w = csv.DictWriter(fh, fieldnames=columns or COLUMNS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
             w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
 
 
-def write_markdown(path: Path, rows: list[dict], meta: dict, truths: dict, presets: dict) -> None:
+def preset_table(rows: list[dict]) -> list[dict]:
+    """Each quality.py preset's measured worst case over the scenes of ``rows``."""
+    from pyjulia4d.quality import PRESETS
+    out = []
+    for q, pr in PRESETS.items():
+        key = setting_key(setting(pr["method"], pr["z_resolution"], pr["post_steps"], pr["epsilon"],
+                                  pr.get("refine", "itp")))
+        rs = [r for r in rows if setting_key(r) == key]
+        if not rs:
+            continue
+        w99 = max(rs, key=lambda r: r["depth_err_p99"])
+        wsil = max(rs, key=lambda r: r["silhouette_err"])
+        fail = [r["scene"] for r in rs if r["depth_err_p99"] > pr["p99_bound"] or r["silhouette_err"] > pr["silhouette_bound"]]
+        nb = sum(r["n_both"] for r in rs)
+        out.append(dict(quality=q, label=label(dict(method=pr["method"], z_resolution=pr["z_resolution"],
+                                                    post_steps=pr["post_steps"], epsilon=pr["epsilon"],
+                                                    refine=pr.get("refine", "itp"))),
+                        p99_bound=pr["p99_bound"], silhouette_bound=pr["silhouette_bound"],
+                        worst_p99=w99["depth_err_p99"], worst_p99_scene=w99["scene"],
+                        worst_sil=wsil["silhouette_err"], worst_sil_scene=wsil["scene"],
+                        worst_max=max(r["depth_err_max"] for r in rs),
+                        median_p99=float(np.median([r["depth_err_p99"] for r in rs])),
+                        worst_bracket_p99=max(r["bracket_p99"] for r in rs),
+                        stepped_over=sum(r["stepped_over"] for r in rs), n_both=nb,
+                        stepped_over_max=max(r["stepped_over_max"] for r in rs),
+                        after_bracket=sum(r["after_bracket"] for r in rs),
+                        total_kernel_s=sum(r["kernel_s"] for r in rs), fails=fail, scenes=len(rs)))
+    return out
+
+
+def write_markdown(path: Path, rows: list[dict], meta: dict, truths: dict, presets: dict,
+                   itp_rows: list[dict] | None = None) -> None:
     L = [f"# Error against run time ({meta['mode']} run)", "",
          f"- device: {meta['device']}", f"- date: {meta['date']}", f"- commit: `{meta['commit']}`",
          f"- image: {meta['width']}x{meta['height']}, float32 kernels; times are medians over up to "
          f"{meta['repeats']} renders (one for renders slower than {meta['min_repeat_s']} s); programs "
-         "built and kernels run once before timing, so compilation is excluded",
+         "built and kernels run once before timing, so compilation is excluded; the machine is shared, "
+         "so times carry load noise",
          f"- command: `{meta['command']}`; total run time {meta['total_s']:.0f} s", "",
          "Depth errors in scene units over pixels both render and truth hit; `px` = the same in pixels' "
          "worth of depth (error / (depth 2 tan(fov/2) / height)); silhouette = fraction of pixels hit "
-         "by exactly one of the two; normal errors in degrees (median / p95). `*` = on the scene's "
-         f"Pareto front (kernel time vs p99 depth error, among settings with silhouette error <= {SIL_MAX:.1%}).",
-         ""]
-    L += ["## Ground truth", "", "| scene | description | truth | hit fraction | time (s) | convergence |",
-          "|---|---|---|---|---|---|"]
+         "by exactly one of the two; normal errors in degrees (median / p95). Bracket = the render's own "
+         "certified bracket width (p50 / p99 / max over its hits): the surface crossing lies in "
+         "[depth, depth + bracket]. `over` = pixels whose truth lies in front of the depth by more than "
+         f"{SLACK_ULPS} float32 spacings (a part the march stepped over before its first crossing - the one "
+         "thing the bracket does not cover); `after` = pixels whose truth lies behind depth + bracket by "
+         "more than that (the float64 truth calls the render's float32 inside point outside). `*` = on "
+         "the scene's Pareto front (kernel time vs p99 depth error, among settings with silhouette error "
+         f"<= {SIL_MAX:.1%}).", ""]
+    L += ["## Ground truth", "", "| scene | description | truth | hit fraction | time (s) | convergence | "
+          "de search (epsilon 1e-10, double) |", "|---|---|---|---|---|---|---|"]
     for name, tr in truths.items():
         L.append(f"| {name} | {SCENES[name][1]} | {tr.kind} | {tr.hit.mean():.3f} | {tr.seconds:.1f} | "
-                 f"{truth_summary(tr)} |")
+                 f"{truth_summary(tr)} | {de_summary(tr)} |")
     L.append("")
+    ptab = preset_table(rows) if meta["mode"] == "full" else []
+    if ptab:
+        L += ["## The presets (pyjulia4d/quality.py) on every scene", "",
+              "| quality | setting | stated p99 | worst p99 (scene) | median p99 | worst max | stated silhouette | "
+              "worst silhouette (scene) | worst bracket p99 | stepped over (pixels, max) | after bracket | "
+              "total kernel s | fails on |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for t in ptab:
+            L.append(f"| {t['quality']} | {t['label']} | {t['p99_bound']:g} | {t['worst_p99']:.3g} ({t['worst_p99_scene']}) | "
+                     f"{t['median_p99']:.3g} | {t['worst_max']:.3g} | {t['silhouette_bound']:.2%} | "
+                     f"{t['worst_sil']:.3%} ({t['worst_sil_scene']}) | {t['worst_bracket_p99']:.3g} | "
+                     f"{t['stepped_over']} of {t['n_both']} ({t['stepped_over'] / max(t['n_both'], 1):.2%}), "
+                     f"{t['stepped_over_max']:.3g} | {t['after_bracket']} | {t['total_kernel_s']:.3g} | "
+                     f"{', '.join(t['fails']) or 'none'} |")
+        L.append("")
     if presets:
         L += ["## Cheapest settings meeting an error bound on every scene", "",
               f"Worst case over all scenes of the p99 depth error, silhouette error <= {SIL_MAX:.1%} "
               "on every scene; cost = total kernel time over the scenes.", "",
-              "| bound (p99, scene units) | setting | worst p99 | worst silhouette | total kernel s |",
+              "| bound (p99, scene units) | setting | worst p99 (scene) | worst silhouette | total kernel s |",
               "|---|---|---|---|---|"]
         for bound, p in presets.items():
-            if bound == "_all":
+            if str(bound).startswith("_"):
                 continue
             if p is None:
                 L.append(f"| {bound:g} | none meets it | | | |")
             else:
-                L.append(f"| {bound:g} | {p['label']} | {p['worst_p99']:.3g} | {p['worst_sil']:.3g} | "
-                         f"{p['total_kernel_s']:.3g} |")
+                L.append(f"| {bound:g} | {p['label']} | {p['worst_p99']:.3g} ({p['worst_p99_scene']}) | "
+                         f"{p['worst_sil']:.3g} | {p['total_kernel_s']:.3g} |")
         L += ["", "### Every setting, worst case over the scenes (cheapest first)", "",
-              "| setting | total kernel s | worst p99 depth err | worst max depth err | worst silhouette |",
-              "|---|---|---|---|---|"]
+              "`old` = the nine scenes of the earlier run (max_iter 8-12, w = 0 cameras). Stepped over = pixels "
+              "(of all pixels both hit, all scenes) whose truth lies in front of the certified outside point.", "",
+              "| setting | total kernel s | worst p99 (scene) | worst p99, old | worst max | worst silhouette | "
+              "worst bracket p99 | stepped over | after bracket |", "|---|---|---|---|---|---|---|---|---|"]
         for c in presets["_all"]:
-            L.append(f"| {c['label']} | {c['total_kernel_s']:.3g} | {c['worst_p99']:.3g} | {c['worst_max']:.3g} | "
-                     f"{c['worst_sil']:.3g} |")
+            L.append(f"| {c['label']} | {c['total_kernel_s']:.3g} | {c['worst_p99']:.3g} ({c['worst_p99_scene']}) | "
+                     f"{c['worst_p99_old']:.3g} | {c['worst_max']:.3g} | {c['worst_sil']:.3g} | "
+                     f"{c['worst_bracket_p99']:.3g} | {c['stepped_over_frac']:.2%} | {c['after_bracket']} |")
         L.append("")
+    if itp_rows:
+        L += itp_markdown(itp_rows)
     for scene in dict.fromkeys(r["scene"] for r in rows):
         L += [f"## {scene}: {SCENES[scene][1]}", "",
-              "| method | z_res | post | eps | kernel s | render s | sil | mean | median | p99 | max | p99 px |"
-              " n jac | n grad | n zbuf |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| method | refine | z_res | post | eps | kernel s | sil | median | p99 | max | p99 px | "
+              "bracket p50 / p99 / max | over (max) | after | shell miss | n jac | n grad | n zbuf |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             if r["scene"] != scene:
                 continue
             star = "*" if r["pareto"] else ""
             zr = r["z_resolution"] if r["method"] == "fixed" else ""
-            ep = fmt(r["epsilon"]) if r["method"] == "de" else ""
+            ep = fmt(float(r["epsilon"])) if r["method"] == "de" else ""
             nn = [f"{fmt(r[f'normal_err_{m}_median'])} / {fmt(r[f'normal_err_{m}_p95'])}" for m in NORMAL_METHODS]
-            L.append(f"| {star}{r['method']} | {zr} | {r['post_steps']} | {ep} | {fmt(r['kernel_s'])} | "
-                     f"{fmt(r['render_s'])} | {fmt(r['silhouette_err'])} | {fmt(r['depth_err_mean'])} | "
-                     f"{fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | {fmt(r['depth_err_max'])} | "
-                     f"{fmt(r['depth_err_px_p99'])} | " + " | ".join(nn) + " |")
+            L.append(f"| {star}{r['method']} | {r['refine']} | {zr} | {r['post_steps']} | {ep} | {fmt(r['kernel_s'])} | "
+                     f"{fmt(r['silhouette_err'])} | {fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | "
+                     f"{fmt(r['depth_err_max'])} | {fmt(r['depth_err_px_p99'])} | {fmt(r['bracket_p50'])} / "
+                     f"{fmt(r['bracket_p99'])} / {fmt(r['bracket_max'])} | {r['stepped_over']} ({fmt(r['stepped_over_max'])}) | "
+                     f"{r['after_bracket']} | {r['shell_miss']} | " + " | ".join(nn) + " |")
         L.append("")
     path.write_text("\n".join(L))
+
+
+def itp_summary(itp_rows: list[dict]) -> list[dict]:
+    """Per setting of ITP_PAIRS: medians over the scenes of the kernel-time ratio, set tests."""
+    out = []
+    for lab in dict.fromkeys(r["label"] for r in itp_rows):
+        rs = [r for r in itp_rows if r["label"] == lab]
+        out.append(dict(label=lab, post_steps=rs[0]["post_steps"], scenes=len(rs),
+                        ratio_median=float(np.median([r["kernel_ratio"] for r in rs])),
+                        ratio_min=min(r["kernel_ratio"] for r in rs), ratio_max=max(r["kernel_ratio"] for r in rs),
+                        itp_tests=float(np.median([r["itp_tests_mean"] for r in rs])),
+                        bisect_tests=float(np.median([r["bisect_tests_mean"] for r in rs])),
+                        itp_kernel=float(np.sum([r["itp_kernel_s"] for r in rs])),
+                        bisect_kernel=float(np.sum([r["bisect_kernel_s"] for r in rs])),
+                        itp_bracket_p99=float(np.median([r["itp_bracket_p99"] for r in rs])),
+                        bisect_bracket_p99=float(np.median([r["bisect_bracket_p99"] for r in rs])),
+                        itp_err_p99=max(r["itp_err_p99"] for r in rs),
+                        bisect_err_p99=max(r["bisect_err_p99"] for r in rs),
+                        samples=float(np.median([r["march_samples_mean"] for r in rs]))))
+    return out
+
+
+def itp_markdown(itp_rows: list[dict]) -> list[str]:
+    L = ["## ITP against bisection at equal post_steps", "",
+         f"Same march, same guaranteed bracket (h / 2^post_steps); kernel times are medians of {ITP_REPEATS} renders "
+         "of each, alternated (ITP, bisect, bisect, ITP, ...) so both see the same load. Set tests per hit ray by "
+         "a float32 twin of kernels/refine.cl from the march's own brackets (ITP also evaluates the level function "
+         "at the two ends once: + 2). Summary = median over the scenes (kernel s: sum).", "",
+         "| setting | march samples (median) | set tests ITP (+2) | set tests bisect | kernel s ITP | kernel s bisect | "
+         "ITP / bisect kernel (median, range) | bracket p99 ITP | bracket p99 bisect | worst p99 err ITP | worst p99 err bisect |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for s in itp_summary(itp_rows):
+        L.append(f"| {s['label']} | {s['samples']:.3g} | {s['itp_tests']:.2f} | {s['bisect_tests']:.2f} | {s['itp_kernel']:.3g} | "
+                 f"{s['bisect_kernel']:.3g} | {s['ratio_median']:.2f} ({s['ratio_min']:.2f}-{s['ratio_max']:.2f}) | "
+                 f"{s['itp_bracket_p99']:.3g} | {s['bisect_bracket_p99']:.3g} | {s['itp_err_p99']:.3g} | {s['bisect_err_p99']:.3g} |")
+    L += ["", "Per scene:", "", "| scene | setting | tests ITP | tests bisect | kernel s ITP | kernel s bisect | ratio | "
+          "bracket p50 ITP / bisect | bracket p99 ITP / bisect |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in itp_rows:
+        L.append(f"| {r['scene']} | {r['label']} | {r['itp_tests_mean']:.2f} | {r['bisect_tests_mean']:.2f} | "
+                 f"{fmt(r['itp_kernel_s'])} | {fmt(r['bisect_kernel_s'])} | {r['kernel_ratio']:.2f} | "
+                 f"{fmt(r['itp_bracket_p50'])} / {fmt(r['bisect_bracket_p50'])} | "
+                 f"{fmt(r['itp_bracket_p99'])} / {fmt(r['bisect_bracket_p99'])} |")
+    L.append("")
+    return L
 
 
 def truth_summary(tr: truth.Truth) -> str:
@@ -294,11 +605,20 @@ def truth_summary(tr: truth.Truth) -> str:
         return (f"2D oracle, scan {tr.record['n_scan'][0]} then {tr.record['n_scan'][1]} steps + 60 bisections: "
                 f"{tr.record['changed_on_doubling']} of {tr.record['rays']} rays changed on doubling")
     steps = tr.record["steps"]
-    parts = [f"z={s['z_resolution']}" + (f": {s['changed_fraction']:.4f} changed" if "changed_fraction" in s else "")
-             for s in steps]
+    parts = [f"z={s['z_resolution']}" + (f": {s['changed_fraction']:.4f} changed (p99 move {s['p99_change']:.2g})"
+                                         if "changed_fraction" in s else "") for s in steps]
     return (f"double fixed scan, {tr.record['post_steps']} post-steps; " + ", ".join(parts) +
             f" (converged = {tr.record['converged']}: {tr.record['confirm']} successive doublings each changed at most "
             f"{tr.record['frac']:.1%} of the pixels, a change being a depth move > {tr.record['tol']:g} or a hit/miss flip)")
+
+
+def de_summary(tr: truth.Truth) -> str:
+    r = tr.record.get("de_search")
+    if not r:
+        return ""
+    return (f"{r['seconds']:.1f} s, {r['verified']} of {r['hit']} hits verified in float64, capped {r['capped']}; "
+            f"earlier than the scan on {r['de_first']} of {r['rays_hit']} pixels (lead p99 {r['de_lead_p99']:.2g}, "
+            f"max {r['de_lead_max']:.2g}), the scan earlier on {r['scan_first']}")
 
 
 def write_plot(path: Path, rows: list[dict], meta: dict) -> None:
@@ -306,12 +626,14 @@ def write_plot(path: Path, rows: list[dict], meta: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    rows = [r for r in rows if r["refine"] == "itp"]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     curves = list(dict.fromkeys(r["curve"] for r in rows))
-    ncol = min(3, len(scenes))
+    ncol = min(4, len(scenes))
     nrow = math.ceil(len(scenes) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 4.2 * nrow + 0.8), squeeze=False)
-    colors = {c: plt.cm.tab10(i % 10) for i, c in enumerate(curves)}
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.8 * nrow + 0.9), squeeze=False)
+    cmap = plt.cm.tab20 if len(curves) > 10 else plt.cm.tab10
+    colors = {c: cmap(i % 20) for i, c in enumerate(curves)}
     markers = {"fixed": "o", "de": "s"}
     floor = 1e-8
     for ax, scene in zip(axes.ravel(), scenes):
@@ -320,32 +642,26 @@ def write_plot(path: Path, rows: list[dict], meta: dict) -> None:
             pts = [r for r in sr if r["curve"] == cv]
             if not pts:
                 continue
-            pts.sort(key=lambda r: r["z_resolution"] if r["method"] == "fixed" else -r["epsilon"])
+            pts.sort(key=lambda r: r["z_resolution"] if r["method"] == "fixed" else -float(r["epsilon"]))
             x = [r["kernel_s"] for r in pts]
             y = [max(r["depth_err_p99"], floor) if not math.isnan(r["depth_err_p99"]) else np.nan for r in pts]
-            ax.plot(x, y, "-", color=colors[cv], lw=1.2, label=cv)
+            ax.plot(x, y, "-", color=colors[cv], lw=1.1, label=cv)
             for r, xi, yi in zip(pts, x, y):
                 good = r["silhouette_err"] <= SIL_MAX
-                ax.plot([xi], [yi], markers[r["method"]], ms=5, color=colors[cv],
+                ax.plot([xi], [yi], markers[r["method"]], ms=4, color=colors[cv],
                         mfc=colors[cv] if good else "none")
-                if cv == "fixed post=0":
-                    ax.annotate(f"z={r['z_resolution']}", (xi, yi), xytext=(3, 3), textcoords="offset points",
-                                fontsize=5.5, color=colors[cv])
-                elif cv == "de post=10":
-                    ax.annotate(f"{r['epsilon']:g}", (xi, yi), xytext=(-3, 0), textcoords="offset points",
-                                fontsize=5.5, color=colors[cv], ha="right")
         front = sorted((r for r in sr if r["pareto"]), key=lambda r: r["kernel_s"])
         if front:
             fx = [r["kernel_s"] for r in front]
             fy = [max(r["depth_err_p99"], floor) for r in front]
             ax.step(fx, fy, where="post", color="k", lw=1.0, ls="--", zorder=0)
-            ax.plot(fx, fy, "o", ms=10, mfc="none", mec="k", mew=1.2, label="Pareto front")
+            ax.plot(fx, fy, "o", ms=9, mfc="none", mec="k", mew=1.1, label="Pareto front")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_title(SCENES[scene][1], fontsize=8.5)
-        ax.set_xlabel("kernel time per render (s)", fontsize=8)
-        ax.set_ylabel("p99 depth error (scene units)", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.set_title(f"{scene}: " + SCENES[scene][1], fontsize=7)
+        ax.set_xlabel("kernel time per render (s)", fontsize=7)
+        ax.set_ylabel("p99 depth error (scene units)", fontsize=7)
+        ax.tick_params(labelsize=6)
         ax.grid(True, which="major", alpha=0.3)
     for ax in axes.ravel()[len(scenes):]:
         ax.axis("off")
@@ -355,40 +671,43 @@ def write_plot(path: Path, rows: list[dict], meta: dict) -> None:
             if l_ not in labels:
                 handles.append(h_)
                 labels.append(l_)
-    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 7), fontsize=8, frameon=False)
-    fig.suptitle(f"Depth error against time, {meta['width']}x{meta['height']} px, float32 kernels - "
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=7, frameon=False)
+    fig.suptitle(f"Depth error against time, {meta['width']}x{meta['height']} px, float32 kernels, ITP refinement - "
                  f"{meta['device']}, {meta['date']}, commit {meta['commit'][:10]}\n"
-                 f"hollow marker: silhouette error > {SIL_MAX:.1%} (overstepped or thickened); "
-                 f"labels: z_resolution (fixed post=0), epsilon (de post=10); error floor drawn at {floor:g}", fontsize=9)
-    fig.tight_layout(rect=(0, 0.04, 1, 0.95))
-    fig.savefig(path, dpi=110)
+                 f"hollow marker: silhouette error > {SIL_MAX:.1%}; curves: fixed (z_resolution 35 .. 16,000) and de "
+                 f"(epsilon 1e-2 .. 1e-6) at each post_steps; error floor drawn at {floor:g}", fontsize=8)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
+    fig.savefig(path, dpi=90)
     plt.close(fig)
 
 
 # ------------------------------------------------------------ seed claim
 
-def find(rows, scene, method, z=None, post=None, eps=None):
+def find(rows, scene, method, z=None, post=None, eps=None, refine="itp"):
     for r in rows:
         if r["scene"] == scene and r["method"] == method and (z is None or r["z_resolution"] == z) and \
-                (post is None or r["post_steps"] == post) and (eps is None or math.isclose(r["epsilon"], eps)):
+                (post is None or r["post_steps"] == post) and r["refine"] == refine and \
+                (eps is None or math.isclose(float(r["epsilon"]), eps)):
             return r
     return None
 
 
 def seed_claim(rows: list[dict], meta: dict) -> str | None:
-    a = find(rows, "fig5", "fixed", 250, 10)
+    a = find(rows, "fig5", "fixed", 250, 10, refine="bisect")     # the seed's post-stepping is bisection
+    ai = find(rows, "fig5", "fixed", 250, 10)
     b = find(rows, "fig5", "fixed", 256000, 0)
     c0 = find(rows, "fig5", "fixed", 250, 0)
-    de = [r for r in rows if r["scene"] == "fig5" and r["method"] == "de" and r["post_steps"] > 0]
+    de = [r for r in rows if r["scene"] == "fig5" and r["method"] == "de" and r["post_steps"] in (10, 20)
+          and r["refine"] == "itp"]
     if a is None or b is None:
         return None
-    hdr = ("| setting | kernel s | render s | silhouette | median depth err | p99 | max | p99 (px) | "
-           "normal jac median/p95 (deg) |\n|---|---|---|---|---|---|---|---|---|")
+    hdr = ("| setting | kernel s | render s | silhouette | median depth err | p99 | max | p99 (px) | bracket p99 | "
+           "normal jac median/p95 (deg) |\n|---|---|---|---|---|---|---|---|---|---|")
 
-    def line(label, r):
-        return (f"| {label} | {fmt(r['kernel_s'])} | {fmt(r['render_s'])} | {fmt(r['silhouette_err'])} | "
+    def line(lab, r):
+        return (f"| {lab} | {fmt(r['kernel_s'])} | {fmt(r['render_s'])} | {fmt(r['silhouette_err'])} | "
                 f"{fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | {fmt(r['depth_err_max'])} | "
-                f"{fmt(r['depth_err_px_p99'])} | {fmt(r['normal_err_jacobian_median'])} / "
+                f"{fmt(r['depth_err_px_p99'])} | {fmt(r['bracket_p99'])} | {fmt(r['normal_err_jacobian_median'])} / "
                 f"{fmt(r['normal_err_jacobian_p95'])} |")
 
     L = ["# Seed 000's post-stepping claim, tested (Fig. 5 scene)", "",
@@ -396,36 +715,40 @@ def seed_claim(rows: list[dict], meta: dict) -> str | None:
          "gives the detail of z-resolution 256,000 (250 x 2^10) for about 7 % more time than z-resolution 250 "
          "alone (19.1 s against 17.9 s).", "",
          f"Measured here: {meta['device']}, {meta['width']}x{meta['height']} px, float32 kernels, "
-         f"{meta['date']}, commit `{meta['commit']}`.", "", hdr]
+         f"{meta['date']}, commit `{meta['commit']}`. The seed's post-steps are bisection (march.refine = bisect); "
+         "ITP rows beside them.", "", hdr]
     if c0:
         L.append(line("fixed z=250, post 0", c0))
-    L.append(line("fixed z=250, post 10", a))
+    L.append(line("fixed z=250, post 10 (bisect)", a))
+    if ai:
+        L.append(line("fixed z=250, post 10 (ITP)", ai))
     L.append(line("fixed z=256000, post 0", b))
     for r in de:
-        L.append(line(f"de eps={r['epsilon']:g}, post {r['post_steps']}", r))
+        L.append(line(f"de eps={float(r['epsilon']):g}, post {r['post_steps']} (ITP)", r))
     L.append("")
     same = a["depth_err_p99"] <= max(2 * b["depth_err_p99"], 1e-5) and a["silhouette_err"] <= b["silhouette_err"] + 0.002
-    L.append(f"- z=250 + 10 post-steps vs z=256,000: p99 depth error {fmt(a['depth_err_p99'])} vs "
+    L.append(f"- z=250 + 10 post-steps (bisect) vs z=256,000: p99 depth error {fmt(a['depth_err_p99'])} vs "
              f"{fmt(b['depth_err_p99'])}, silhouette {fmt(a['silhouette_err'])} vs {fmt(b['silhouette_err'])} -> "
              + ("**as accurate** (within 2x on p99 and 0.2 % on silhouette)" if same else "**not as accurate**")
              + f"; kernel time {fmt(a['kernel_s'])} s vs {fmt(b['kernel_s'])} s "
              f"({b['kernel_s'] / max(a['kernel_s'], 1e-12):.0f}x).")
     if c0:
         L.append(f"- post-steps' cost at z=250: {fmt(c0['kernel_s'])} s -> {fmt(a['kernel_s'])} s "
-                 f"({100 * (a['kernel_s'] / max(c0['kernel_s'], 1e-12) - 1):+.0f} %; the seed: +7 %); p99 depth error "
-                 f"{fmt(c0['depth_err_p99'])} -> {fmt(a['depth_err_p99'])}.")
+                 f"({100 * (a['kernel_s'] / max(c0['kernel_s'], 1e-12) - 1):+.0f} %; the seed: +7 %; timing noise on "
+                 f"this shared machine is of that order); p99 depth error {fmt(c0['depth_err_p99'])} -> "
+                 f"{fmt(a['depth_err_p99'])}.")
     good = [r for r in de if r["silhouette_err"] <= SIL_MAX]
     if good:
         beat = [r for r in good if r["kernel_s"] < a["kernel_s"] and r["depth_err_p99"] <= a["depth_err_p99"]]
         best = min(good, key=lambda r: r["depth_err_p99"])
         if beat:
             r = min(beat, key=lambda r: r["kernel_s"])
-            L.append(f"- de with post-steps **beats both**: eps={r['epsilon']:g} + {r['post_steps']} post-steps "
+            L.append(f"- de with post-steps **beats both**: eps={float(r['epsilon']):g} + {r['post_steps']} post-steps "
                      f"is faster ({fmt(r['kernel_s'])} s) with p99 error {fmt(r['depth_err_p99'])} "
                      f"(silhouette {fmt(r['silhouette_err'])}).")
         else:
             L.append(f"- de with post-steps does **not** beat fixed z=250 + 10 post-steps on both time and p99 error; "
-                     f"its most accurate setting (eps={best['epsilon']:g}) takes {fmt(best['kernel_s'])} s "
+                     f"its most accurate setting (eps={float(best['epsilon']):g}) takes {fmt(best['kernel_s'])} s "
                      f"for p99 {fmt(best['depth_err_p99'])}.")
     else:
         L.append(f"- no de setting with post-steps keeps the silhouette error within {SIL_MAX:.1%}.")
@@ -434,30 +757,42 @@ def seed_claim(rows: list[dict], meta: dict) -> str | None:
 
 # --------------------------------------------------------------- presets
 
-PRESET_BOUNDS = (1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 2e-6)
+PRESET_BOUNDS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 2e-6)
+
+
+def candidates(rows: list[dict]) -> list[dict]:
+    """Every setting measured on all scenes of ``rows``, with its worst case over them."""
+    scenes = set(r["scene"] for r in rows)
+    by: dict = {}
+    for r in rows:
+        by.setdefault(setting_key(r), []).append(r)
+    out = []
+    for key, rs in by.items():
+        if {r["scene"] for r in rs} != scenes:
+            continue
+        p99 = [r["depth_err_p99"] for r in rs]
+        w = max(rs, key=lambda r: r["depth_err_p99"] if not math.isnan(r["depth_err_p99"]) else math.inf)
+        old = [r["depth_err_p99"] for r in rs if r["scene"] in OLD_SCENES]
+        nb = sum(r["n_both"] for r in rs)
+        out.append(dict(key=key, label=label(rs[0]),
+                        worst_p99=max(p99) if not any(math.isnan(x) for x in p99) else math.inf,
+                        worst_p99_scene=w["scene"],
+                        worst_p99_old=max(old) if old else math.nan,
+                        worst_sil=max(r["silhouette_err"] for r in rs),
+                        worst_max=max((r["depth_err_max"] for r in rs if not math.isnan(r["depth_err_max"])),
+                                      default=math.nan),
+                        worst_bracket_p99=max((r["bracket_p99"] for r in rs if not math.isnan(r["bracket_p99"])),
+                                              default=math.nan),
+                        stepped_over_frac=sum(r["stepped_over"] for r in rs) / max(nb, 1),
+                        after_bracket=sum(r["after_bracket"] for r in rs),
+                        total_kernel_s=sum(r["kernel_s"] for r in rs)))
+    return out
 
 
 def choose_presets(rows: list[dict], bounds=PRESET_BOUNDS) -> dict:
     """For each bound, the setting with the least total kernel time over all scenes whose
     worst-case p99 depth error <= bound and worst silhouette error <= SIL_MAX."""
-    scenes = set(r["scene"] for r in rows)
-    by = {}
-    for r in rows:
-        key = (r["method"], r["z_resolution"] if r["method"] == "fixed" else 0, r["post_steps"],
-               r["epsilon"] if r["method"] == "de" else 0)
-        by.setdefault(key, []).append(r)
-    cands = []
-    for key, rs in by.items():
-        if {r["scene"] for r in rs} != scenes:
-            continue
-        p99 = [r["depth_err_p99"] for r in rs]
-        cands.append(dict(key=key, worst_p99=max(p99) if not any(math.isnan(x) for x in p99) else math.inf,
-                          worst_sil=max(r["silhouette_err"] for r in rs),
-                          worst_max=max((r["depth_err_max"] for r in rs if not math.isnan(r["depth_err_max"])),
-                                        default=math.nan),
-                          total_kernel_s=sum(r["kernel_s"] for r in rs),
-                          label=(f"fixed z={key[1]} post={key[2]}" if key[0] == "fixed"
-                                 else f"de eps={key[3]:g} post={key[2]}")))
+    cands = candidates(rows)
     out = {}
     for b in bounds:
         ok = [c for c in cands if c["worst_p99"] <= b and c["worst_sil"] <= SIL_MAX]
@@ -493,6 +828,7 @@ def main(argv=None) -> int:
     nk = NormalKernels(dev)
     settings = grid(a.quick)
     rows: list[dict] = []
+    itp_rows: list[dict] = []
     truths: dict[str, truth.Truth] = {}
     for name in names:
         over, desc = SCENES[name]
@@ -502,9 +838,11 @@ def main(argv=None) -> int:
                                 **({"z_start": 1000} if a.quick else {}))
         truths[name] = tr
         print(f"[{time.perf_counter() - t_all:6.0f} s] {name}: truth {tr.kind} in {tr.seconds:.1f} s, "
-              f"hit {tr.hit.mean():.3f}; {truth_summary(tr)}", flush=True)
+              f"hit {tr.hit.mean():.3f}; {truth_summary(tr)}; {de_summary(tr)}", flush=True)
         srows = []
         for s in settings:
+            if not runs_on(s, name):
+                continue
             scene = base.with_overrides(setting_overrides(s))
             res, ks, rs, nrep = timed(scene, dev, a.repeats, a.min_repeat_s)
             normals = {"jacobian": res.normal.astype(np.float64)}
@@ -514,17 +852,27 @@ def main(argv=None) -> int:
             row.update(measure(scene, res, tr, normals))
             row.update(device=meta["device"], date=meta["date"], commit=meta["commit"], width=w, height=h)
             srows.append(row)
-            print(f"    {row['curve']:>15} z={s['z_resolution']:<6} eps={s['epsilon']:<7g} "
-                  f"kernel {ks:8.4f} s  sil {row['silhouette_err']:.4f}  p99 {row['depth_err_p99']:.3g}  "
-                  f"max {row['depth_err_max']:.3g}", flush=True)
+            print(f"    {label(s):>28} kernel {ks:8.4f} s  sil {row['silhouette_err']:.4f}  "
+                  f"p99 {row['depth_err_p99']:.3g}  max {row['depth_err_max']:.3g}  bracket p99 {row['bracket_p99']:.3g}  "
+                  f"over {row['stepped_over']} after {row['after_bracket']}", flush=True)
         front = pareto(srows)
         for i, r in enumerate(srows):
             r["pareto"] = i in front
         rows += srows
+        if not a.quick:
+            ir = itp_phase(name, base, dev, tr)
+            for r in ir:
+                r.update(device=meta["device"], commit=meta["commit"])
+                print(f"    ITP vs bisect {r['label']:>22}: tests {r['itp_tests_mean']:.2f}+2 vs {r['bisect_tests_mean']:.2f}, "
+                      f"kernel {r['itp_kernel_s']:.4f} vs {r['bisect_kernel_s']:.4f} s, bracket p99 "
+                      f"{r['itp_bracket_p99']:.3g} vs {r['bisect_bracket_p99']:.3g}", flush=True)
+            itp_rows += ir
     meta["total_s"] = time.perf_counter() - t_all
     presets = choose_presets(rows) if not a.quick else {}
     write_csv(a.out / "error_vs_time.csv", rows)
-    write_markdown(a.out / "error_vs_time.md", rows, meta, truths, presets)
+    if itp_rows:
+        write_csv(a.out / "error_vs_time_itp.csv", itp_rows, ITP_COLUMNS)
+    write_markdown(a.out / "error_vs_time.md", rows, meta, truths, presets, itp_rows)
     write_plot(a.out / "error_vs_time.png", rows, meta)
     (a.out / "truth.json").write_text(json.dumps(
         {n: {"kind": t.kind, "seconds": t.seconds, "hit_fraction": float(t.hit.mean()), "record": t.record}
@@ -534,10 +882,14 @@ def main(argv=None) -> int:
         (a.out / "seed_claim.md").write_text(claim)
         print(claim)
     for b, p in presets.items():
-        if b == "_all":
+        if str(b).startswith("_"):
             continue
         print(f"p99 <= {b:g}: {p['label'] if p else 'none'}"
-              + (f" (worst p99 {p['worst_p99']:.3g}, worst sil {p['worst_sil']:.3g}, total {p['total_kernel_s']:.3g} s)" if p else ""))
+              + (f" (worst p99 {p['worst_p99']:.3g} on {p['worst_p99_scene']}, worst sil {p['worst_sil']:.3g}, "
+                 f"total {p['total_kernel_s']:.3g} s)" if p else ""))
+    for t in (preset_table(rows) if not a.quick else []):
+        print(f"preset {t['quality']}: {t['label']}: worst p99 {t['worst_p99']:.3g} ({t['worst_p99_scene']}) vs "
+              f"stated {t['p99_bound']:g}; worst sil {t['worst_sil']:.3g}; fails on {t['fails'] or 'none'}")
     print(f"wrote {a.out} in {meta['total_s']:.0f} s")
     return 0
 

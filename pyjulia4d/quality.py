@@ -35,14 +35,14 @@ QUALITIES = ("custom", "draft", "normal", "final")
 # the benchmark's pick among epsilons moves between runs; these are fixed from one run.
 PRESETS: dict[str, dict] = {
     "draft": {"method": "de", "z_resolution": 250, "post_steps": 0, "epsilon": 1e-4,
-              "p99_bound": 3e-2, "silhouette_bound": 0.005},
+              "refine": "itp", "p99_bound": 3e-2, "silhouette_bound": 0.005},
     "normal": {"method": "de", "z_resolution": 250, "post_steps": 10, "epsilon": 1e-5,
-               "p99_bound": 1e-4, "silhouette_bound": 0.005},
+               "refine": "itp", "p99_bound": 1e-4, "silhouette_bound": 0.005},
     "final": {"method": "de", "z_resolution": 250, "post_steps": 20, "epsilon": 1e-5,
-              "p99_bound": 2e-6, "silhouette_bound": 0.005},
+              "refine": "itp", "p99_bound": 2e-6, "silhouette_bound": 0.005},
 }
 
-MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon")
+MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon", "refine")
 
 
 def preset_values(quality: str) -> dict:
