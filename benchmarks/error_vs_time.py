@@ -8,8 +8,9 @@ epsilon 1e-10 - the earlier float64-verified crossing wins; never a float32 sett
 test).  Then for a grid of
 
 * distance-estimate marching: epsilon 1e-2 .. 1e-6 x post_steps 0, 2, 4, 6, 10, 20 with
-  ITP refinement (march.refine = itp, the default), epsilon 1e-7 (below float32's
-  spacing of t ~ 5: every smallest step becomes one ulp) with 10 and 20, and a few
+  ITP refinement (march.refine = itp, the default), epsilon 3e-7 and 1e-7 (at and
+  below float32's spacing of t at depths 2-8: the smallest steps become one ulp,
+  counted as ulp_step) with 10 and 20, and a few
   settings with bisection (march.refine = bisect, seed 000's post-stepping);
 * fixed marching: z_resolution 35 .. 16,000 (log-spaced) x post_steps 0, 4, 10, 20 with
   ITP, a few with bisection, and z = 256,000 without post-steps on the Fig. 5 scene only
@@ -112,7 +113,7 @@ QUICK_SCENES = ["sphere", "real"]
 
 DE_EPS = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
 DE_POSTS = [0, 2, 4, 6, 10, 20]
-DE_EXTRA = [(1e-7, 10), (1e-7, 20)]                         # below float32's spacing of t: ulp steps
+DE_EXTRA = [(3e-7, 10), (3e-7, 20), (1e-7, 10), (1e-7, 20)]  # at and below float32 spacing of t ~ 2-5: ulp steps
 DE_BISECT = [(1e-4, 6), (1e-4, 10), (1e-5, 6), (1e-5, 10), (1e-5, 20), (1e-6, 10), (1e-6, 20)]
 Z_RES = [35, 70, 250, 1000, 4000, 16000]
 FIXED_POSTS = [0, 4, 10, 20]
