@@ -473,8 +473,9 @@ def _unit(v: Iterable[float]) -> list[float]:
     return [x / n for x in v]
 
 
-# camera.target closer to camera.position than this times max(1, |position|, |target|)
-# leaves the view direction to rounding (camera.py refuses an absolute 1e-9)
+# camera.target at least this times max(1, |position|, |target|) from camera.position:
+# the float64 view direction then holds to ~2e-8 rad, finer than the smallest fov
+# (1e-6 degrees); camera.py refuses below an absolute 1e-9
 _MIN_VIEW_DISTANCE = 1e-8
 
 
@@ -486,8 +487,9 @@ def _check_camera(cam: Camera) -> None:
     view = _sub(cam.target, cam.position)
     least = _MIN_VIEW_DISTANCE * max(1.0, _norm(cam.position), _norm(cam.target))
     if _norm(view) < least:
-        raise SceneError("camera.target", f"within {least:.1e} of camera.position (the view "
-                         "direction would be lost in rounding)")
+        raise SceneError("camera.target", f"closer than {least:.1e} to camera.position (1e-8 x "
+                         "max(1, |position|, |target|): the view direction must hold to the "
+                         "smallest fov)")
     fwd = _unit(view)
     limbo = _reject(_unit(cam.limbo), [fwd])
     if _norm(limbo) < 1e-6:

@@ -353,7 +353,8 @@ def test_every_catalogue_case_is_valid() -> None:
     ("", "--set: malformed override '', expected SECTION.KEY=VALUE"),
     ("fractal.c\n=1", "fractal.c: expected a list of 4 numbers, got 1"),
     ("a\nb=1", "'a\\nb': unknown key"),
-    ("camera.target=1.8,1.6,-2.2,1e-9", "camera.target: within 3.3e-08 of camera.position (the view direction would be lost in rounding)"),
+    ("camera.target=1.8,1.6,-2.2,1e-9", "camera.target: closer than 3.3e-08 to camera.position (1e-8 x max(1, |position|, |target|): "
+     "the view direction must hold to the smallest fov)"),
 ])
 def test_out_of_range_messages(text: str, message: str) -> None:
     with pytest.raises(SceneError) as info:
