@@ -12,6 +12,7 @@ import os
 import signal
 import stat
 import tempfile
+import threading
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
@@ -23,9 +24,9 @@ FORMATS = (".png", ".exr")
 _RANDOM_CHARS = 16
 # Where pathconf() cannot tell: the usual Linux limits.
 _NAME_MAX, _PATH_MAX = 255, 4096
-# Held while a temp file is created or removed, so that no signal's exception can
+# Deferred while a temp file is created or removed, so that no signal's exception can
 # fall between creating a file and knowing its name (which would leave it behind).
-_HELD = {getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s)}
+_HELD = tuple(getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s))
 
 
 class OutputError(ValueError):
@@ -67,15 +68,27 @@ def _temp_affixes(p: Path, name_max: int) -> tuple[str, str]:
 
 @contextlib.contextmanager
 def _signals_held() -> Iterator[None]:
-    """Defer SIGINT, SIGTERM and SIGHUP to the end of the block (where supported)."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
+    """Run the Python handlers of SIGINT, SIGTERM and SIGHUP (Ctrl-C's KeyboardInterrupt,
+    the CLI's exceptions) at the end of the block instead of inside it.
+
+    Python runs every handler in the main thread, whichever thread the signal was
+    delivered to (OpenCL's workers take some): blocking it with pthread_sigmask in this
+    thread would not defer it, swapping the handlers does."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread runs handlers (and may swap them)
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    caught: list[int] = []
+    old = {}
+    for s in _HELD:
+        if callable(signal.getsignal(s)):
+            old[s] = signal.signal(s, lambda signum, frame: caught.append(signum))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for s, handler in old.items():
+            signal.signal(s, handler)
+        if caught:
+            old[caught[0]](caught[0], None)  # the first one's exception, now
 
 
 def check_output_path(path: str | Path) -> Path:

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import os
 import signal
+import threading
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -214,15 +216,20 @@ def test_signal_during_write_leaves_nothing(tmp_path, monkeypatch, fmt: str) -> 
 @pytest.mark.parametrize("call", [1, 2], ids=["probe", "write"])
 def test_signal_while_creating_the_temp_file_is_deferred(tmp_path, monkeypatch, call: int) -> None:
     """A signal that arrives while a temp file is created (check_output_path's probe, then
-    the write's own) is raised only once its name is known, so it is removed."""
+    the write's own) is raised only once its name is known, so it is removed - also when
+    another thread (as OpenCL's workers) is the one the signal is delivered to."""
     real = output.tempfile.mkstemp
     calls = []
+    done = threading.Event()
+    other = threading.Thread(target=done.wait)  # a thread that does not hold the signal
+    other.start()
 
     def mkstemp_then_signal(*args, **kwargs):
         made = real(*args, **kwargs)
         calls.append(made)
         if len(calls) == call:
-            signal.raise_signal(signal.SIGTERM)  # held: raised when the block ends
+            os.kill(os.getpid(), signal.SIGTERM)  # to the process: any thread may take it
+            time.sleep(0.05)  # Python runs the handler here unless it is deferred
         return made
 
     monkeypatch.setattr(output.tempfile, "mkstemp", mkstemp_then_signal)
@@ -232,4 +239,6 @@ def test_signal_while_creating_the_temp_file_is_deferred(tmp_path, monkeypatch, 
             write_image(tmp_path / "out.png", FakeResult(*_color_alpha()), {})
     finally:
         signal.signal(signal.SIGTERM, old)
+        done.set()
+        other.join()
     assert len(calls) == call and _names(tmp_path) == []
