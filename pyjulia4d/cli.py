@@ -48,10 +48,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: the built-in scene)")
     r.add_argument("-o", "--output", metavar="OUT", help="OUT.png or OUT.exr (default: <scene stem>.png, or julia.png)")
     # kept as text so bad sizes get the same one-line scene error as --set
-    r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W)")
-    r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H)")
+    r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W; not both)")
+    r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H; not both)")
     r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable)")
+                   help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; README lists every key and its valid range)")
     r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
     r.add_argument("--force", action="store_true",
                    help="render settings whose estimated work is refused as hopeless (hours)")
