@@ -88,22 +88,18 @@ def _render(args: argparse.Namespace) -> int:
     from .render import render  # heavy (kernel build); only once the input is known good
 
     result = render(scene, device=device, progress=True, force=args.force)
-    header = {
-        "pyjulia4d.scene": scene.to_toml(),
-        "pyjulia4d.device": result.device_name,
-        "pyjulia4d.render_seconds": "%.6f" % result.seconds,
-        "pyjulia4d.capped_pixels": str(result.capped),
-        "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in result.guards.items()),
-    }
+    from .quality import PRESETS
+
+    # capped rays, the guards that fired and the certified depth bracket are part of the
+    # result: said in the header and the closing line, never hidden
+    stated = PRESETS[scene.march.quality]["p99_bound"] if scene.march.quality in PRESETS else None
+    report, tail = result.report(stated)
+    header = {"pyjulia4d.scene": scene.to_toml(), **report}
     write_image(out, result, header)
     w, h = scene.image.width, scene.image.height
-    # guards that fired and capped rays are part of the result: say so (never hidden)
-    fired = [f"{k} {v}" for k, v in result.guards.items() if v]
-    extra = f", {result.capped} capped" if result.capped else ""
-    extra += f"; guards fired: {', '.join(fired)}" if fired else ""
     print(
         f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}, "
-        f"{100 * result.hit_fraction:.1f}% of pixels hit{extra}"
+        f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
     return 0
 
