@@ -71,7 +71,20 @@ def test_cli_reports_guards_that_fired(tmp_path):
     p = cli("--width", "8", "--height", "6", "--set", "camera.position=0.05,0.1,-0.1,0",
             "--set", "camera.target=0,0,1,0", "-o", "in.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert p.stdout.strip().endswith("100.0% of pixels hit; guards fired: eye_hit 48")
+    # the eye is the first inside point of every ray: depth 0, bracket 0 (exact)
+    assert p.stdout.strip().endswith("100.0% of pixels hit; guards fired: eye_hit 48; "
+                                     "depth bracket p50 0 p99 0 max 0")
+
+
+def test_cli_reports_the_bracket_and_the_preset_bound(tmp_path):
+    p = cli("--width", "32", "--height", "24", "--set", "march.quality=final", "-o", "f.exr", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "; depth bracket p50 " in p.stdout and "preset's stated" in p.stdout
+    hdr = OpenEXR.File(str(tmp_path / "f.exr")).header()
+    stats = dict(kv.split("=") for kv in str(hdr["pyjulia4d.depth_bracket"]).split())
+    assert set(stats) == {"p50", "p99", "max"}
+    assert 0 <= float(stats["p50"]) <= float(stats["p99"]) <= float(stats["max"])
+    assert str(hdr["pyjulia4d.preset_bound_met"]) in ("yes", "no")
 
 
 def test_cli_default_scene_png(tmp_path):
