@@ -2,7 +2,9 @@
 
 A scene is read from TOML (or a plain dict), then ``--set section.key=VALUE``
 overrides are applied, and the result is validated in one pass. Every error is a
-:class:`SceneError` whose message starts with the dotted key it concerns.
+:class:`SceneError` whose message starts with the dotted key it concerns.  Every key
+has a valid range, declared once in ``_CHECKS`` (:func:`valid_range` words it; README's
+"Scene keys" table is tested against it).
 """
 from __future__ import annotations
 
