@@ -154,6 +154,9 @@ class FakeResult:
     def exr_channels(self) -> dict[str, np.ndarray]:
         return {"R": self.color[..., 0], "A": self.alpha}
 
+    def report(self, stated_p99=None) -> tuple[dict[str, str], str]:
+        return {"pyjulia4d.device": self.device_name}, ""
+
 
 class FakeRender:
     """Stands in for pyjulia4d.render.render; records calls, optionally raises."""

@@ -554,6 +554,9 @@ class Result:
         self.device_name, self.seconds, self.hit_fraction, self.capped = "stand-in", 0.1, 0.5, 0
         self.guards = {}
 
+    def report(self, stated_p99=None):
+        return {}, ""
+
 def render(scene, device=None, progress=False, force=False):
     if phase == "render":
         print("rendering", file=sys.stderr, flush=True)
