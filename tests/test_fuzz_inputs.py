@@ -480,6 +480,14 @@ def test_huge_images_refused(size: list[str], tmp_path) -> None:
 
 # ------------------------------------------------------------------ signals
 
+def _default_signals() -> None:
+    """In the child: SIGTERM and SIGHUP at their default action, as a terminal gives them.
+    A suite run under nohup (or a CI runner that ignores SIGHUP) would otherwise hand the
+    child an ignored SIGHUP, which the CLI rightly leaves ignored."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
+
 def _wait_for(predicate, timeout: float) -> bool:
     end = time.monotonic() + timeout
     while time.monotonic() < end:
@@ -518,7 +526,8 @@ def test_signal_during_a_real_render(sig: int, tmp_path) -> None:
         args += ["--device", os.environ["PYJULIA4D_DEVICE"]]
     with open(err_path, "w") as err:
         proc = subprocess.Popen([sys.executable, "-m", "pyjulia4d", *args], cwd=tmp_path, env=_env(),
-                                stdout=subprocess.PIPE, stderr=err, text=True)
+                                stdout=subprocess.PIPE, stderr=err, text=True,
+                                preexec_fn=_default_signals)
     try:
         # the progress bar (redrawn with carriage returns) appears once the render has run
         # for a second
@@ -590,7 +599,8 @@ def test_signal_during_the_write(sig: int, phase: str, tmp_path) -> None:
     with open(err_path, "w") as err:
         proc = subprocess.Popen([sys.executable, "-c", _STAND_IN, phase, "render", "-o", "out/julia.png",
                                  "--width", "64", "--height", "48"],
-                                cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=err, text=True)
+                                cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=err, text=True,
+                                preexec_fn=_default_signals)
     try:
         word = "writing" if phase == "write" else "rendering"
         assert _wait_for(lambda: word in err_path.read_text(), 30), err_path.read_text()
