@@ -55,3 +55,22 @@ def test_extreme_cases_report_runs(tmp_path):
     assert all(r["verdict"] == "ok" and r["nan_inf32"] == "0" and r["nan_inf64"] == "0" for r in rows)
     md = (tmp_path / "extreme_cases.md").read_text()
     assert "commit `" in md and "| epsilon_below_ulp | de |" in md and "ulp_step=" in md
+
+
+def test_preset_check_runs(tmp_path):
+    """benchmarks/preset_check.py on two unseen scenes, tiny, so the check cannot rot."""
+    spec = importlib.util.spec_from_file_location("preset_check", ROOT / "benchmarks" / "preset_check.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--n", "2", "--width", "16", "--height", "12", "--z-start", "1000", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "preset_check.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 2 * 3 and {r["quality"] for r in rows} == {"draft", "normal", "final"}
+    assert [r["kind"] for r in rows[::3]] == ["boundary", "dust"]
+    for r in rows:
+        assert r["commit"] and r["device"] and r["date"]
+        assert int(r["max_iter"]) == 12 and float(r["truth_hit"]) >= mod.MIN_HIT
+        assert r["p99_held"] in ("True", "False") and 0 <= float(r["silhouette_err"]) <= 1
+        assert float(r["bracket_p99"]) >= 0 and int(r["stepped_over"]) >= 0
+    md = (tmp_path / "preset_check.md").read_text()
+    assert "commit: `" in md and "| quality | stated p99 |" in md and "| s01_dust |" in md
