@@ -32,7 +32,7 @@ seeds 20261125 (12 scenes) and 1 (24 scenes) were, while deriving them.
 Writes benchmarks/results/preset_check.csv and .md (device, date, commit, command).
 
     python benchmarks/preset_check.py                 # 24 scenes, 64x48 (~2 min on 2 CPU cores)
-    python benchmarks/preset_check.py --n 1 --width 16 --height 12 --z-start 1000   # smoke run
+    python benchmarks/preset_check.py --n 2 --width 16 --height 12 --z-start 1000 --time-default 0  # smoke run
 """
 from __future__ import annotations
 
@@ -177,7 +177,25 @@ def summary(rows: list[dict]) -> list[dict]:
     return out
 
 
-def write(out: Path, rows: list[dict], scenes: list[dict], meta: dict) -> None:
+def time_default(dev, rounds: int = 5) -> list[dict]:
+    """The default scene (Scene.default(): 640x480, c = -0.2+0.8i, max_iter 12) with each
+    preset and as it is (custom), rendered ``rounds`` times in rotating order so all see
+    the same load; medians of kernel and whole-render time."""
+    base = Scene.default()
+    names = ["custom", *PRESETS]
+    for q in names:                                      # build and warm every program
+        render(apply_quality(base, q), device=dev)
+    times = {q: ([], []) for q in names}
+    for i in range(rounds):
+        for q in names[i % len(names):] + names[:i % len(names)]:
+            r = render(apply_quality(base, q), device=dev)
+            times[q][0].append(r.kernel_seconds)
+            times[q][1].append(r.seconds)
+    return [dict(quality=q, kernel_s=float(np.median(k)), render_s=float(np.median(w)), rounds=rounds,
+                 width=base.image.width, height=base.image.height) for q, (k, w) in times.items()]
+
+
+def write(out: Path, rows: list[dict], scenes: list[dict], meta: dict, timing: list[dict] | None = None) -> None:
     with open(out / "preset_check.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
         w.writeheader()
@@ -208,6 +226,12 @@ def write(out: Path, rows: list[dict], scenes: list[dict], meta: dict) -> None:
                  f"({s['stepped_over_deep'] / max(s['n_both_deep'], 1):.2%}) | {s['silhouette_bound']:.2%} | "
                  f"{s['worst_sil']:.3%} ({s['worst_sil_scene']}) | {s['sil_held']} of {s['scenes']} | "
                  f"{g(s['worst_bracket_p99'])} | {g(s['kernel_s'])} |")
+    if timing:
+        L += ["", f"## The default scene ({timing[0]['width']}x{timing[0]['height']}), each preset", "",
+              f"Medians of {timing[0]['rounds']} renders each, in rotating order (programs built first). `custom` = the "
+              "default scene's own march keys.", "", "| quality | kernel s | render s |", "|---|---|---|"]
+        for t in timing:
+            L.append(f"| {t['quality']} | {t['kernel_s']:.3g} | {t['render_s']:.3g} |")
     L += ["", "## Scenes", "", "| scene | kind | c (critical orbit escapes at) | max_iter | camera position | limbo | "
           "truth hit | truth s | de search first on | scan converged |", "|---|---|---|---|---|---|---|---|---|---|"]
     for s in scenes:
@@ -235,6 +259,8 @@ def main(argv=None) -> int:
     ap.add_argument("--z-start", type=int, default=8000, help="the truth scan's first z-resolution")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     ap.add_argument("--device", default=None)
+    ap.add_argument("--time-default", type=int, default=5, metavar="ROUNDS",
+                    help="time the default scene with each preset, ROUNDS renders each (0: skip)")
     a = ap.parse_args(argv)
     t_all = time.perf_counter()
     dev = select_device(a.device)
@@ -278,8 +304,11 @@ def main(argv=None) -> int:
             print(f"    {q:>6}: p99 {row['depth_err_p99']:.3g} (stated {row['p99_bound']}) max {row['depth_err_max']:.3g} "
                   f"sil {row['silhouette_err']:.4f} bracket p99 {row['bracket_p99']:.3g} over {row['stepped_over']} "
                   f"-> {'held' if ok else 'NOT held'}", flush=True)
+    timing = time_default(dev, a.time_default) if a.time_default > 0 else None
+    for t in timing or []:
+        print(f"default scene, {t['quality']}: kernel {t['kernel_s']:.3f} s, render {t['render_s']:.3f} s")
     meta["total_s"] = time.perf_counter() - t_all
-    write(a.out, rows, scenes, meta)
+    write(a.out, rows, scenes, meta, timing)
     for s in summary(rows):
         print(f"{s['quality']}: max_iter <= {BOUND_MAX_ITER}: worst p99 {s['worst_p99']:.3g} ({s['worst_p99_scene']}) vs "
               f"stated {s['p99_bound']:g}, held on {s['p99_held']} of {s['scenes_bounded']}; max_iter 30-50: worst p99 "

@@ -62,7 +62,8 @@ def test_preset_check_runs(tmp_path):
     spec = importlib.util.spec_from_file_location("preset_check", ROOT / "benchmarks" / "preset_check.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    assert mod.main(["--n", "2", "--width", "16", "--height", "12", "--z-start", "1000", "--out", str(tmp_path)]) == 0
+    assert mod.main(["--n", "2", "--width", "16", "--height", "12", "--z-start", "1000", "--time-default", "0",
+                     "--out", str(tmp_path)]) == 0
     with open(tmp_path / "preset_check.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 2 * 3 and {r["quality"] for r in rows} == {"draft", "normal", "final"}
