@@ -88,12 +88,17 @@ def _render(args: argparse.Namespace) -> int:
     from .render import render  # heavy (kernel build); only once the input is known good
 
     result = render(scene, device=device, progress=True, force=args.force)
-    from .quality import PRESETS
+    from .quality import BOUND_MAX_ITER, stated_p99
 
     # capped rays, the guards that fired and the certified depth bracket are part of the
     # result: said in the header and the closing line, never hidden
-    stated = PRESETS[scene.march.quality]["p99_bound"] if scene.march.quality in PRESETS else None
+    q = scene.march.quality
+    stated = stated_p99(q, scene.fractal.max_iter)
     report, tail = result.report(stated)
+    if q != "custom" and stated is None:  # never claim a bound that was not measured
+        tail += (f"; march.quality={q} states no depth-error bound beyond fractal.max_iter "
+                 f"{BOUND_MAX_ITER}: the bracket above is this render's own")
+        report["pyjulia4d.preset_bound_met"] = "no bound stated"
     header = {"pyjulia4d.scene": scene.to_toml(), **report}
     write_image(out, result, header)
     w, h = scene.image.width, scene.image.height

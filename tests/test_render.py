@@ -116,3 +116,13 @@ def test_image_too_large_for_memory_refused_before_rendering():
         s = Scene.default().with_overrides([f"image.width={w}", f"image.height={h}"])
         with pytest.raises(SceneError, match=r"^image\.(width|height): .* pixels needs ~.* GiB"):
             workload.check(s, force=True)
+
+
+def test_cli_claims_no_bound_beyond_the_measured_max_iter(tmp_path):
+    from pyjulia4d.quality import BOUND_MAX_ITER
+
+    p = cli("--width", "16", "--height", "12", "--set", "march.quality=normal",
+            "--set", f"fractal.max_iter={BOUND_MAX_ITER + 10}", "-o", "n.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "states no depth-error bound beyond fractal.max_iter" in p.stdout
+    assert "within the preset's stated" not in p.stdout
