@@ -39,7 +39,7 @@ PRESETS: dict[str, dict] = {
     "normal": {"method": "de", "z_resolution": 250, "post_steps": 10, "epsilon": 1e-6, "refine": "itp",
                "p99_bound": 1e-4, "silhouette_bound": 0.005},
     "final": {"method": "de", "z_resolution": 250, "post_steps": 20, "epsilon": 5e-7, "refine": "itp",
-              "p99_bound": 3e-6, "silhouette_bound": 0.005},
+              "p99_bound": 1e-5, "silhouette_bound": 0.005},
 }
 
 # The bounds are stated for scenes with fractal.max_iter up to this; beyond it (measured at

@@ -62,7 +62,7 @@ def test_preset_check_runs(tmp_path):
     spec = importlib.util.spec_from_file_location("preset_check", ROOT / "benchmarks" / "preset_check.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    assert mod.main(["--n", "2", "--width", "16", "--height", "12", "--z-start", "1000", "--time-default", "0",
+    assert mod.main(["--n", "2", "--seeds", "2027", "--width", "16", "--height", "12", "--z-start", "1000", "--time-default", "0",
                      "--out", str(tmp_path)]) == 0
     with open(tmp_path / "preset_check.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -74,4 +74,4 @@ def test_preset_check_runs(tmp_path):
         assert r["p99_held"] in ("True", "False") and 0 <= float(r["silhouette_err"]) <= 1
         assert float(r["bracket_p99"]) >= 0 and int(r["stepped_over"]) >= 0
     md = (tmp_path / "preset_check.md").read_text()
-    assert "commit: `" in md and "| quality | stated p99 |" in md and "| s01_dust |" in md
+    assert "commit: `" in md and "| quality | stated p99 |" in md and "| 2027_s01_dust |" in md
