@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from .camera import Frame, camera_frame, light_position, march_radius
-from .render import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
+from .render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
                      STATUS_CAPPED,
                      STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
 from .scene import Scene
@@ -541,7 +541,7 @@ def render(scene: Scene) -> RenderResult:
     if scene.normals.method == "jacobian":
         normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard)
     elif scene.normals.method == "gradient":
-        step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
+        step = gradient_step(scene)
         normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard)
     else:
         normal = normals_zbuffer(point, depth, status, w, h, frame, guard)

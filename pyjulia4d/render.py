@@ -154,6 +154,20 @@ def _float4(v3, w=0.0):
     return cl.cltypes.make_float4(*[float(x) for x in v3], float(w))
 
 
+# The floor of normals.step = "auto": a central difference of the estimate over a step h
+# carries its rounding error divided by h; at h = epsilon = 5e-7 (the final preset) float32
+# differences are noise (2.8 degrees median on the c = 0 ball, against 0.1 at 1e-5).
+GRADIENT_STEP_FLOOR = {"single": 1e-5, "double": 1e-8}
+
+
+def gradient_step(scene: Scene) -> float:
+    """The gradient normals' difference step: normals.step, or for "auto" march.epsilon
+    floored at GRADIENT_STEP_FLOOR[render.float]."""
+    if scene.normals.step != "auto":
+        return float(scene.normals.step)
+    return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.render.float])
+
+
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
                    point, depth, status, normal, size: tuple[int, int] | None = None) -> None:
     """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
@@ -168,7 +182,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
         cl.Kernel(prg, "normals_jacobian")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
                                            pr.scalar(f.bailout), right, up, fwd, normal.data)
     elif method == "gradient":
-        step = m.epsilon if scene.normals.step == "auto" else float(scene.normals.step)
+        step = gradient_step(scene)
         cl.Kernel(prg, "normals_gradient")(queue, (n,), None, point.data, status.data, c, np.int32(f.max_iter),
                                            pr.scalar(f.bailout), pr.scalar(step), right, up, fwd, normal.data)
     else:
