@@ -480,6 +480,17 @@ def test_huge_images_refused(size: list[str], tmp_path) -> None:
 
 # ------------------------------------------------------------------ signals
 
+def _signal_and_check(proc, sig: int, err_path: Path, out: Path) -> None:
+    """Send ``sig``; the CLI must exit 128 + sig with its one line and leave ``out`` empty."""
+    proc.send_signal(sig)
+    proc.wait(timeout=30)
+    text = err_path.read_text()
+    assert proc.returncode == 128 + sig, text
+    assert _last_line(text) == f"pyjulia4d: terminated by {signal.Signals(sig).name}", text
+    assert "Traceback" not in text
+    assert list(out.iterdir()) == []
+
+
 def _default_signals() -> None:
     """In the child: SIGTERM and SIGHUP at their default action, as a terminal gives them.
     A suite run under nohup (or a CI runner that ignores SIGHUP) would otherwise hand the
@@ -533,17 +544,11 @@ def test_signal_during_a_real_render(sig: int, tmp_path) -> None:
         # for a second
         assert _wait_for(lambda: b"\r" in err_path.read_bytes(), 60), err_path.read_text()
         assert proc.poll() is None, "the render finished before the signal"
-        proc.send_signal(sig)
-        proc.wait(timeout=30)
+        _signal_and_check(proc, sig, err_path, out)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-    text = err_path.read_text()
-    assert proc.returncode == 128 + sig, text
-    assert _last_line(text) == f"pyjulia4d: terminated by {signal.Signals(sig).name}", text
-    assert "Traceback" not in text
-    assert list(out.iterdir()) == []
 
 
 # A CLI whose render is a stand-in and whose PNG writer pauses once the temp file holds the
@@ -607,14 +612,8 @@ def test_signal_during_the_write(sig: int, phase: str, tmp_path) -> None:
         if phase == "write":  # the write itself is under way: its temp file is there
             [tmp] = list(out.iterdir())
             assert tmp.name.startswith(".julia.") and tmp.suffix == ".png" and tmp.stat().st_size > 0
-        proc.send_signal(sig)
-        proc.wait(timeout=30)
+        _signal_and_check(proc, sig, err_path, out)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-    text = err_path.read_text()
-    assert proc.returncode == 128 + sig, text
-    assert _last_line(text) == f"pyjulia4d: terminated by {signal.Signals(sig).name}", text
-    assert "Traceback" not in text
-    assert list(out.iterdir()) == []
