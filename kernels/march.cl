@@ -5,7 +5,7 @@
  * guard flags (real.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (refine.cl), +inf where nothing was hit. */
 
-__kernel void march(__global const real4 *origins, __global const real4 *dirs,
+__kernel void march(const int n_items, __global const real4 *origins, __global const real4 *dirs,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
@@ -14,6 +14,8 @@ __kernel void march(__global const real4 *origins, __global const real4 *dirs,
                     __global real *bracket)
 {
     size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)   /* launches are padded to whole work-groups (render.launch) */
+        return;
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
     real4 o = origins[i];
     real4 d = dirs[i];

@@ -17,12 +17,14 @@ inline real4 normal_gradient(real4 p, julia_params jp, real h, real4 right, real
                    de_field(p - h * forward, jp) - de_field(p + h * forward, jp), 0);
 }
 
-__kernel void normals_gradient(__global const real4 *point, __global const int *status,
+__kernel void normals_gradient(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real h, const real4 right, const real4 up,
                                const real4 forward, __global real4 *normal)
 {
     size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
     if (status[i] != STATUS_HIT) {
         normal[i] = (real4)(0);
         return;

@@ -56,12 +56,14 @@ inline real4 to_camera_unit(real4 g, real4 right, real4 up, real4 forward, int *
     return (real4)(0, 0, 1, 0);
 }
 
-__kernel void normals_jacobian(__global const real4 *point, __global const int *status,
+__kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real4 right, const real4 up, const real4 forward,
                                __global real4 *normal)
 {
     size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
     if (status[i] != STATUS_HIT) {
         normal[i] = (real4)(0);
         return;

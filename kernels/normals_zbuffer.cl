@@ -39,14 +39,16 @@ inline real3 zb_tangent(__global const real4 *point, __global const real *depth,
     return axis;
 }
 
-__kernel void normals_zbuffer(__global const real4 *point, __global const real *depth,
+__kernel void normals_zbuffer(const int n_items, __global const real4 *point, __global const real *depth,
                               __global const int *status, const int width, const int height,
                               const real4 eye, const real4 right, const real4 up,
                               const real4 forward, __global real4 *normal)
 {
-    int x = get_global_id(0);
-    int y = get_global_id(1);
-    size_t i = (size_t)y * width + x;
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    int x = (int)(i % (size_t)width);
+    int y = (int)(i / (size_t)width);
     if (status[i] != STATUS_HIT) {
         normal[i] = (real4)(0);
         return;

@@ -5,18 +5,20 @@
  * with y = 0 at the top row.  Every ray starts at the camera position.  A launch covers
  * one tile of the image (render.py renders any size in tiles of bounded memory). */
 
-__kernel void generate_rays(const real4 position, const real4 forward, const real4 right,
+__kernel void generate_rays(const int n_items, const real4 position, const real4 forward, const real4 right,
                             const real4 up, const real tan_half_fov, const int width,
-                            const int height, const int x0, const int y0,
+                            const int height, const int x0, const int y0, const int tile_w,
                             __global real4 *origins, __global real4 *dirs)
 {
-    /* one tile of tw x th pixels (the launch size) whose top-left pixel is (x0, y0) */
-    int x = x0 + get_global_id(0);
-    int y = y0 + get_global_id(1);
+    /* one tile of tile_w x (n_items / tile_w) pixels whose top-left pixel is (x0, y0) */
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    int x = x0 + (int)(i % (size_t)tile_w);
+    int y = y0 + (int)(i / (size_t)tile_w);
     real aspect = (real)width / (real)height;
     real u = ((real)2 * ((real)x + (real)0.5) / (real)width - (real)1) * tan_half_fov * aspect;
     real v = ((real)1 - (real)2 * ((real)y + (real)0.5) / (real)height) * tan_half_fov;
-    size_t i = get_global_id(1) * get_global_size(0) + get_global_id(0);
     origins[i] = position;
     dirs[i] = normalize(forward + u * right + v * up);
 }

@@ -4,7 +4,7 @@
  *     rgb = light_color (color (ambient + diffuse max(n.l, 0)) + specular max(n.h, 0)^shininess)
  * All vectors in camera coordinates; output is float RGBA whatever the precision. */
 
-__kernel void shade(__global const int *status, __global const real4 *normal,
+__kernel void shade(const int n_items, __global const int *status, __global const real4 *normal,
                     __global const real4 *point, const real4 eye, const real4 right,
                     const real4 up, const real4 forward, const real4 light_pos,
                     const float4 color, const float4 background, const float4 light_color,
@@ -12,6 +12,8 @@ __kernel void shade(__global const int *status, __global const real4 *normal,
                     const float shininess, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
     if (status[i] != STATUS_HIT) {
         rgba[i] = (float4)(background.xyz, 0.0f);
         return;

@@ -9,7 +9,7 @@ import pyopencl.array as cla
 
 from pyjulia4d import build
 from pyjulia4d.devices import select_device
-from pyjulia4d.render import queue_for
+from pyjulia4d.render import launch, queue_for
 
 
 def device():
@@ -51,6 +51,9 @@ class Runner:
         return a.get().view(self.real).reshape(-1, 4).astype(np.float64)
 
     def __call__(self, name, size, *args):
+        """Run kernel ``name`` over ``size`` = (n,) items the way render.py does
+        (render.launch: padded work-groups, n passed first)."""
         conv = [a.data if isinstance(a, cla.Array) else a for a in args]
-        cl.Kernel(self.prg, name)(self.queue, size, None, *conv)
+        (n,) = size
+        launch(self.queue, cl.Kernel(self.prg, name), n, *conv)
         self.queue.finish()

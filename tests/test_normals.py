@@ -49,7 +49,7 @@ def test_normals_match_reference(method, fl, c):
           vec(fr.forward), out)
         want = ref.normals_gradient(point, status, f.c, f.max_iter, f.bailout, h, fr)
     else:
-        R("normals_zbuffer", (W, H), R.buf4(point), R.buf(depth), R.buf(status, np.int32),
+        R("normals_zbuffer", (W * H,), R.buf4(point), R.buf(depth), R.buf(status, np.int32),
           np.int32(W), np.int32(H), vec(fr.position), vec(fr.right), vec(fr.up), vec(fr.forward), out)
         with np.errstate(invalid="ignore"):
             want = ref.normals_zbuffer(point, depth, status, W, H, fr)
