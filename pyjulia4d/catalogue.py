@@ -1,4 +1,4 @@
-"""A named catalogue of extreme cases (issue 4): the places where quaternion Julia
+"""A named catalogue of extreme cases: the places where quaternion Julia
 rendering is known to break, each with what it stresses, what pyjulia4d must do,
 and how close the float32 render must come to the float64 one.
 

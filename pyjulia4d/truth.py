@@ -1,4 +1,4 @@
-"""Ground truth for the accuracy benchmark (issue 3): depth and normals that do
+"""Ground truth for the accuracy benchmark: depth and normals that do
 not come from the marching method under test.
 
 Three oracles, from exact to merely converged:
