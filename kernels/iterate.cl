@@ -8,10 +8,13 @@ inline int julia_inside(real4 p, julia_params jp)
 {
     real4 q = p;
     for (int n = 0; n < jp.max_iter; ++n) {
-        if (dot(q, q) > jp.bailout2)
+        if (dot(q, q) > jp.bailout2) {
+            COUNT_ITER(jp, n);
             return 0;
+        }
         q = julia_f(q, jp.c);
     }
+    COUNT_ITER(jp, jp.max_iter);
     return dot(q, q) <= jp.bailout2;
 }
 
@@ -31,6 +34,7 @@ inline real julia_level(real4 p, julia_params jp, int *inside)
         q = julia_f(q, jp.c);
         m2 = dot(q, q);
     }
+    COUNT_ITER(jp, n);
     *inside = m2 <= jp.bailout2;
     if (*inside)
         return m2 / jp.bailout2 - (real)1;
@@ -67,6 +71,7 @@ inline real julia_distance_formula(real4 p, julia_params jp, int *escaped)
         q = julia_f(q, jp.c);
         m2 = dot(q, q);
     }
+    COUNT_ITER(jp, n);
     *escaped = m2 > jp.bailout2;
     /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
     real mq = fmax(m2, REAL_MIN);

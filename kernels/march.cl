@@ -11,12 +11,12 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
                     __global int *status, __global int *samples, __global int *flags,
-                    __global real *bracket)
+                    __global real *bracket COUNTER_ARG)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)   /* launches are padded to whole work-groups (render.launch) */
         return;
-    julia_params jp = { c, bailout * bailout, epsilon, max_iter };
+    julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i) };
     real4 o = origins[i];
     real4 d = dirs[i];
 

@@ -22,7 +22,22 @@ typedef struct {
     real bailout2;   /* escape radius squared */
     real epsilon;    /* distance-estimate hit threshold */
     int max_iter;
+#ifdef COUNT_ITERATIONS
+    __global int *count;   /* this ray's iterations of f (benchmarks/throughput.py); 0: none */
+#endif
 } julia_params;
+
+/* -D COUNT_ITERATIONS (benchmarks only): the march counts every iteration of f its set
+ * tests make, per ray, through an extra kernel argument; otherwise these are empty. */
+#ifdef COUNT_ITERATIONS
+#define COUNT_ITER(jp, n) do { if ((jp).count) *(jp).count += (n); } while (0)
+#define COUNTER_ARG , __global int *iter_count
+#define COUNTER_INIT(i) , iter_count + (i)
+#else
+#define COUNT_ITER(jp, n)
+#define COUNTER_ARG
+#define COUNTER_INIT(i)
+#endif
 
 /* Pixel status codes written by the march kernel (mirrored in reference.py). */
 #define STATUS_MISS 0

@@ -75,3 +75,31 @@ def test_preset_check_runs(tmp_path):
         assert float(r["bracket_p99"]) >= 0 and int(r["stepped_over"]) >= 0
     md = (tmp_path / "preset_check.md").read_text()
     assert "commit: `" in md and "| quality | stated p99 |" in md and "| 2027_s01_dust |" in md
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_iteration_counter_counts_exactly():
+    """benchmarks/throughput.py's -D COUNT_ITERATIONS build: with the eye inside the c = 0
+    set every ray's first set test is inside, after exactly max_iter iterations of f."""
+    from harness import device
+    from pyjulia4d.scene import Scene
+
+    tp = load("throughput")
+    s = Scene.default().with_overrides(["fractal.c=0,0,0,0", "fractal.max_iter=37", "march.method=fixed",
+                                        "march.post_steps=0", "camera.position=0.1,0.1,0.1,0",
+                                        "image.width=9", "image.height=7"])
+    r = tp.march_throughput(s, device(), repeats=1)
+    assert r["iterations"] == 9 * 7 * 37 and r["hit"] == 1.0
+
+
+def test_throughput_report_runs(tmp_path):
+    tp = load("throughput")
+    assert tp.main(["--size", "16x12", "--repeats", "1", "--widths", "1,4", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "throughput.md").read_text()
+    assert "| single | float4 |" in md and "iterations/s" in md and "commit" in md
