@@ -1,0 +1,82 @@
+"""Render time and peak memory against image size, the default scene.
+
+Each size runs in its own child process (so its peak resident memory, ru_maxrss, is its
+own): a warm-up render at 64x48 builds the program, then one render at the size, timed,
+every output kept.  Reports
+pixels per second and peak memory per pixel above the warm process's baseline.
+
+Writes benchmarks/results/scaling.md (appends a section per run: device, date, commit).
+
+    python benchmarks/scaling.py [--sizes 160x120,640x480,1920x1080,3840x2160] [--set KEY=VALUE ...]
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+CHILD = r"""
+import json, resource, sys, time, warnings
+warnings.simplefilter("ignore")
+from pyjulia4d import Scene, render
+w, h = (int(x) for x in sys.argv[1].split("x"))
+over = sys.argv[2:]
+render(Scene.default().with_overrides(over + ["image.width=64", "image.height=48"]))
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+t = time.perf_counter()
+r = render(Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}"]))
+sec = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(json.dumps({"seconds": sec, "kernel_seconds": r.kernel_seconds, "peak": peak, "base": base,
+                  "device": r.device_name, "hit": r.hit_fraction}))
+"""
+
+
+def git_head() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", default="160x120,320x240,640x480,1280x960,1920x1080,3840x2160")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    a = ap.parse_args(argv)
+    rows, device = [], "?"
+    for size in a.sizes.split(","):
+        p = subprocess.run([sys.executable, "-c", CHILD, size, *a.set], capture_output=True, text=True,
+                           cwd=ROOT, timeout=3600)
+        if p.returncode != 0:
+            print(f"{size}: failed: {(p.stderr.strip().splitlines() or ['?'])[-1]}", file=sys.stderr)
+            return 1
+        r = json.loads(p.stdout)
+        device = r["device"]
+        w, h = (int(x) for x in size.split("x"))
+        px = w * h
+        extra = max(r["peak"] - r["base"], 0)
+        rows.append(f"| {size} | {px:,} | {r['seconds']:.3f} | {r['kernel_seconds']:.3f} | {px / r['seconds']:.3g} | "
+                    f"{r['peak'] / 2**20:.0f} | {extra / px:.0f} | {100 * r['hit']:.1f} % |")
+        print(rows[-1], flush=True)
+    head = (f"\n## {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M} UTC, {device}, commit {git_head()}"
+            f"{', ' + ' '.join(a.set) if a.set else ''}\n\n"
+            "| size | pixels | render s | kernels s | pixels/s | peak RSS MiB | bytes/pixel above the warm process | hit |\n"
+            "|---|---|---|---|---|---|---|---|\n")
+    a.out.mkdir(parents=True, exist_ok=True)
+    md = a.out / "scaling.md"
+    title = "# Render time and peak memory against image size\n\nWritten by `python benchmarks/scaling.py`.\n"
+    md.write_text((md.read_text() if md.exists() else title) + head + "\n".join(rows) + "\n")
+    print(f"wrote {md}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
