@@ -103,3 +103,14 @@ def test_throughput_report_runs(tmp_path):
     assert tp.main(["--size", "16x12", "--repeats", "1", "--widths", "1,4", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "throughput.md").read_text()
     assert "| single | float4 |" in md and "iterations/s" in md and "commit" in md
+
+
+def test_peers_report_runs(tmp_path):
+    """benchmarks/peers.py, tiny: POV-Ray where installed (skipped with a message otherwise),
+    pyjulia4d always; the POV-Ray scene is the default scene."""
+    peers = load("peers")
+    src = peers.pov_scene(16, 12)
+    assert "<-0.2, 0.8, 0.0, 0.0>" in src and "max_iteration 12" in src and "location <1.8, 1.6, -2.2>" in src
+    assert peers.main(["--size", "16x12", "--repeats", "1", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "peers.md").read_text()
+    assert "| pyjulia4d default |" in md and "pixels per CPU-second" in md
