@@ -137,7 +137,8 @@ def main(argv=None) -> int:
                 runs.setdefault(name, []).append(r)
     px = w * h
     pov = runs.get("POV-Ray 3.7 julia_fractal (precision 20)")
-    pov_rate = px / statistics.median(r["cpu"] for r in pov) if pov else None
+    pov_cpu = statistics.median(r["cpu"] for r in pov) if pov else 0.0
+    pov_rate = px / pov_cpu if pov_cpu > 0 else None   # a tiny image can report 0.000 s
     lines = [f"\n## {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M} UTC, {w}x{h}, pyjulia4d on {device}, "
              f"commit {git_head()}, median of {a.repeats} alternating runs\n",
              "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pixels hit |", "|---|---|---|---|---|"]
