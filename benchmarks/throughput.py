@@ -3,8 +3,9 @@
 For each scene and precision it counts the iterations of f = q^2 + c that the march's set
 tests make - the same kernel source built with -D COUNT_ITERATIONS, which adds a per-ray
 counter (kernels/real.cl), summed on the host - and times the march kernel alone in the
-normal build (median of --repeats after a warm-up launch, rays made once).  Iterations
-per second = counted iterations / march seconds.
+normal build (median of --repeats after a warm-up launch, rays made once), one ray per
+work-item and in packets (the width pyjulia4d.lanes probes for the device, single
+precision).  Iterations per second = counted iterations / march seconds.
 
 The peak: a kernel of independent FMA chains (8 chains of 512 dependent fma's per
 work-item) on float, float4, float8 and float16 (double likewise), each width in a child
@@ -42,6 +43,7 @@ import pyopencl.array as cla  # noqa: E402
 from pyjulia4d import build  # noqa: E402
 from pyjulia4d.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
+from pyjulia4d.lanes import lanes_for  # noqa: E402
 from pyjulia4d.render import Precision, launch, queue_for  # noqa: E402
 from pyjulia4d.scene import Scene  # noqa: E402
 
@@ -123,8 +125,10 @@ def fma_peak(spec: str | None, width: int, double: bool) -> dict:
     return json.loads(p.stdout)
 
 
-def march_throughput(scene: Scene, dev, repeats: int) -> dict:
-    """Counted iterations of f in the march, the march kernel's median time, and their ratio."""
+def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1) -> dict:
+    """Counted iterations of f in the march (one ray per work-item: the count is the
+    algorithm's, whatever the variant), the march kernel's median time with ``lanes`` rays
+    per work-item, and their ratio."""
     ctx, queue = queue_for(dev)
     pr = Precision(scene.render.float == "double")
     cfg = build.scene_config(scene)
@@ -145,15 +149,16 @@ def march_throughput(scene: Scene, dev, repeats: int) -> dict:
             np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps), depth.data,
             point.data, status.data, samples.data, flags.data, bracket.data)
     prg = build.program(ctx, cfg)
+    mprg = prg if lanes == 1 else build.program(ctx, build.march_config(scene, lanes))
     launch(queue, cl.Kernel(prg, "generate_rays"), n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
            np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), origins.data, dirs.data)
-    march = cl.Kernel(prg, "march")
-    launch(queue, march, n, *args)  # warm-up: PoCL's first launch specialises the work-group function
+    march = cl.Kernel(mprg, "march")
+    launch(queue, march, n, *args, lanes=lanes)  # warm-up: PoCL specialises the work-group function
     queue.finish()
     ts = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        launch(queue, march, n, *args)
+        launch(queue, march, n, *args, lanes=lanes)
         queue.finish()
         ts.append(time.perf_counter() - t0)
     launch(queue, cl.Kernel(build.program(ctx, counted), "march"), n, *args, counts.data)
@@ -195,18 +200,20 @@ def main(argv=None) -> int:
             if r["flops"] == r["flops"]:
                 peak[prec] = max(peak.get(prec, 0.0), r["flops"])
             print(lines[-1], flush=True)
-    lines += ["", "| scene | precision | iterations of f in the march | march kernel s (median) | "
-              "iterations/s | share of the FMA peak (20 flops each) | pixels hit |",
-              "|---|---|---|---|---|---|---|"]
+    lines += ["", "| scene | precision | rays per work-item | iterations of f in the march | "
+              "march kernel s (median) | iterations/s | share of the FMA peak (20 flops each) | "
+              "pixels hit |", "|---|---|---|---|---|---|---|---|"]
+    auto = lanes_for(dev, "packet", False)
     for name, over in SCENES.items():
         for prec in ("single", "double"):
             s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",
                                                        f"render.float={prec}"])
-            r = march_throughput(s, dev, a.repeats)
-            share = r["its"] * FLOPS_PER_ITERATION / peak[prec] if prec in peak else float("nan")
-            lines.append(f"| {name} | {prec} | {r['iterations']:.4g} | {r['seconds']:.4f} | {r['its']:.3g} | "
-                         f"{100 * share:.1f} % | {100 * r['hit']:.1f} % |")
-            print(lines[-1], flush=True)
+            for lanes in sorted({1, auto if prec == "single" else 1}):
+                r = march_throughput(s, dev, a.repeats, lanes)
+                share = r["its"] * FLOPS_PER_ITERATION / peak[prec] if prec in peak else float("nan")
+                lines.append(f"| {name} | {prec} | {lanes} | {r['iterations']:.4g} | {r['seconds']:.4f} | "
+                             f"{r['its']:.3g} | {100 * share:.1f} % | {100 * r['hit']:.1f} % |")
+                print(lines[-1], flush=True)
     a.out.mkdir(parents=True, exist_ok=True)
     md = a.out / "throughput.md"
     head = ("# Iterations per second inside the march\n\nWritten by `python benchmarks/throughput.py` "

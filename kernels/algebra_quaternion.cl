@@ -10,11 +10,12 @@ inline real4 alg_mul(real4 a, real4 b)
                    a.x * b.w + a.y * b.z - a.z * b.y + a.w * b.x);
 }
 
-/* q^2 = (q1^2 - q2^2 - q3^2 - q4^2, 2 q1 q2, 2 q1 q3, 2 q1 q4)  (seed 000, eq. 4). */
-inline real4 alg_sqr(real4 q)
+/* q^2 = (q1^2 - q2^2 - q3^2 - q4^2, 2 q1 q2, 2 q1 q3, 2 q1 q4)  (seed 000, eq. 4), on a
+ * lane type (real.cl): one ray or a packet of rays. */
+inline quat alg_sqr(quat q)
 {
-    return (real4)(q.x * q.x - q.y * q.y - q.z * q.z - q.w * q.w,
-                   (real)2 * q.x * q.y, (real)2 * q.x * q.z, (real)2 * q.x * q.w);
+    return QUAT(q.x * q.x - q.y * q.y - q.z * q.z - q.w * q.w,
+                (real)2 * q.x * q.y, (real)2 * q.x * q.z, (real)2 * q.x * q.w);
 }
 
 /* Directional derivative of q -> q^2 along h: q h + h q = 2 (q1 h1 - v.hv, q1 hv + h1 v);

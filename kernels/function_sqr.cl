@@ -6,7 +6,7 @@
  *                      derivative of the distance estimate: |q'_{n+1}| = 2 |q_n| |q'_n|
  *                      because the quaternion norm is multiplicative. */
 
-inline real4 julia_f(real4 q, real4 c) { return alg_sqr(q) + c; }
+inline quat julia_f(quat q, real4 c) { return QADD_UNIFORM(alg_sqr(q), c); }
 
 inline real4 julia_f_jvp(real4 q, real4 h) { return alg_sqr_jvp(q, h); }
 

@@ -1,21 +1,21 @@
-/* iterate.cl: the escape-time iteration and the distance estimate.
+/* iterate.cl: the escape-time iteration and the distance estimate, on a lane type
+ * (real.cl: one ray, or a packet of rays whose finished lanes are frozen).
  *
  * A point p is inside when |q_n| <= bailout for n = 0 .. max_iter, with q_0 = p and
  * q_{n+1} = f(q_n) (seed 003: "none of the vectors in the sequence escapes";
  * seed 000 §2.1, eq. 5). */
 
-inline int julia_inside(real4 p, julia_params jp)
+inline lmask julia_inside(quat p, julia_params jp)
 {
-    real4 q = p;
-    for (int n = 0; n < jp.max_iter; ++n) {
-        if (dot(q, q) > jp.bailout2) {
-            COUNT_ITER(jp, n);
-            return 0;
-        }
-        q = julia_f(q, jp.c);
+    quat q = p;
+    lmask live = QNORM2(q) <= jp.bailout2;
+    int n = 0;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        q = QSEL(q, julia_f(q, jp.c), live);
+        live = QNORM2(q) <= jp.bailout2;
     }
-    COUNT_ITER(jp, jp.max_iter);
-    return dot(q, q) <= jp.bailout2;
+    COUNT_ITER(jp, n);
+    return live;
 }
 
 /* The level function of the truncated set (refine.cl): F = |q_N|^2 / bailout^2 - 1 at
@@ -25,25 +25,25 @@ inline int julia_inside(real4 p, julia_params jp)
  * point (seed 002_6b6c8e6b1cd19649.txt).  An orbit that escapes at n < N is not iterated
  * on (it would overflow); |q_N|^2 is extrapolated as (|q_n|^2)^(2^(N-n)), the growth of
  * q^2 for large q, and capped at 1e30: only the interpolation uses the value. */
-inline real julia_level(real4 p, julia_params jp, int *inside)
+inline lreal julia_level(quat p, julia_params jp, lmask *inside)
 {
-    real4 q = p;
-    real m2 = dot(q, q);
+    quat q = p;
+    lreal m2 = QNORM2(q);
+    lmask live = m2 <= jp.bailout2;
+    lmask steps = 0;                /* iterations done, per lane */
     int n = 0;
-    for (; n < jp.max_iter && m2 <= jp.bailout2; ++n) {
-        q = julia_f(q, jp.c);
-        m2 = dot(q, q);
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        q = QSEL(q, julia_f(q, jp.c), live);
+        m2 = QNORM2(q);
+        steps = L_SEL(steps, steps + 1, live);
+        live = m2 <= jp.bailout2;
     }
     COUNT_ITER(jp, n);
     *inside = m2 <= jp.bailout2;
-    if (*inside)
-        return m2 / jp.bailout2 - (real)1;
-    int k = jp.max_iter - n;
-    real l = log(m2 / jp.bailout2);
-    if (k > 60)
-        return (real)1e30;
-    real e = ldexp(l, k);
-    return e > (real)69 ? (real)1e30 : expm1(e);
+    lmask k = jp.max_iter - steps;
+    lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
+    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
+    return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
 }
 
 /* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (seed 001 §3.1, eq. 8)
@@ -52,39 +52,40 @@ inline real julia_level(real4 p, julia_params jp, int *inside)
  * d = sqrt(m2 / dm2) ln(m2) / 4.  Where |q'| would overflow, it is carried as a
  * mantissa times 2^e (ldexp), so the estimate stays finite at any max_iter.
  * Sets *escaped.  This is the smooth field the gradient normal differentiates. */
-inline real julia_distance_formula(real4 p, julia_params jp, int *escaped)
+inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
-    real4 q = p;
-    real m2 = dot(q, q);
-    real dm2 = (real)1;
-    int e = 0;                      /* dm2 is really dm2 * 2^e */
+    quat q = p;
+    lreal m2 = QNORM2(q);
+    lreal dm2 = (lreal)1;
+    lmask e = 0;                    /* dm2 is really dm2 * 2^e */
+    lmask live = m2 <= jp.bailout2;
     int n = 0;
-    for (; n < jp.max_iter; ++n) {
-        if (m2 > jp.bailout2)
-            break;
-        dm2 *= JULIA_DF2(m2);
-        if (dm2 > (real)1e16) {     /* rescale long before float32 overflows (3e38) */
-            int k;
-            dm2 = frexp(dm2, &k);
-            e += k;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        dm2 = L_SEL(dm2, dm2 * JULIA_DF2(m2), live);
+        lmask big = live & (dm2 > (real)1e16);
+        if (L_ANY(big)) {           /* rescale long before float32 overflows (3e38) */
+            lmask k;
+            lreal mant = frexp(dm2, &k);
+            dm2 = L_SEL(dm2, mant, big);
+            e = L_SEL(e, e + k, big);
         }
-        q = julia_f(q, jp.c);
-        m2 = dot(q, q);
+        q = QSEL(q, julia_f(q, jp.c), live);
+        m2 = QNORM2(q);
+        live = m2 <= jp.bailout2;
     }
     COUNT_ITER(jp, n);
     *escaped = m2 > jp.bailout2;
     /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
-    real mq = fmax(m2, REAL_MIN);
-    real ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
-    if (e & 1)
-        ratio *= (real)0.70710678118654752;
+    lreal mq = fmax(m2, REAL_MIN);
+    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
+    ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
     return ratio * log(mq) / ((real)2 * JULIA_DEGREE);
 }
 
 /* The distance estimate the march steps by: 0 inside (the point never escaped). */
-inline real julia_distance(real4 p, julia_params jp)
+inline lreal julia_distance(quat p, julia_params jp)
 {
-    int escaped;
-    real d = julia_distance_formula(p, jp, &escaped);
-    return escaped ? d : (real)0;
+    lmask escaped;
+    lreal d = julia_distance_formula(p, jp, &escaped);
+    return L_SEL((lreal)0, d, escaped);
 }

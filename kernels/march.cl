@@ -1,4 +1,4 @@
-/* march.cl: the march kernel, one ray per work-item.  The ray o + t d (|d| = 1)
+/* march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  The ray o + t d (|d| = 1)
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
@@ -13,12 +13,29 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
                     __global int *status, __global int *samples, __global int *flags,
                     __global real *bracket COUNTER_ARG)
 {
-    size_t i = get_global_id(0);
-    if (i >= (size_t)n_items)   /* launches are padded to whole work-groups (render.launch) */
+    /* LANES neighbouring rays per work-item (real.cl); launches are padded to whole
+     * work-groups (render.launch) and the last packet may be partly past n_items */
+    size_t i0 = get_global_id(0) * LANES;
+    if (i0 >= (size_t)n_items)
         return;
-    julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i) };
-    real4 o = origins[i];
-    real4 d = dirs[i];
+    julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i0) };
+    quat o, d;
+    lmask valid;
+#if LANES == 1
+    o = origins[i0];
+    d = dirs[i0];
+    valid = 1;
+#else
+    for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
+        size_t i = min(i0 + k, (size_t)n_items - 1);    /* a tail lane repeats the last ray */
+        real4 ok = origins[i], dk = dirs[i];
+        ((real *)&o.x)[k] = ok.x; ((real *)&o.y)[k] = ok.y;
+        ((real *)&o.z)[k] = ok.z; ((real *)&o.w)[k] = ok.w;
+        ((real *)&d.x)[k] = dk.x; ((real *)&d.y)[k] = dk.y;
+        ((real *)&d.z)[k] = dk.z; ((real *)&d.w)[k] = dk.w;
+        ((int *)&valid)[k] = i0 + k < (size_t)n_items ? -1 : 0;
+    }
+#endif
 
     /* |o + t d|^2 = radius^2  ->  t = -b -+ sqrt(b^2 - (|o|^2 - radius^2)).  The
      * discriminant is taken as radius^2 - |o - b d|^2 (the squared distance of the
@@ -26,27 +43,40 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
      * catastrophically: b^2 - |o|^2 loses everything in float32 for a camera 1e4 away
      * (ulp(1e8) = 8 > radius^2), which threw near/far off by ~1 (extreme case
      * camera_far). */
-    real b = dot(o, d);
-    real4 perp = o - b * d;
-    real disc = radius * radius - dot(perp, perp);
-    int st = STATUS_MISS;
-    int n = 0;
-    int fl = 0;
-    real t = INFINITY;
-    real width = INFINITY;
-    if (disc >= (real)0) {
-        real s = sqrt(disc);
-        real near = fmax(-b - s, (real)0);
-        real far = -b + s;
-        if (near_set >= (real)0) near = near_set;
-        if (far_set >= (real)0) far = far_set;
-        if (far >= near)
-            t = march_ray(o, d, near, far, jp, z_resolution, post_steps, max_steps, &st, &n, &fl, &width);
+    lreal b = QDOT(o, d);
+    quat perp = QRAY(o, d, -b);
+    lreal disc = radius * radius - QNORM2(perp);
+    lreal s = sqrt(fmax(disc, (real)0));
+    lreal near = fmax(-b - s, (real)0);
+    lreal far = -b + s;
+    if (near_set >= (real)0) near = (lreal)near_set;
+    if (far_set >= (real)0) far = (lreal)far_set;
+    lmask live = valid & (disc >= (real)0) & (far >= near);
+    lmask st = STATUS_MISS, n = 0, fl = 0;
+    lreal t = INFINITY, width = INFINITY;
+    if (L_ANY(live))
+        t = march_ray(o, d, near, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
+                      &width);
+#if LANES == 1
+    depth[i0] = t;
+    point[i0] = st == STATUS_HIT ? o + t * d : (real4)(NAN);
+    status[i0] = st;
+    samples[i0] = n;
+    flags[i0] = fl;
+    bracket[i0] = st == STATUS_HIT ? width : INFINITY;
+#else
+    for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
+        size_t i = i0 + k;
+        real tk = ((real *)&t)[k];
+        int sk = ((int *)&st)[k];
+        real4 ok = (real4)(((real *)&o.x)[k], ((real *)&o.y)[k], ((real *)&o.z)[k], ((real *)&o.w)[k]);
+        real4 dk = (real4)(((real *)&d.x)[k], ((real *)&d.y)[k], ((real *)&d.z)[k], ((real *)&d.w)[k]);
+        depth[i] = tk;
+        point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
+        status[i] = sk;
+        samples[i] = ((int *)&n)[k];
+        flags[i] = ((int *)&fl)[k];
+        bracket[i] = sk == STATUS_HIT ? ((real *)&width)[k] : INFINITY;
     }
-    depth[i] = t;
-    point[i] = st == STATUS_HIT ? o + t * d : (real4)(NAN);
-    status[i] = st;
-    samples[i] = n;
-    flags[i] = fl;
-    bracket[i] = st == STATUS_HIT ? width : INFINITY;
+#endif
 }

@@ -1,4 +1,5 @@
-/* march_de.cl: distance-estimate marching (seed 001 §3.2, eq. 9),
+/* march_de.cl: distance-estimate marching (seed 001 §3.2, eq. 9), on a lane type
+ * (real.cl):
  *     r_{n+1} = r_n + max(d(r_n), epsilon),
  * until a point is inside the truncated set (d = 0: its orbit never escaped, the
  * scene's own definition), which with the previous point - outside, since its orbit
@@ -11,48 +12,46 @@
  * that came within epsilon by the estimate but found no inside point before the far end
  * is a miss, flagged GUARD_SHELL_MISS and counted - never a hit at an outside point.
  * The march starts at the bounding sphere (seed 001 §3.4) and is capped at max_steps
- * estimates (STATUS_CAPPED, counted).
+ * estimates (STATUS_CAPPED, counted).  Lanes outside ``live`` are left alone.
  *
  * Precision: where max(d, epsilon) is below half the spacing of t, t + step rounds back
  * to t; the step is then one ulp of t (the next representable t), flagged GUARD_ULP_STEP
  * and counted: the effective epsilon becomes the spacing of t (seed 001 §4.2's epsilon
  * as a function of distance, forced by the number format), and the bracket one ulp. */
 
-inline real march_ray(real4 o, real4 d, real near, real far, julia_params jp,
-                      int z_resolution, int post_steps, int max_steps, int *status, int *samples,
-                      int *flags, real *width)
+inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
+                       int z_resolution, int post_steps, int max_steps, lmask *status,
+                       lmask *samples, lmask *flags, lreal *width)
 {
-    real t = near;
-    real t_prev = near;
-    int shell = 0;                  /* the estimate fell below epsilon somewhere on the ray */
-    for (int i = 0; i < max_steps; ++i) {
-        if (t > far) {
-            *samples = i;
-            *status = STATUS_MISS;
-            if (shell)
-                *flags |= GUARD_SHELL_MISS;
-            return INFINITY;
-        }
-        int escaped;
-        real dist = julia_distance_formula(o + t * d, jp, &escaped);
-        if (!escaped) {
-            *samples = i + 1;
-            *status = STATUS_HIT;
-            if (i == 0) {
-                *width = (real)0;
-                return t;
-            }
-            return refine_bracket(o, d, t_prev, t, post_steps, jp, width);
-        }
-        shell |= dist < jp.epsilon;
-        t_prev = t;
-        t += fmax(dist, jp.epsilon);
-        if (t == t_prev) {          /* the step rounded away: one ulp instead (see above) */
-            t = nextafter(t_prev, (real)INFINITY);
-            *flags |= GUARD_ULP_STEP;
-        }
+    lreal t = near, t_prev = near;
+    lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
+    for (int i = 0; i < max_steps && L_ANY(active); ++i) {
+        lmask out = active & (t > far);
+        *samples = L_SEL(*samples, (lmask)i, out);
+        miss |= out;
+        active &= !out;
+        lmask escaped;
+        lreal dist = julia_distance_formula(QRAY(o, d, t), jp, &escaped);
+        lmask got = active & !escaped;
+        *samples = L_SEL(*samples, (lmask)(i + 1), got);
+        hit |= got;
+        if (i == 0)
+            first = got;
+        active &= !got;
+        shell |= active & (dist < jp.epsilon);
+        lreal next = t + fmax(dist, jp.epsilon);
+        lmask stall = active & (next == t);    /* the step rounded away: one ulp instead */
+        next = L_SEL(next, nextafter(t, (lreal)INFINITY), stall);
+        *flags |= L_SEL((lmask)0, (lmask)GUARD_ULP_STEP, stall);
+        t_prev = L_SEL(t_prev, t, active);
+        t = L_SEL(t, next, active);
     }
-    *samples = max_steps;
-    *status = STATUS_CAPPED;
-    return INFINITY;
+    *samples = L_SEL(*samples, (lmask)max_steps, active);
+    *flags |= L_SEL((lmask)0, (lmask)GUARD_SHELL_MISS, miss & shell);
+    *status = L_SEL(*status, L_SEL(L_SEL((lmask)STATUS_CAPPED, (lmask)STATUS_MISS, miss),
+                                   (lmask)STATUS_HIT, hit), live);
+    lreal w;
+    lreal a = refine_bracket(o, d, t_prev, t, hit & !first, post_steps, jp, &w);
+    *width = L_SEL(*width, L_SEL((lreal)0, w, hit & !first), hit);
+    return L_SEL((lreal)INFINITY, L_SEL(t, a, hit & !first), hit);
 }

@@ -17,19 +17,24 @@ typedef float3 real3;
 #endif
 
 /* The scene's fractal constants, passed by value to every piece. */
+#ifndef LANES
+#define LANES 1      /* rays per work-item (see "Lanes" below) */
+#endif
+
 typedef struct {
     real4 c;         /* Julia constant */
     real bailout2;   /* escape radius squared */
     real epsilon;    /* distance-estimate hit threshold */
     int max_iter;
-#ifdef COUNT_ITERATIONS
+#if defined(COUNT_ITERATIONS) && LANES == 1
     __global int *count;   /* this ray's iterations of f (benchmarks/throughput.py); 0: none */
 #endif
 } julia_params;
 
-/* -D COUNT_ITERATIONS (benchmarks only): the march counts every iteration of f its set
- * tests make, per ray, through an extra kernel argument; otherwise these are empty. */
-#ifdef COUNT_ITERATIONS
+/* -D COUNT_ITERATIONS (benchmarks only; one ray per work-item): the march counts every
+ * iteration of f its set tests make, per ray, through an extra kernel argument; otherwise
+ * these are empty. */
+#if defined(COUNT_ITERATIONS) && LANES == 1
 #define COUNT_ITER(jp, n) do { if ((jp).count) *(jp).count += (n); } while (0)
 #define COUNTER_ARG , __global int *iter_count
 #define COUNTER_INIT(i) , iter_count + (i)
@@ -52,3 +57,48 @@ typedef struct {
 /* The march kernel writes its own flags buffer (same counting on the host). */
 #define GUARD_ULP_STEP 4          /* de: a step below the spacing of t was raised to one ulp */
 #define GUARD_SHELL_MISS 8        /* de: came within epsilon by the estimate, never inside: a miss */
+
+/* Lanes: the per-ray code is written once on these types.  LANES = 1 (the default) is one
+ * ray per work-item, quat = real4 (GPUs, and the normals and shading everywhere); LANES = N
+ * (-D LANES=8, 16) is a packet of N neighbouring rays per work-item in structure-of-arrays
+ * form, quat = four realN, so a CPU runs the N rays in its vector lanes (PoCL does not
+ * vectorise a data-dependent loop across work-items).  A lane mask is what a comparison
+ * gives: 1 / 0 for one lane, -1 / 0 per lane for N; finished lanes are frozen by L_SEL and
+ * loops run while L_ANY lane is live.  Packets are single precision only. */
+#define CAT_(a, b) a##b
+#define CAT(a, b) CAT_(a, b)
+#if LANES == 1
+typedef real lreal;
+typedef int lmask;
+typedef real4 quat;
+#define L_ANY(m) (m)
+#define L_SEL(a, b, m) ((m) ? (b) : (a))
+#define QUAT(a, b, c, d) ((real4)((a), (b), (c), (d)))
+#define QNORM2(q) dot((q), (q))
+#define QADD_UNIFORM(q, v) ((q) + (v))
+#define QSEL(a, b, m) ((m) ? (b) : (a))
+#define QRAY(o, d, t) ((o) + (t) * (d))
+#define QDOT(a, b) dot((a), (b))
+#else
+#ifdef REAL_DOUBLE
+#error "packets of rays are single precision (LANES > 1 with REAL_DOUBLE)"
+#endif
+typedef CAT(float, LANES) lreal;   /* packets are float (checked above) */
+typedef CAT(int, LANES) lmask;
+typedef struct { lreal x, y, z, w; } quat;
+#define L_ANY(m) any(m)
+#define L_SEL(a, b, m) select((a), (b), (m))
+inline quat quat_make(lreal a, lreal b, lreal c, lreal d) { quat q = {a, b, c, d}; return q; }
+#define QUAT(a, b, c, d) quat_make((a), (b), (c), (d))
+inline lreal QNORM2(quat q) { return q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w; }
+inline quat QADD_UNIFORM(quat q, real4 v) { return QUAT(q.x + v.x, q.y + v.y, q.z + v.z, q.w + v.w); }
+inline quat QRAY(quat o, quat d, lreal t)
+{
+    return QUAT(o.x + t * d.x, o.y + t * d.y, o.z + t * d.z, o.w + t * d.w);
+}
+inline lreal QDOT(quat a, quat b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }
+inline quat QSEL(quat a, quat b, lmask m)
+{
+    return QUAT(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m), select(a.w, b.w, m));
+}
+#endif

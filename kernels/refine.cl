@@ -3,6 +3,7 @@
  * definition, iterate.cl), so the surface crossing lies in [a, b].  The march returns
  * the outside end a as the depth and b - a as the bracket width: the crossing lies
  * within the width behind the depth (a thin part stepped over before a is not covered).
+ * On a lane type (real.cl): lanes outside ``todo`` are left as they are.
  *
  * Bisection (-U REFINE_ITP): seed 000_1dc675fe64448cc1.txt §7.1 eq. 11, post-stepping,
  * each step halves the bracket: after n steps its width is h / 2^n (eq. 12).  Unlike the
@@ -18,48 +19,53 @@
  * (and two level evaluations at the ends), usually far fewer; the loop stops there.
  * Both stop early once the bracket cannot be split in the number format. */
 
-inline real refine_bracket(real4 o, real4 d, real a, real b, int steps, julia_params jp,
-                           real *width)
+inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int steps,
+                            julia_params jp, lreal *width)
 {
+    if (!L_ANY(todo)) {             /* nothing bracketed: no set tests at all */
+        *width = b - a;
+        return a;
+    }
 #ifdef REFINE_ITP
-    int inside;
-    real fa = julia_level(o + a * d, jp, &inside);
-    real fb = julia_level(o + b * d, jp, &inside);
+    lmask inside;
+    lreal fa = julia_level(QRAY(o, d, a), jp, &inside);
+    lreal fb = julia_level(QRAY(o, d, b), jp, &inside);
     /* g = -F: g(a) < 0 outside, g(b) >= 0 inside, the orientation ITP is stated in */
-    real ya = -fmax(fa, REAL_MIN), yb = -fmin(fb, (real)0);
-    real w0 = b - a;
-    real eps = ldexp(w0, -(steps + 1));        /* target: b - a <= 2 eps = w0 / 2^steps */
-    real k1 = (real)0.2 / w0;
-    for (int j = 0; j <= steps && b - a > (real)2 * eps; ++j) {
-        real xh = (real)0.5 * (a + b);
-        if (!(xh > a && xh < b))
-            break;                              /* adjacent numbers: nothing left to split */
-        real r = ldexp(eps, steps + 1 - j) - (real)0.5 * (b - a);
-        real delta = k1 * (b - a) * (b - a);
-        real xf = yb != ya ? (yb * a - ya * b) / (yb - ya) : xh;
-        real sigma = xh >= xf ? (real)1 : (real)-1;
-        real xt = delta <= fabs(xh - xf) ? xf + sigma * delta : xh;
-        real x = fabs(xt - xh) <= r ? xt : xh - sigma * r;
-        if (!(x > a && x < b))
-            x = xh;
-        real y = -julia_level(o + x * d, jp, &inside);
-        if (inside) {
-            b = x;
-            yb = fmax(y, (real)0);
-        } else {
-            a = x;
-            ya = fmin(y, -REAL_MIN);
-        }
+    lreal ya = -fmax(fa, REAL_MIN), yb = -fmin(fb, (real)0);
+    lreal w0 = b - a;
+    lreal eps = ldexp(w0, -(steps + 1));       /* target: b - a <= 2 eps = w0 / 2^steps */
+    lreal k1 = (real)0.2 / w0;
+    lmask live = todo & (b - a > (real)2 * eps);
+    for (int j = 0; j <= steps && L_ANY(live); ++j) {
+        lreal xh = (real)0.5 * (a + b);
+        live &= (xh > a) & (xh < b);           /* adjacent numbers: nothing left to split */
+        if (!L_ANY(live))
+            break;
+        lreal r = ldexp(eps, steps + 1 - j) - (real)0.5 * (b - a);
+        lreal delta = k1 * (b - a) * (b - a);
+        lreal xf = L_SEL(xh, (yb * a - ya * b) / (yb - ya), yb != ya);
+        lreal sigma = L_SEL((lreal)-1, (lreal)1, xh >= xf);
+        lreal xt = L_SEL(xh, xf + sigma * delta, delta <= fabs(xh - xf));
+        lreal x = L_SEL(xh - sigma * r, xt, fabs(xt - xh) <= r);
+        x = L_SEL(xh, x, (x > a) & (x < b));
+        lreal y = -julia_level(QRAY(o, d, x), jp, &inside);
+        lmask got_in = live & inside, got_out = live & !inside;
+        b = L_SEL(b, x, got_in);
+        yb = L_SEL(yb, fmax(y, (real)0), got_in);
+        a = L_SEL(a, x, got_out);
+        ya = L_SEL(ya, fmin(y, -REAL_MIN), got_out);
+        live &= b - a > (real)2 * eps;
     }
 #else
-    for (int j = 0; j < steps; ++j) {
-        real m = (real)0.5 * (a + b);
-        if (!(m > a && m < b))
-            break;                              /* adjacent numbers: nothing left to split */
-        if (julia_inside(o + m * d, jp))
-            b = m;
-        else
-            a = m;
+    lmask live = todo;
+    for (int j = 0; j < steps && L_ANY(live); ++j) {
+        lreal m = (real)0.5 * (a + b);
+        live &= (m > a) & (m < b);             /* adjacent numbers: nothing left to split */
+        if (!L_ANY(live))
+            break;
+        lmask got_in = julia_inside(QRAY(o, d, m), jp);
+        b = L_SEL(b, m, live & got_in);
+        a = L_SEL(a, m, live & !got_in);
     }
 #endif
     *width = b - a;

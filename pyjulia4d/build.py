@@ -48,6 +48,15 @@ def scene_config(scene: Scene) -> KernelConfig:
     return KernelConfig(tuple(pieces), tuple(defines))
 
 
+def march_config(scene: Scene, lanes: int) -> KernelConfig:
+    """The march alone with ``lanes`` rays per work-item (-D LANES, kernels/real.cl): the
+    same pieces as scene_config up to march.cl; rays, normals and shading stay one per
+    work-item in the scene's program."""
+    cfg = scene_config(scene)
+    pieces = cfg.pieces[: cfg.pieces.index("march") + 1]
+    return KernelConfig(pieces, cfg.defines + ((f"LANES={lanes}",) if lanes > 1 else ()))
+
+
 def probe_config(scene: Scene) -> KernelConfig:
     """The iteration alone, wrapped for the tests (kernels/probe.cl)."""
     return KernelConfig(iteration_pieces(scene) + ("probe",), precision_defines(scene))

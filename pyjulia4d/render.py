@@ -19,6 +19,7 @@ from tqdm import tqdm
 from . import build, workload
 from .camera import camera_frame, light_position, march_radius
 from .devices import has_fp64, select_device
+from .lanes import lanes_for
 from .scene import Scene, SceneError
 
 STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
@@ -44,6 +45,7 @@ class RenderResult:
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
     kernel_seconds: float = 0.0  # the kernels alone
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
+    lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
 
     @property
     def hit_fraction(self) -> float:
@@ -69,6 +71,7 @@ class RenderResult:
         bracket = " ".join(f"{k}={v:.3g}" for k, v in b.items())
         header = {
             "pyjulia4d.device": self.device_name,
+            "pyjulia4d.rays_per_work_item": str(self.lanes),
             "pyjulia4d.render_seconds": "%.6f" % self.seconds,
             "pyjulia4d.capped_pixels": str(self.capped),
             "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in self.guards.items()),
@@ -189,12 +192,14 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
     return _local[key]
 
 
-def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args) -> None:
-    """Enqueue ``kernel`` over n items: n_items = n first, then ``args``."""
+def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1) -> None:
+    """Enqueue ``kernel`` over n items, ``lanes`` per work-item (the march's packets):
+    n_items = n first, then ``args``."""
     if n <= 0:
         return
     loc = local_size(kernel, queue.device)
-    kernel(queue, (-(-n // loc) * loc,), (loc,), np.int32(n), *args)
+    items = -(-n // lanes)
+    kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
 
 
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
@@ -234,9 +239,11 @@ def tiles(width: int, height: int, tile: int = TILE):
 
 
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
-           force: bool = False, tile: int = TILE) -> RenderResult:
+           force: bool = False, tile: int = TILE, lanes: int | None = None) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
-    ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work)."""
+    ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
+    ``lanes`` (rays per work-item of the march) overrides render.variant's choice
+    (lanes.lanes_for); the tests and the width probe use it."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
     workload.check(scene, dev, force=force)  # before any kernel: hopeless, overflowing or too large
@@ -246,6 +253,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     frame = camera_frame(scene)
     ctx, queue = queue_for(dev)
     prg = build.program(ctx, build.scene_config(scene))
+    if lanes is None:
+        lanes = lanes_for(dev, scene.render.variant, double)
+    march_prg = prg if lanes == 1 else build.program(ctx, build.march_config(scene, lanes))
     pr = Precision(double)
     W, H = scene.image.width, scene.image.height
     f, m, sh = scene.fractal, scene.march, scene.shading
@@ -279,7 +289,8 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
                    np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
     lp = light_position(scene)
     light = pr.v4(lp if lp is not None else frame.position)
-    rays_k, march_k, shade_k = (cl.Kernel(prg, k) for k in ("generate_rays", "march", "shade"))
+    rays_k, shade_k = (cl.Kernel(prg, k) for k in ("generate_rays", "shade"))
+    march_k = cl.Kernel(march_prg, "march")
 
     queue.finish()
     t_kernels = time.perf_counter()
@@ -296,7 +307,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             launch(queue, rays_k, n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov), np.int32(W),
                    np.int32(H), np.int32(ax0), np.int32(ay0), np.int32(aw), origins.data, dirs.data)
             launch(queue, march_k, n, origins.data, dirs.data, *march_const, depth.data, point.data,
-                   status.data, samples.data, flags.data, bracket.data)
+                   status.data, samples.data, flags.data, bracket.data, lanes=lanes)
             launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status,
                            normal, size=(aw, ah))
             launch(queue, shade_k, n, status.data, normal.data, point.data, eye, right, up, fwd, light,
@@ -334,7 +345,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     result = RenderResult(
         color=color, alpha=alpha, depth=depth_img, normal=normal_img, position=position,
         status=status_img, samples=samples_img, bracket=bracket_img,
-        device_name=dev.name.strip(), kernel_seconds=kernel_seconds,
+        device_name=dev.name.strip(), kernel_seconds=kernel_seconds, lanes=lanes,
         guards=count_guards(status_img, depth_img, guard_img))
     result.seconds = time.perf_counter() - t_start
     return result

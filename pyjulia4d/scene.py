@@ -128,6 +128,7 @@ class Render:
     """[render]: device-side settings."""
 
     float: str = "single"
+    variant: str = "auto"
 
 
 # ---------------------------------------------------------------- checkers
@@ -357,6 +358,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
     },
     "render": {
         "float": _Choice("single", "double"),
+        "variant": _Choice("auto", "scalar", "packet"),
     },
 }
 

@@ -1,0 +1,72 @@
+"""One source, two variants (kernels/real.cl, "Lanes"): the march run one ray per
+work-item and in packets of 4, 8 and 16 neighbouring rays must give the same pixels.
+
+Not bit for bit: the packet variant sums |q|^2 as four products where the one-ray variant
+calls dot(), and ITP's interpolation amplifies that last-bit difference into a different
+point inside the same certified bracket.  So: the same status on every pixel but a
+handful, the same sample counts and guard flags there, and brackets that overlap."""
+import json
+
+import numpy as np
+import pytest
+
+from pyjulia4d import lanes as lanes_mod
+from pyjulia4d.render import STATUS_HIT, render
+from pyjulia4d.scene import Scene
+
+SCENES = [
+    [],
+    ["march.method=fixed", "march.post_steps=10", "fractal.c=0.4,0.5,0,0", "fractal.max_iter=20"],
+    ["march.quality=final", "camera.position=-2,1,5,0.8", "camera.limbo=0,0.3,0,1"],
+    ["march.method=de", "march.refine=bisect", "fractal.c=-0.75,0.15,0,0", "fractal.max_iter=20"],
+    ["march.epsilon=1e-8", "march.post_steps=0", "fractal.max_iter=100"],   # ulp steps
+    ["camera.position=0.05,0.1,-0.1,0", "camera.target=0,0,1,0"],           # eye inside
+]
+
+
+@pytest.mark.parametrize("lanes", [4, 8, 16])
+@pytest.mark.parametrize("over", SCENES)
+def test_packets_give_the_same_pixels(over, lanes):
+    # 61 x 37 = 2257 pixels: the last packet is partly past the image
+    s = Scene.default().with_overrides(over + ["image.width=61", "image.height=37"])
+    one, pk = render(s, lanes=1), render(s, lanes=lanes)
+    assert pk.lanes == lanes and one.lanes == 1
+    same = one.status == pk.status
+    assert np.mean(same) >= 0.998
+    assert np.mean(one.samples[same] == pk.samples[same]) >= 0.99
+    assert one.guards == pytest.approx(pk.guards, abs=max(2, 0.002 * s.image.width * s.image.height))
+    hit = (one.status == STATUS_HIT) & (pk.status == STATUS_HIT)
+    a, wa = one.depth[hit].astype(float), one.bracket[hit].astype(float)
+    b, wb = pk.depth[hit].astype(float), pk.bracket[hit].astype(float)
+    slack = 1e-6 * (1 + np.maximum(a, b))
+    overlap = np.maximum(a, b) <= np.minimum(a + wa, b + wb) + slack
+    assert np.mean(overlap) >= 0.995
+    # the normals run one ray per work-item in both: the same depth gives the same normal
+    # (where the depths differ by a few ulp, so may the normals of a max_iter-20 surface)
+    eq = a == b
+    assert np.mean(eq) >= 0.75          # measured 79-100 %
+    np.testing.assert_array_equal(pk.normal[hit][eq], one.normal[hit][eq])
+
+
+def test_variant_choice_and_its_cache(tmp_path, monkeypatch):
+    from harness import device
+
+    dev = device()
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    lanes_mod._memo.clear()
+    assert lanes_mod.lanes_for(dev, "scalar", False) == 1
+    assert lanes_mod.lanes_for(dev, "packet", True) == 1          # packets are float
+    probed = lanes_mod.lanes_for(dev, "packet", False)
+    assert probed in (1,) + lanes_mod.WIDTHS
+    known = json.loads((tmp_path / "lanes.json").read_text())
+    assert known[lanes_mod.device_key(dev)] == probed
+    # cached: no second probe, in this process or the next
+    lanes_mod._memo.clear()
+    monkeypatch.setattr(lanes_mod, "probe", lambda *a, **k: pytest.fail("probed twice"))
+    assert lanes_mod.lanes_for(dev, "packet", False) == probed
+    lanes_mod._memo.clear()
+
+
+def test_scene_variant_key():
+    s = Scene.default().with_overrides(["render.variant=scalar", "image.width=9", "image.height=7"])
+    assert render(s).lanes == 1
