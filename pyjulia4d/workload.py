@@ -24,17 +24,17 @@ from dataclasses import dataclass
 from .camera import camera_frame, march_radius
 from .scene import Scene, SceneError
 
-# Measured set-test throughput, iterations per second.  "CPU": PoCL on the 2-core
-# development machine, measured with render() on c = 0, max_iter 20000, the eye at
-# (0.1, 0.1, 0.1, 0) inside the set, fixed scan, zbuffer normals, 256x128 pixels: every
-# ray's first sample is inside, so each pixel runs exactly max_iter iterations;
-# kernel_seconds 8.9 s single (7.3e7 it/s), 9.9 s double (6.7e7 it/s).
+# Set-test throughput, iterations of f per second, measured by benchmarks/throughput.py
+# (benchmarks/results/throughput.md, commit 19393ea) inside the march of the default scene on
+# the 2-core AMD EPYC development machine with Debian's PoCL: float32 in packets of 16 rays
+# 1.29e9, float64 (one ray per work-item) 1.6e8.  Other CPUs and PyPI's PoCL can be several
+# times slower; the estimate is an upper bound of the work, so the hours are too.
 # "GPU" is NOT measured here (no GPU OpenCL device on the development machine): an
 # assumed 2e10 it/s, a conservative figure for a current discrete GPU (~30 flops per
 # iteration, a few TFLOP/s sustained); fp64 on consumer GPUs can be 32x slower.
 ITERATIONS_PER_SECOND = {
-    ("CPU", "single"): 7.3e7,
-    ("CPU", "double"): 6.7e7,
+    ("CPU", "single"): 1.29e9,
+    ("CPU", "double"): 1.6e8,
     ("GPU", "single"): 2e10,
     ("GPU", "double"): 2e10 / 32,
 }
