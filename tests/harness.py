@@ -17,6 +17,16 @@ def device():
     return select_device(os.environ.get("PYJULIA4D_DEVICE") or None)
 
 
+def packet_widths(widths=(4, 8, 16)):
+    """The packet widths the device under test survives: those up to the width its probe
+    found (pyjulia4d/lanes.py runs the probe in a child process; a width a driver crashes
+    on - PyPI's PoCL on float16 - must never run in the test process itself)."""
+    from pyjulia4d.lanes import lanes_for
+
+    most = lanes_for(device(), "packet", False)
+    return [w for w in widths if w <= most]
+
+
 class Runner:
     """Kernels of one build configuration; arrays in, arrays out."""
 

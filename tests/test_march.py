@@ -3,7 +3,7 @@ identical rays, one ray per work-item and in packets of rays (kernels/real.cl, "
 import numpy as np
 import pytest
 
-from harness import Runner
+from harness import Runner, packet_widths
 from pyjulia4d import build, reference as ref
 from pyjulia4d.camera import camera_frame, march_radius
 from pyjulia4d.scene import Scene
@@ -58,7 +58,7 @@ CASES = [
 def _variants(case):
     # packets of 16 and 8 rays (48x36 = 1728: whole packets; a 7-ray tail at 13 lanes is
     # not a width we build) are single precision only
-    return [1] if "render.float=double" in case else [1, 8, 16]
+    return [1] if "render.float=double" in case else [1] + packet_widths((8, 16))
 
 
 @pytest.mark.parametrize("over,lanes", [(c, n) for c in CASES for n in _variants(c)])

@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from harness import packet_widths
 from pyjulia4d import lanes as lanes_mod
 from pyjulia4d.render import STATUS_HIT, render
 from pyjulia4d.scene import Scene
@@ -24,7 +25,7 @@ SCENES = [
 ]
 
 
-@pytest.mark.parametrize("lanes", [4, 8, 16])
+@pytest.mark.parametrize("lanes", packet_widths())
 @pytest.mark.parametrize("over", SCENES)
 def test_packets_give_the_same_pixels(over, lanes):
     # 61 x 37 = 2257 pixels: the last packet is partly past the image
