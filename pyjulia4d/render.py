@@ -114,18 +114,23 @@ def count_guards(status, depth, guard) -> dict[str, int]:
     with those the normals kernels write into the normal's w."""
     status, guard = (np.asarray(a).ravel() for a in (status, guard))
     hit = status == STATUS_HIT
-    guard = guard.astype(np.int64)
+    guard = guard.astype(np.int32, copy=False)
+
+    def fired(flag, on=None):
+        m = (guard & flag) != 0
+        return int(np.count_nonzero(m if on is None else m & on))
+
     return {
         # de step below the spacing of t raised to one ulp (march_de.cl): effective epsilon = ulp(t)
-        "ulp_step": int(np.sum((guard & GUARD_ULP_STEP) != 0)),
+        "ulp_step": fired(GUARD_ULP_STEP),
         # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
-        "normal_fallback": int(np.sum(hit & ((guard & GUARD_NORMAL_FALLBACK) != 0))),
+        "normal_fallback": fired(GUARD_NORMAL_FALLBACK, hit),
         # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
-        "jacobian_tiny": int(np.sum(hit & ((guard & GUARD_JACOBIAN_TINY) != 0))),
+        "jacobian_tiny": fired(GUARD_JACOBIAN_TINY, hit),
         # de: within epsilon of the set by the estimate, yet no point inside: a miss (march_de.cl)
-        "shell_miss": int(np.sum((guard & GUARD_SHELL_MISS) != 0)),
+        "shell_miss": fired(GUARD_SHELL_MISS),
         # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
-        "eye_hit": int(np.sum(hit & (np.asarray(depth).ravel() == 0))),
+        "eye_hit": int(np.count_nonzero(hit & (np.asarray(depth).ravel() == 0))),
     }
 
 
