@@ -5,7 +5,9 @@ tests make - the same kernel source built with -D COUNT_ITERATIONS, which adds a
 counter (kernels/real.cl), summed on the host - and times the march kernel alone in the
 normal build (median of --repeats after a warm-up launch, rays made once), one ray per
 work-item and in packets (the width pyjulia4d.lanes probes for the device, single
-precision).  Iterations per second = counted iterations / march seconds.
+precision), and in packets of rays shuffled across the image (what divergence costs:
+neighbouring pixels' rays take similar paths, random ones do not).  Iterations per
+second = counted iterations / march seconds.
 
 The peak: a kernel of independent FMA chains (8 chains of 512 dependent fma's per
 work-item) on float, float4, float8 and float16 (double likewise), each width in a child
@@ -125,10 +127,12 @@ def fma_peak(spec: str | None, width: int, double: bool) -> dict:
     return json.loads(p.stdout)
 
 
-def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1) -> dict:
+def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: bool = False) -> dict:
     """Counted iterations of f in the march (one ray per work-item: the count is the
     algorithm's, whatever the variant), the march kernel's median time with ``lanes`` rays
-    per work-item, and their ratio."""
+    per work-item, and their ratio.  ``shuffle`` permutes the rays (seeded), so a packet
+    holds rays from all over the image instead of neighbouring pixels: what divergence
+    costs."""
     ctx, queue = queue_for(dev)
     pr = Precision(scene.render.float == "double")
     cfg = build.scene_config(scene)
@@ -152,6 +156,9 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1) -> dict:
     mprg = prg if lanes == 1 else build.program(ctx, build.march_config(scene, lanes))
     launch(queue, cl.Kernel(prg, "generate_rays"), n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
            np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), origins.data, dirs.data)
+    if shuffle:
+        perm = np.random.default_rng(0).permutation(n)
+        dirs.set(dirs.get()[perm])
     march = cl.Kernel(mprg, "march")
     launch(queue, march, n, *args, lanes=lanes)  # warm-up: PoCL specialises the work-group function
     queue.finish()
@@ -208,10 +215,12 @@ def main(argv=None) -> int:
         for prec in ("single", "double"):
             s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",
                                                        f"render.float={prec}"])
-            for lanes in sorted({1, auto if prec == "single" else 1}):
-                r = march_throughput(s, dev, a.repeats, lanes)
+            runs = [(1, False)] + ([(auto, False), (auto, True)] if prec == "single" and auto > 1 else [])
+            for lanes, shuffle in runs:
+                r = march_throughput(s, dev, a.repeats, lanes, shuffle)
                 share = r["its"] * FLOPS_PER_ITERATION / peak[prec] if prec in peak else float("nan")
-                lines.append(f"| {name} | {prec} | {lanes} | {r['iterations']:.4g} | {r['seconds']:.4f} | "
+                label = f"{lanes}" + (", rays shuffled" if shuffle else "")
+                lines.append(f"| {name} | {prec} | {label} | {r['iterations']:.4g} | {r['seconds']:.4f} | "
                              f"{r['its']:.3g} | {100 * share:.1f} % | {100 * r['hit']:.1f} % |")
                 print(lines[-1], flush=True)
     a.out.mkdir(parents=True, exist_ok=True)
