@@ -2,16 +2,22 @@
 
 A scene compiles only the pieces it uses (the way Mandelbulber2 stitches only the
 formula files a scene uses): one .cl file per concern, concatenated in data-flow
-order, with -D switches for the optional terms.  Built programs are cached per
-(context, pieces, switches).
+order, with -D switches for the optional terms.  Built programs are kept per
+(context, pieces, switches) for the process, and their binaries on disk across
+processes in ``<cache>/programs`` (devices.cache_dir), keyed by the source, the options and
+the device and driver (devices.device_key): not every driver caches its own (PoCL does;
+others may not).  A binary that no longer loads is rebuilt from source.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import hashlib
+import os
+
 import pyopencl as cl
 
-from .devices import cannot_compile, compile_error
+from .devices import cache_dir, cannot_compile, compile_error, device_key
 from .resources import kernel_dir
 from .scene import Scene
 
@@ -75,6 +81,32 @@ def source(config: KernelConfig) -> str:
 _programs: dict[tuple, cl.Program] = {}
 
 
+def _from_binary(ctx: cl.Context, dev: cl.Device, path, opts) -> cl.Program | None:
+    """The program from a cached binary, or None (none cached, or it no longer loads)."""
+    try:
+        binary = path.read_bytes()
+    except OSError:
+        return None
+    try:
+        return cl.Program(ctx, [dev], [binary]).build(options=opts)
+    except (cl.Error, RuntimeError, ValueError):
+        return None
+
+
+def _save_binary(prg: cl.Program, path) -> None:
+    """Write the program's binary atomically; a cache that cannot be written costs only time."""
+    try:
+        binary = prg.get_info(cl.program_info.BINARIES)[0]
+        if not binary:
+            return
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.{os.getpid()}")
+        tmp.write_bytes(bytes(binary))
+        os.replace(tmp, path)
+    except (cl.Error, OSError):
+        pass
+
+
 def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
     """Build (once per context and configuration) and return the program."""
     key = (ctx.int_ptr, config)
@@ -84,6 +116,13 @@ def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
         dev = ctx.devices[0]
         if compile_error(dev):  # a compiler that fails on everything: one line, not a build log
             raise cannot_compile(dev)
-        prg = cl.Program(ctx, source(config)).build(options=opts)
+        src = source(config)
+        digest = hashlib.sha256("\0".join([src, " ".join(opts), device_key(dev), cl.VERSION_TEXT])
+                                .encode()).hexdigest()
+        path = cache_dir() / "programs" / f"{digest}.bin"
+        prg = _from_binary(ctx, dev, path, opts)
+        if prg is None:
+            prg = cl.Program(ctx, src).build(options=opts)
+            _save_binary(prg, path)
         _programs[key] = prg
     return prg

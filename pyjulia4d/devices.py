@@ -79,6 +79,23 @@ def cannot_compile(device: cl.Device) -> DeviceError:
                        f"(a CPU unknown to PyPI's PoCL: install Debian's pocl-opencl-icd)")
 
 
+def device_key(device: cl.Device) -> str:
+    """Platform, platform version, device, device version and driver version: what a
+    cached answer about a device (a program binary, a probed width) is keyed by."""
+    p = device.platform
+    return " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version,
+                                           device.driver_version))
+
+
+def cache_dir() -> "Path":
+    """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
+    import os
+    from pathlib import Path
+
+    root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
+    return Path(root)
+
+
 def describe_devices() -> str:
     """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``, and
     whether it compiles (a device that cannot is never picked by default)."""

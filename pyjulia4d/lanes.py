@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pyopencl as cl
 
-from .devices import device_type
+from .devices import cache_dir, device_key, device_type
 
 WIDTHS = (16, 8, 4)
 
@@ -46,13 +46,7 @@ print("ok" if same and close else "wrong")
 
 
 def cache_path() -> Path:
-    root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
-    return Path(root) / "lanes.json"
-
-
-def device_key(device: cl.Device) -> str:
-    p = device.platform
-    return " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version, device.driver_version))
+    return cache_dir() / "lanes.json"
 
 
 def device_spec(device: cl.Device) -> str:

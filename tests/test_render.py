@@ -5,6 +5,7 @@ import sys
 
 import numpy as np
 import OpenEXR
+import pyopencl as cl
 import pytest
 from PIL import Image
 
@@ -126,3 +127,27 @@ def test_cli_claims_no_bound_beyond_the_measured_max_iter(tmp_path):
     assert p.returncode == 0, p.stderr
     assert "states no depth-error bound beyond fractal.max_iter" in p.stdout
     assert "within the preset's stated" not in p.stdout
+
+
+def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
+    # build.program keeps each program's binary under <cache>/programs, keyed by source,
+    # options and device; a later process loads it instead of compiling, and a binary that
+    # no longer loads is rebuilt from source
+    from harness import device
+    from pyjulia4d import build
+    from pyjulia4d.render import queue_for
+
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    ctx, _ = queue_for(device())
+    cfg = build.KernelConfig(build.probe_config(Scene.default()).pieces, ("PROBE_CACHE_TEST",))
+    build._programs.pop((ctx.int_ptr, cfg), None)
+    build.program(ctx, cfg)
+    [binary] = list((tmp_path / "programs").glob("*.bin"))
+    assert binary.stat().st_size > 0
+    build._programs.pop((ctx.int_ptr, cfg))
+    assert build._from_binary(ctx, ctx.devices[0], binary, ["-DPROBE_CACHE_TEST"]) is not None
+    binary.write_bytes(b"not a program")
+    assert build._from_binary(ctx, ctx.devices[0], binary, ["-DPROBE_CACHE_TEST"]) is None
+    prg = build.program(ctx, cfg)                      # rebuilt from source, cache rewritten
+    assert prg.get_info(cl.program_info.KERNEL_NAMES)
+    assert binary.read_bytes() != b"not a program"
