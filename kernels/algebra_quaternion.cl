@@ -20,10 +20,10 @@ inline quat alg_sqr(quat q)
 
 /* Directional derivative of q -> q^2 along h: q h + h q = 2 (q1 h1 - v.hv, q1 hv + h1 v);
  * the cross products cancel, so the Jacobian is the matrix of seed 004, method 3. */
-inline real4 alg_sqr_jvp(real4 q, real4 h)
+inline quat alg_sqr_jvp(quat q, quat h)
 {
-    return (real)2 * (real4)(q.x * h.x - q.y * h.y - q.z * h.z - q.w * h.w,
-                             q.x * h.y + h.x * q.y,
-                             q.x * h.z + h.x * q.z,
-                             q.x * h.w + h.x * q.w);
+    return QUAT((real)2 * (q.x * h.x - q.y * h.y - q.z * h.z - q.w * h.w),
+                (real)2 * (q.x * h.y + h.x * q.y),
+                (real)2 * (q.x * h.z + h.x * q.z),
+                (real)2 * (q.x * h.w + h.x * q.w));
 }

@@ -8,7 +8,7 @@
 
 inline quat julia_f(quat q, real4 c) { return QADD_UNIFORM(alg_sqr(q), c); }
 
-inline real4 julia_f_jvp(real4 q, real4 h) { return alg_sqr_jvp(q, h); }
+inline quat julia_f_jvp(quat q, quat h) { return alg_sqr_jvp(q, h); }
 
 #define JULIA_DF2(m2) ((real)4 * (m2))
 /* d = |q| ln|q| / (DEGREE |q'|) is seed 001's eq. 8 with the factor for degree 2. */

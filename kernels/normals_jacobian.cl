@@ -6,15 +6,15 @@
  * any max_iter.  The 4D gradient is projected onto the 3D space the rays span
  * and returned in camera coordinates (x right, y up, z towards the eye). */
 
-inline real4 normal_jacobian(real4 p, julia_params jp, int *guard)
+inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
-    real4 q = p;
-    real4 j0 = (real4)(1, 0, 0, 0), j1 = (real4)(0, 1, 0, 0);
-    real4 j2 = (real4)(0, 0, 1, 0), j3 = (real4)(0, 0, 0, 1);
-    for (int n = 0; n < jp.max_iter; ++n) {
-        real m2 = dot(q, q);
-        if (m2 > jp.bailout2)
-            break;
+    quat q = p;
+    quat j0 = QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0), j1 = QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0);
+    quat j2 = QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0), j3 = QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1);
+    lmask live = L_TRUE;
+    for (int n = 0; n < jp.max_iter && L_ANY(live); ++n) {
+        lreal m2 = QNORM2(q);
+        live &= m2 <= jp.bailout2;
         /* Inside points of c = 0 go to 0 like p^(2^n): q underflows to exactly 0 within a
          * few dozen iterations (float32 and float64 alike) and grad |q_n|^2 = 2 J^T q_n
          * with it, a zero normal on a hit (measured: every fixed-scan hit of c = 0 at
@@ -22,55 +22,97 @@ inline real4 normal_jacobian(real4 p, julia_params jp, int *guard)
          * c = 0 every |q_k|^2 has the same (radial) level sets, so the normal is exact.
          * For c away from 0 this needs q^2 + c to cancel below sqrt(REAL_MIN), i.e. an
          * exact hit of the critical point 0.  Counted (GUARD_JACOBIAN_TINY). */
-        if (m2 < sqrt(REAL_MIN)) {
-            *guard |= GUARD_JACOBIAN_TINY;
+        lmask tiny = live & (m2 < sqrt(REAL_MIN));
+        *guard |= L_SEL((lmask)0, (lmask)GUARD_JACOBIAN_TINY, tiny);
+        live &= !tiny;
+        if (!L_ANY(live))
             break;
-        }
-        j0 = julia_f_jvp(q, j0);
-        j1 = julia_f_jvp(q, j1);
-        j2 = julia_f_jvp(q, j2);
-        j3 = julia_f_jvp(q, j3);
-        q = julia_f(q, jp.c);
-        real s = fmax(fmax(length(j0), length(j1)), fmax(length(j2), length(j3)));
+        j0 = QSEL(j0, julia_f_jvp(q, j0), live);
+        j1 = QSEL(j1, julia_f_jvp(q, j1), live);
+        j2 = QSEL(j2, julia_f_jvp(q, j2), live);
+        j3 = QSEL(j3, julia_f_jvp(q, j3), live);
+        q = QSEL(q, julia_f(q, jp.c), live);
+        lreal s = fmax(fmax(QLEN(j0), QLEN(j1)), fmax(QLEN(j2), QLEN(j3)));
         /* rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
-        if (s > (real)1e12 || (s < (real)1e-12 && s > (real)0)) {
-            s = (real)1 / s;
-            j0 *= s; j1 *= s; j2 *= s; j3 *= s;
+        lmask rescale = live & ((s > (real)1e12) | ((s < (real)1e-12) & (s > (real)0)));
+        if (L_ANY(rescale)) {
+            lreal inv = (real)1 / s;
+            j0 = QSEL(j0, QSCALE(inv, j0), rescale);
+            j1 = QSEL(j1, QSCALE(inv, j1), rescale);
+            j2 = QSEL(j2, QSCALE(inv, j2), rescale);
+            j3 = QSEL(j3, QSCALE(inv, j3), rescale);
         }
     }
-    return (real4)(dot(q, j0), dot(q, j1), dot(q, j2), dot(q, j3));
+    return QUAT(QDOT(q, j0), QDOT(q, j1), QDOT(q, j2), QDOT(q, j3));
 }
 
-/* 4D vector -> camera coordinates (right, up, -forward), normalised.  Degenerate (zero:
- * the orbit hit the critical point 0 exactly, e.g. an eye at 0 inside the set; or
- * non-finite): the view axis (0, 0, 1), flagged GUARD_NORMAL_FALLBACK, never a zero
- * normal on a hit. */
-inline real4 to_camera_unit(real4 g, real4 right, real4 up, real4 forward, int *guard)
+/* 4D vector -> camera coordinates (right, up, -forward), normalised: (*nx, *ny, *nz).
+ * Degenerate (zero: the orbit hit the critical point 0 exactly, e.g. an eye at 0 inside
+ * the set; or non-finite): the view axis (0, 0, 1), flagged GUARD_NORMAL_FALLBACK, never a
+ * zero normal on a hit. */
+inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *guard,
+                           lreal *nx, lreal *ny, lreal *nz)
 {
+#if LANES == 1
     real4 n = (real4)(dot(g, right), dot(g, up), -dot(g, forward), 0);
     real l = length(n);
-    if (l > (real)0 && isfinite(l))
-        return n / l;
-    *guard |= GUARD_NORMAL_FALLBACK;
-    return (real4)(0, 0, 1, 0);
+    int ok = l > (real)0 && isfinite(l);
+    n = ok ? n / l : (real4)(0, 0, 1, 0);
+    *nx = n.x, *ny = n.y, *nz = n.z;
+#else
+    lreal x = QDOT_UNIFORM(g, right), y = QDOT_UNIFORM(g, up), z = -QDOT_UNIFORM(g, forward);
+    lreal m = fmax(fabs(x), fmax(fabs(y), fabs(z)));   /* scaled first, as length() does */
+    x /= m, y /= m, z /= m;
+    lreal l = sqrt(x * x + y * y + z * z);
+    lmask ok = (m > (real)0) & isfinite(m) & isfinite(l);
+    *nx = select((lreal)0, x / l, ok);
+    *ny = select((lreal)0, y / l, ok);
+    *nz = select((lreal)1, z / l, ok);
+#endif
+    *guard |= L_SEL((lmask)GUARD_NORMAL_FALLBACK, (lmask)0, ok);
 }
 
+/* LANES hit points per work-item (real.cl), like the march. */
 __kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real4 right, const real4 up, const real4 forward,
                                __global real4 *normal)
 {
-    size_t i = get_global_id(0);
-    if (i >= (size_t)n_items)
+    size_t i0 = get_global_id(0) * LANES;
+    if (i0 >= (size_t)n_items)
         return;
-    if (status[i] != STATUS_HIT) {
-        normal[i] = (real4)(0);
+    julia_params jp = { c, bailout * bailout, 0, max_iter };
+#if LANES == 1
+    if (status[i0] != STATUS_HIT) {
+        normal[i0] = (real4)(0);
         return;
     }
-    julia_params jp = { c, bailout * bailout, 0, max_iter };
     int guard = 0;
-    real4 n = to_camera_unit(normal_jacobian(point[i], jp, &guard), right, up, forward, &guard);
-    n.w = (real)guard;                /* guard flags ride in the unused w (real.cl) */
-    normal[i] = n;
+    real nx, ny, nz;
+    to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+    normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (real.cl) */
+#else
+    quat p;
+    int any_hit = 0;
+    for (int k = 0; k < LANES; ++k) {  /* gather; a miss or a lane past the end takes point 0 */
+        size_t i = min(i0 + k, (size_t)n_items - 1);
+        int hit = status[i] == STATUS_HIT;
+        any_hit |= hit;
+        real4 pk = hit ? point[i] : (real4)(0);
+        ((real *)&p.x)[k] = pk.x; ((real *)&p.y)[k] = pk.y;
+        ((real *)&p.z)[k] = pk.z; ((real *)&p.w)[k] = pk.w;
+    }
+    lmask guard = 0;
+    lreal nx = 0, ny = 0, nz = 0;
+    if (any_hit)
+        to_camera_unit(normal_jacobian(p, jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+    for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
+        size_t i = i0 + k;
+        normal[i] = status[i] == STATUS_HIT
+                        ? (real4)(((real *)&nx)[k], ((real *)&ny)[k], ((real *)&nz)[k],
+                                  (real)((int *)&guard)[k])
+                        : (real4)(0);
+    }
+#endif
 }

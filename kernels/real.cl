@@ -79,6 +79,10 @@ typedef real4 quat;
 #define QSEL(a, b, m) ((m) ? (b) : (a))
 #define QRAY(o, d, t) ((o) + (t) * (d))
 #define QDOT(a, b) dot((a), (b))
+#define QLEN(q) length(q)
+#define QSCALE(s, q) ((s) * (q))
+#define QDOT_UNIFORM(q, v) dot((q), (v))
+#define L_TRUE 1
 #else
 #ifdef REAL_DOUBLE
 #error "packets of rays are single precision (LANES > 1 with REAL_DOUBLE)"
@@ -97,6 +101,10 @@ inline quat QRAY(quat o, quat d, lreal t)
     return QUAT(o.x + t * d.x, o.y + t * d.y, o.z + t * d.z, o.w + t * d.w);
 }
 inline lreal QDOT(quat a, quat b) { return a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w; }
+inline lreal QDOT_UNIFORM(quat a, real4 v) { return a.x * v.x + a.y * v.y + a.z * v.z + a.w * v.w; }
+inline lreal QLEN(quat q) { return sqrt(QNORM2(q)); }
+inline quat QSCALE(lreal s, quat q) { return QUAT(s * q.x, s * q.y, s * q.z, s * q.w); }
+#define L_TRUE (-1)
 inline quat QSEL(quat a, quat b, lmask m)
 {
     return QUAT(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m), select(a.w, b.w, m));

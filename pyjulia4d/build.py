@@ -55,11 +55,14 @@ def scene_config(scene: Scene) -> KernelConfig:
 
 
 def march_config(scene: Scene, lanes: int) -> KernelConfig:
-    """The march alone with ``lanes`` rays per work-item (-D LANES, kernels/real.cl): the
-    same pieces as scene_config up to march.cl; rays, normals and shading stay one per
-    work-item in the scene's program."""
+    """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
+    per work-item (-D LANES, kernels/real.cl): the same pieces as scene_config up to
+    march.cl; rays, shading and the other normals stay one per work-item in the scene's
+    program."""
     cfg = scene_config(scene)
     pieces = cfg.pieces[: cfg.pieces.index("march") + 1]
+    if scene.normals.method == "jacobian":
+        pieces += ("normals_jacobian",)
     return KernelConfig(pieces, cfg.defines + ((f"LANES={lanes}",) if lanes > 1 else ()))
 
 

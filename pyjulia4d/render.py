@@ -208,7 +208,8 @@ def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int 
 
 
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
-                   point, depth, status, normal, size: tuple[int, int] | None = None) -> None:
+                   point, depth, status, normal, size: tuple[int, int] | None = None,
+                   lanes: int = 1) -> None:
     """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
     device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
     image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
@@ -220,7 +221,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
     kernel = cl.Kernel(prg, f"normals_{method}")
     if method == "jacobian":
         launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
-               right, up, fwd, normal.data)
+               right, up, fwd, normal.data, lanes=lanes)
     elif method == "gradient":
         launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
                pr.scalar(gradient_step(scene)), right, up, fwd, normal.data)
@@ -313,8 +314,12 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
                    np.int32(H), np.int32(ax0), np.int32(ay0), np.int32(aw), origins.data, dirs.data)
             launch(queue, march_k, n, origins.data, dirs.data, *march_const, depth.data, point.data,
                    status.data, samples.data, flags.data, bracket.data, lanes=lanes)
-            launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status,
-                           normal, size=(aw, ah))
+            if scene.normals.method == "jacobian":   # in packets too (build.march_config)
+                launch_normals(queue, march_prg, scene, "jacobian", frame, pr, point, depth, status,
+                               normal, size=(aw, ah), lanes=lanes)
+            else:
+                launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status,
+                               normal, size=(aw, ah))
             launch(queue, shade_k, n, status.data, normal.data, point.data, eye, right, up, fwd, light,
                     _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
                     np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),

@@ -3,7 +3,7 @@ on identical hit points."""
 import numpy as np
 import pytest
 
-from harness import Runner
+from harness import Runner, packet_widths
 from pyjulia4d import build, reference as ref
 from pyjulia4d.camera import camera_frame, march_radius
 from pyjulia4d.scene import Scene
@@ -25,13 +25,19 @@ def angles(a, b):
     return np.degrees(np.arccos(np.clip(np.sum(a * b, -1), -1, 1)))
 
 
-@pytest.mark.parametrize("method", ["jacobian", "gradient", "zbuffer"])
+# (method, lanes): the Jacobian normals also run in packets of rays (build.march_config)
+METHODS = [("jacobian", 1), ("gradient", 1), ("zbuffer", 1)] + [("jacobian", w) for w in packet_widths((16,))]
+
+
+@pytest.mark.parametrize("method,lanes", METHODS)
 @pytest.mark.parametrize("fl", ["single", "double"])
 @pytest.mark.parametrize("c", [(-0.2, 0.8, 0, 0), (-0.125, -0.256, 0.847, 0.0895)])
-def test_normals_match_reference(method, fl, c):
+def test_normals_match_reference(method, lanes, fl, c):
+    if lanes > 1 and fl == "double":
+        pytest.skip("packets are single precision")
     s = Scene.default().with_overrides([f"normals.method={method}", f"render.float={fl}",
                                         "fractal.c=" + ",".join(map(str, c))])
-    R = Runner(build.scene_config(s))
+    R = Runner(build.march_config(s, lanes) if lanes > 1 else build.scene_config(s))
     fr = camera_frame(s)
     depth, point, status = hits(s, R.real)
     n = len(point)
@@ -40,7 +46,7 @@ def test_normals_match_reference(method, fl, c):
     vec = R.vec
     if method == "jacobian":
         R("normals_jacobian", (n,), R.buf4(point), R.buf(status, np.int32), vec(f.c),
-          np.int32(f.max_iter), R.scalar(f.bailout), vec(fr.right), vec(fr.up), vec(fr.forward), out)
+          np.int32(f.max_iter), R.scalar(f.bailout), vec(fr.right), vec(fr.up), vec(fr.forward), out, lanes=lanes)
         want = ref.normals_jacobian(point, status, f.c, f.max_iter, f.bailout, fr)
     elif method == "gradient":
         h = s.march.epsilon

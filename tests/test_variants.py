@@ -42,11 +42,13 @@ def test_packets_give_the_same_pixels(over, lanes):
     slack = 1e-6 * (1 + np.maximum(a, b))
     overlap = np.maximum(a, b) <= np.minimum(a + wa, b + wb) + slack
     assert np.mean(overlap) >= 0.995
-    # the normals run one ray per work-item in both: the same depth gives the same normal
-    # (where the depths differ by a few ulp, so may the normals of a max_iter-20 surface)
+    # the same depth gives the same normal up to the rounding of the Jacobian's sums, which
+    # packets add as products where one ray calls dot() (where the depths differ by a few
+    # ulp, so may the normals of a max_iter-20 surface)
     eq = a == b
     assert np.mean(eq) >= 0.75          # measured 79-100 %
-    np.testing.assert_array_equal(pk.normal[hit][eq], one.normal[hit][eq])
+    dn = np.abs(pk.normal[hit][eq] - one.normal[hit][eq]).max(axis=-1)
+    assert np.mean(dn <= 1e-4) >= 0.99, np.percentile(dn, [50, 99, 100])
 
 
 def test_variant_choice_and_its_cache(tmp_path, monkeypatch):
