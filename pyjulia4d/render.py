@@ -285,6 +285,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     depth, bracket = (cla.empty(queue, nmax, pr.scalar) for _ in range(2))
     status, samples, flags = (cla.empty(queue, nmax, np.int32) for _ in range(3))
     rgba = cla.empty(queue, nmax, cl.cltypes.float4)
+    buffers = {"rgba": rgba, "depth": depth, "bracket": bracket, "normal": normal, "point": point,
+               "status": status, "samples": samples, "flags": flags}
+    stage = {name: np.empty(nmax, buf.dtype) for name, buf in buffers.items()}
 
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
     c = pr.v4(f.c)
@@ -331,25 +334,30 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             ys, xs = slice(y0 - ay0, y0 - ay0 + th), slice(x0 - ax0, x0 - ax0 + tw)
             dst = (slice(y0, y0 + th), slice(x0, x0 + tw))
 
-            def get(buf, k=None, dtype=None):
-                a = buf.get()[:n]
+            # the tile's n items into staging arrays made once (no allocation, no page
+            # faults per tile), all copies queued before one wait
+            for name, buf in buffers.items():
+                cl.enqueue_copy(queue, stage[name][:n], buf.data, is_blocking=False)
+            queue.finish()
+
+            def get(name, k=None):
+                a = stage[name][:n]
                 if k is not None:
-                    a = a.view(pr.scalar).reshape(n, 4)[:, :k]
-                    return a.reshape(ah, aw, k)[ys, xs]
+                    return a.view(pr.scalar).reshape(ah, aw, 4)[ys, xs, :k]
                 return a.reshape(ah, aw)[ys, xs]
 
-            col = rgba.get()[:n].view(np.float32).reshape(ah, aw, 4)[ys, xs]
+            col = stage["rgba"][:n].view(np.float32).reshape(ah, aw, 4)[ys, xs]
             color[dst] = col[..., :3]
             alpha[dst] = col[..., 3]
-            depth_img[dst] = get(depth)
-            bracket_img[dst] = get(bracket)
-            nrm = get(normal, 4)
+            depth_img[dst] = get("depth")
+            bracket_img[dst] = get("bracket")
+            nrm = get("normal", 4)
             normal_img[dst] = nrm[..., :3]
-            position[dst] = get(point, 4)
-            status_img[dst] = get(status)
-            samples_img[dst] = get(samples)
+            position[dst] = get("point", 4)
+            status_img[dst] = get("status")
+            samples_img[dst] = get("samples")
             # guard flags (kernels/real.cl): the march's buffer and the normals' w
-            guard_img[dst] = get(flags) | nrm[..., 3].astype(np.int32)
+            guard_img[dst] = get("flags") | nrm[..., 3].astype(np.int32)
             bar.update(tw * th)
 
     result = RenderResult(
