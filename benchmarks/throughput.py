@@ -46,7 +46,7 @@ from pyjulia4d import build  # noqa: E402
 from pyjulia4d.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
 from pyjulia4d.lanes import lanes_for  # noqa: E402
-from pyjulia4d.render import Precision, launch, queue_for  # noqa: E402
+from pyjulia4d.render import Precision, launch, march_items, queue_for  # noqa: E402
 from pyjulia4d.scene import Scene  # noqa: E402
 
 FLOPS_PER_ITERATION = 20
@@ -160,15 +160,16 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
         perm = np.random.default_rng(0).permutation(n)
         dirs.set(dirs.get()[perm])
     march = cl.Kernel(mprg, "march")
-    launch(queue, march, n, *args, lanes=lanes)  # warm-up: PoCL specialises the work-group function
+    items = march_items(n, w, lanes)
+    launch(queue, march, n, np.int32(w), *args, items=items)  # warm-up: PoCL specialises the work-group function
     queue.finish()
     ts = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        launch(queue, march, n, *args, lanes=lanes)
+        launch(queue, march, n, np.int32(w), *args, items=items)
         queue.finish()
         ts.append(time.perf_counter() - t0)
-    launch(queue, cl.Kernel(build.program(ctx, counted), "march"), n, *args, counts.data)
+    launch(queue, cl.Kernel(build.program(ctx, counted), "march"), n, np.int32(w), *args, counts.data)
     queue.finish()
     iters = int(counts.get().astype(np.int64).sum())
     sec = statistics.median(ts)

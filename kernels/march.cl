@@ -5,7 +5,7 @@
  * guard flags (real.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (refine.cl), +inf where nothing was hit. */
 
-__kernel void march(const int n_items, __global const real4 *origins, __global const real4 *dirs,
+__kernel void march(const int n_items, const int tile_w, __global const real4 *origins, __global const real4 *dirs,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
@@ -13,11 +13,28 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
                     __global int *status, __global int *samples, __global int *flags,
                     __global real *bracket COUNTER_ARG)
 {
-    /* LANES neighbouring rays per work-item (real.cl); launches are padded to whole
-     * work-groups (render.launch) and the last packet may be partly past n_items */
-    size_t i0 = get_global_id(0) * LANES;
+    /* LANES neighbouring rays per work-item (real.cl): one ray, or a block of BLOCK_W x
+     * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
+     * to whole work-groups (render.launch) and a block may reach past the tile's edges */
+#if LANES == 1
+    size_t i0 = get_global_id(0);
     if (i0 >= (size_t)n_items)
         return;
+#else
+    int tile_h = n_items / tile_w;
+    int blocks_x = (tile_w + BLOCK_W - 1) / BLOCK_W;
+    int bx = (int)(get_global_id(0) % (size_t)blocks_x) * BLOCK_W;
+    int by = (int)(get_global_id(0) / (size_t)blocks_x) * BLOCK_H;
+    if (by >= tile_h)
+        return;
+    size_t i0 = (size_t)by * tile_w + bx;
+    size_t lane_index[LANES];
+    for (int k = 0; k < LANES; ++k) {
+        int x = bx + k % BLOCK_W, y = by + k / BLOCK_W;
+        /* a lane past the tile's edge repeats the block's first pixel and is not written */
+        lane_index[k] = x < tile_w && y < tile_h ? (size_t)y * tile_w + x : (size_t)n_items;
+    }
+#endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i0) };
     quat o, d;
     lmask valid;
@@ -27,13 +44,13 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
     valid = 1;
 #else
     for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
-        size_t i = min(i0 + k, (size_t)n_items - 1);    /* a tail lane repeats the last ray */
+        size_t i = lane_index[k] < (size_t)n_items ? lane_index[k] : i0;
         real4 ok = origins[i], dk = dirs[i];
         ((real *)&o.x)[k] = ok.x; ((real *)&o.y)[k] = ok.y;
         ((real *)&o.z)[k] = ok.z; ((real *)&o.w)[k] = ok.w;
         ((real *)&d.x)[k] = dk.x; ((real *)&d.y)[k] = dk.y;
         ((real *)&d.z)[k] = dk.z; ((real *)&d.w)[k] = dk.w;
-        ((int *)&valid)[k] = i0 + k < (size_t)n_items ? -1 : 0;
+        ((int *)&valid)[k] = lane_index[k] < (size_t)n_items ? -1 : 0;
     }
 #endif
 
@@ -65,8 +82,10 @@ __kernel void march(const int n_items, __global const real4 *origins, __global c
     flags[i0] = fl;
     bracket[i0] = st == STATUS_HIT ? width : INFINITY;
 #else
-    for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
-        size_t i = i0 + k;
+    for (int k = 0; k < LANES; ++k) {   /* scatter */
+        size_t i = lane_index[k];
+        if (i >= (size_t)n_items)
+            continue;
         real tk = ((real *)&t)[k];
         int sk = ((int *)&st)[k];
         real4 ok = (real4)(((real *)&o.x)[k], ((real *)&o.y)[k], ((real *)&o.z)[k], ((real *)&o.w)[k]);

@@ -197,13 +197,27 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
     return _local[key]
 
 
-def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1) -> None:
-    """Enqueue ``kernel`` over n items, ``lanes`` per work-item (the march's packets):
-    n_items = n first, then ``args``."""
+# Pixels per packet of the march (kernels/real.cl BLOCK_W x BLOCK_H) by lane count.
+BLOCKS = {16: (4, 4), 8: (4, 2), 4: (2, 2)}
+
+
+def march_items(n: int, tile_w: int, lanes: int) -> int:
+    """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
+    per block of pixels (kernels/march.cl)."""
+    if lanes == 1:
+        return n
+    bw, bh = BLOCKS.get(lanes, (lanes, 1))
+    return -(-tile_w // bw) * -(-(n // tile_w) // bh)
+
+
+def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
+           items: int | None = None) -> None:
+    """Enqueue ``kernel`` over n items, ``lanes`` per work-item (packets of rays) or
+    ``items`` work-items: n_items = n first, then ``args``."""
     if n <= 0:
         return
     loc = local_size(kernel, queue.device)
-    items = -(-n // lanes)
+    items = -(-n // lanes) if items is None else items
     kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
 
 
@@ -315,8 +329,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             n = aw * ah
             launch(queue, rays_k, n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov), np.int32(W),
                    np.int32(H), np.int32(ax0), np.int32(ay0), np.int32(aw), origins.data, dirs.data)
-            launch(queue, march_k, n, origins.data, dirs.data, *march_const, depth.data, point.data,
-                   status.data, samples.data, flags.data, bracket.data, lanes=lanes)
+            launch(queue, march_k, n, np.int32(aw), origins.data, dirs.data, *march_const, depth.data,
+                   point.data, status.data, samples.data, flags.data, bracket.data,
+                   items=march_items(n, aw, lanes))
             if scene.normals.method == "jacobian":   # in packets too (build.march_config)
                 launch_normals(queue, march_prg, scene, "jacobian", frame, pr, point, depth, status,
                                normal, size=(aw, ah), lanes=lanes)

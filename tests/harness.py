@@ -60,10 +60,11 @@ class Runner:
     def get4(self, a):
         return a.get().view(self.real).reshape(-1, 4).astype(np.float64)
 
-    def __call__(self, name, size, *args, lanes: int = 1):
+    def __call__(self, name, size, *args, lanes: int = 1, items: int | None = None):
         """Run kernel ``name`` over ``size`` = (n,) items the way render.py does
-        (render.launch: padded work-groups, n passed first, ``lanes`` per work-item)."""
+        (render.launch: padded work-groups, n passed first, ``lanes`` per work-item or
+        ``items`` work-items)."""
         conv = [a.data if isinstance(a, cla.Array) else a for a in args]
         (n,) = size
-        launch(self.queue, cl.Kernel(self.prg, name), n, *conv, lanes=lanes)
+        launch(self.queue, cl.Kernel(self.prg, name), n, *conv, lanes=lanes, items=items)
         self.queue.finish()
