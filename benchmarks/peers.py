@@ -22,7 +22,6 @@ Writes benchmarks/results/peers.md (appends a section per run).
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import math
 import re
@@ -36,6 +35,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 POV_SCENE = """#version 3.7;
 global_settings {{ assumed_gamma 1.0 }}
@@ -106,14 +109,6 @@ def run_pyjulia4d(over: list[str]) -> dict:
     return json.loads(p.stdout)
 
 
-def git_head() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480")
@@ -139,8 +134,8 @@ def main(argv=None) -> int:
     pov = runs.get("POV-Ray 3.7 julia_fractal (precision 20)")
     pov_cpu = statistics.median(r["cpu"] for r in pov) if pov else 0.0
     pov_rate = px / pov_cpu if pov_cpu > 0 else None   # a tiny image can report 0.000 s
-    lines = [f"\n## {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M} UTC, {w}x{h}, pyjulia4d on {device}, "
-             f"commit {git_head()}, median of {a.repeats} alternating runs\n",
+    lines = [f"\n## {utc_now()}, {w}x{h}, pyjulia4d on {device}, "
+             f"commit {git_commit()}, median of {a.repeats} alternating runs\n",
              "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pixels hit |", "|---|---|---|---|---|"]
     for name, rs in runs.items():
         cpu = statistics.median(r["cpu"] for r in rs)
@@ -148,11 +143,9 @@ def main(argv=None) -> int:
         ratio = f"{rate / pov_rate:.2f}" if pov_rate else "-"
         lines.append(f"| {name} | {cpu:.3f} | {rate:.3g} | {ratio} | {100 * statistics.median(r['hit'] for r in rs):.1f} % |")
         print(lines[-1], flush=True)
-    a.out.mkdir(parents=True, exist_ok=True)
     md = a.out / "peers.md"
-    title = ("# pyjulia4d beside its peers\n\nWritten by `python benchmarks/peers.py` (see its docstring: "
-             "the scene, what is timed, what is left out).\n")
-    md.write_text((md.read_text() if md.exists() else title) + "\n".join(lines) + "\n")
+    append_run(md, "# pyjulia4d beside its peers\n\nWritten by `python benchmarks/peers.py` (see its "
+               "docstring: the scene, what is timed, what is left out).\n", "\n".join(lines) + "\n")
     print(f"wrote {md}")
     return 0
 

@@ -12,21 +12,16 @@ from __future__ import annotations
 import argparse
 import datetime
 import statistics
-import subprocess
+import sys
 import time
 from pathlib import Path
 
-from pyjulia4d import Scene, render
-from pyjulia4d.devices import select_device
-from pyjulia4d.output import write_png
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-
-def git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
+from pyjulia4d import Scene, render  # noqa: E402
+from pyjulia4d.devices import select_device  # noqa: E402
+from pyjulia4d.output import write_png  # noqa: E402
+from run_log import append_run, git_commit  # noqa: E402
 
 
 def main(argv=None) -> None:
@@ -50,10 +45,7 @@ def main(argv=None) -> None:
            f"{first.hit_fraction:.1%} |")
     head = ("| date | commit | device | size | overrides | first render s (with build) | "
             "median render s | median kernels s | hit |\n|---|---|---|---|---|---|---|---|---|\n")
-    a.out.mkdir(parents=True, exist_ok=True)
-    md = a.out / "render_time.md"
-    text = md.read_text() if md.exists() else "# Default-scene render time\n\n" + head
-    md.write_text(text + row + "\n")
+    append_run(a.out / "render_time.md", "# Default-scene render time\n\n" + head, row + "\n")
     if not a.set:  # the README's picture is this render
         write_png(a.out / "default.png", first.color, first.alpha)
     print(head + row)

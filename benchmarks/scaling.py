@@ -12,13 +12,16 @@ Writes benchmarks/results/scaling.md (appends a section per run: device, date, c
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 CHILD = r"""
 import json, resource, sys, time, warnings
@@ -35,14 +38,6 @@ peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"seconds": sec, "kernel_seconds": r.kernel_seconds, "peak": peak, "base": base,
                   "device": r.device_name, "hit": r.hit_fraction}))
 """
-
-
-def git_head() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def main(argv=None) -> int:
@@ -66,14 +61,13 @@ def main(argv=None) -> int:
         rows.append(f"| {size} | {px:,} | {r['seconds']:.3f} | {r['kernel_seconds']:.3f} | {px / r['seconds']:.3g} | "
                     f"{r['peak'] / 2**20:.0f} | {extra / px:.0f} | {100 * r['hit']:.1f} % |")
         print(rows[-1], flush=True)
-    head = (f"\n## {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M} UTC, {device}, commit {git_head()}"
+    head = (f"\n## {utc_now()}, {device}, commit {git_commit()}"
             f"{', ' + ' '.join(a.set) if a.set else ''}\n\n"
             "| size | pixels | render s | kernels s | pixels/s | peak RSS MiB | bytes/pixel above the warm process | hit |\n"
             "|---|---|---|---|---|---|---|---|\n")
-    a.out.mkdir(parents=True, exist_ok=True)
     md = a.out / "scaling.md"
-    title = "# Render time and peak memory against image size\n\nWritten by `python benchmarks/scaling.py`.\n"
-    md.write_text((md.read_text() if md.exists() else title) + head + "\n".join(rows) + "\n")
+    append_run(md, "# Render time and peak memory against image size\n\nWritten by "
+               "`python benchmarks/scaling.py`.\n", head + "\n".join(rows) + "\n")
     print(f"wrote {md}")
     return 0
 

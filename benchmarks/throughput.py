@@ -25,7 +25,6 @@ Writes benchmarks/results/throughput.md (appends a section per run: device, date
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import statistics
 import subprocess
@@ -36,8 +35,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+for _p in (ROOT, ROOT / "benchmarks"):
+    if str(_p) not in sys.path:
+        sys.path.insert(0, str(_p))
 
 import pyopencl as cl  # noqa: E402
 import pyopencl.array as cla  # noqa: E402
@@ -48,6 +48,7 @@ from pyjulia4d.devices import select_device  # noqa: E402
 from pyjulia4d.lanes import lanes_for  # noqa: E402
 from pyjulia4d.render import Precision, launch, march_items, queue_for  # noqa: E402
 from pyjulia4d.scene import Scene  # noqa: E402
+from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 FLOPS_PER_ITERATION = 20
 SCENES = {
@@ -177,14 +178,6 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
             "hit": float(np.mean(status.get() == 1))}
 
 
-def git_head() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
@@ -195,8 +188,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     w, h = (int(x) for x in a.size.split("x"))
     dev = select_device(a.device)
-    lines = [f"\n## {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M} UTC, {dev.name.strip()} "
-             f"({dev.platform.name.strip()} {dev.platform.version.strip()}), commit {git_head()}, {w}x{h}\n",
+    lines = [f"\n## {utc_now()}, {dev.name.strip()} "
+             f"({dev.platform.name.strip()} {dev.platform.version.strip()}), commit {git_commit()}, {w}x{h}\n",
              "| precision | FMA kernel width | flop/s |", "|---|---|---|"]
     peak = {}
     for prec in ("single", "double"):
@@ -224,11 +217,9 @@ def main(argv=None) -> int:
                 lines.append(f"| {name} | {prec} | {label} | {r['iterations']:.4g} | {r['seconds']:.4f} | "
                              f"{r['its']:.3g} | {100 * share:.1f} % | {100 * r['hit']:.1f} % |")
                 print(lines[-1], flush=True)
-    a.out.mkdir(parents=True, exist_ok=True)
     md = a.out / "throughput.md"
-    head = ("# Iterations per second inside the march\n\nWritten by `python benchmarks/throughput.py` "
-            "(see its docstring for what is counted and how).\n")
-    md.write_text((md.read_text() if md.exists() else head) + "\n".join(lines) + "\n")
+    append_run(md, "# Iterations per second inside the march\n\nWritten by `python benchmarks/throughput.py` "
+               "(see its docstring for what is counted and how).\n", "\n".join(lines) + "\n")
     print(f"wrote {md}")
     return 0
 

@@ -67,19 +67,9 @@ typedef struct {
  * loops run while L_ANY lane is live.  Packets are single precision only. */
 #define CAT_(a, b) a##b
 #define CAT(a, b) CAT_(a, b)
-/* A packet is a block of BLOCK_W x BLOCK_H neighbouring pixels: square blocks keep its
- * rays closer together than a row would (the default scene's march: 0.031 s in 4x4 blocks
- * against 0.040 s in rows of 16). */
-#if LANES == 16
-#define BLOCK_W 4
-#define BLOCK_H 4
-#elif LANES == 8
-#define BLOCK_W 4
-#define BLOCK_H 2
-#elif LANES == 4
-#define BLOCK_W 2
-#define BLOCK_H 2
-#else
+/* A packet is a block of BLOCK_W x BLOCK_H neighbouring pixels (-D from build.py's
+ * PACKET_BLOCKS; a row of LANES pixels if not given). */
+#ifndef BLOCK_W
 #define BLOCK_W LANES
 #define BLOCK_H 1
 #endif

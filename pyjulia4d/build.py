@@ -54,6 +54,17 @@ def scene_config(scene: Scene) -> KernelConfig:
     return KernelConfig(tuple(pieces), tuple(defines))
 
 
+# The pixel block a packet of rays covers, by lane count (kernels/real.cl BLOCK_W x
+# BLOCK_H): square blocks keep a packet's rays closer together than a row would (the
+# default scene's march: 0.031 s in 4x4 blocks against 0.040 s in rows of 16).
+PACKET_BLOCKS = {16: (4, 4), 8: (4, 2), 4: (2, 2)}
+
+
+def packet_block(lanes: int) -> tuple[int, int]:
+    """(width, height) in pixels of a packet of ``lanes`` rays."""
+    return PACKET_BLOCKS.get(lanes, (lanes, 1))
+
+
 def march_config(scene: Scene, lanes: int) -> KernelConfig:
     """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
     per work-item (-D LANES, kernels/real.cl): the same pieces as scene_config up to
@@ -63,7 +74,10 @@ def march_config(scene: Scene, lanes: int) -> KernelConfig:
     pieces = cfg.pieces[: cfg.pieces.index("march") + 1]
     if scene.normals.method == "jacobian":
         pieces += ("normals_jacobian",)
-    return KernelConfig(pieces, cfg.defines + ((f"LANES={lanes}",) if lanes > 1 else ()))
+    if lanes == 1:
+        return KernelConfig(pieces, cfg.defines)
+    bw, bh = packet_block(lanes)
+    return KernelConfig(pieces, cfg.defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
 
 
 def probe_config(scene: Scene) -> KernelConfig:

@@ -1,6 +1,9 @@
 """OpenCL device discovery and selection."""
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import pyopencl as cl
 
 
@@ -87,11 +90,8 @@ def device_key(device: cl.Device) -> str:
                                            device.driver_version))
 
 
-def cache_dir() -> "Path":
+def cache_dir() -> Path:
     """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
-    import os
-    from pathlib import Path
-
     root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
     return Path(root)
 

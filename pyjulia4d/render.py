@@ -197,16 +197,12 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
     return _local[key]
 
 
-# Pixels per packet of the march (kernels/real.cl BLOCK_W x BLOCK_H) by lane count.
-BLOCKS = {16: (4, 4), 8: (4, 2), 4: (2, 2)}
-
-
 def march_items(n: int, tile_w: int, lanes: int) -> int:
     """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
     per block of pixels (kernels/march.cl)."""
     if lanes == 1:
         return n
-    bw, bh = BLOCKS.get(lanes, (lanes, 1))
+    bw, bh = build.packet_block(lanes)
     return -(-tile_w // bw) * -(-(n // tile_w) // bh)
 
 
@@ -227,7 +223,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
     """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
     device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
     image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
-    f, m = scene.fractal, scene.march
+    f = scene.fractal
     w, h = size or (scene.image.width, scene.image.height)
     n = w * h
     c = pr.v4(f.c)
@@ -316,7 +312,6 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     march_k = cl.Kernel(march_prg, "march")
 
     queue.finish()
-    t_kernels = time.perf_counter()
     kernel_seconds = 0.0
     with tqdm(total=W * H, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
               disable=not progress, desc="render") as bar:

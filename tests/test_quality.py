@@ -3,9 +3,7 @@ and real c (the 2D oracle); the presets differ where they say they do."""
 import numpy as np
 import pytest
 
-from pyjulia4d import reference as ref
 from pyjulia4d import truth
-from pyjulia4d.camera import camera_frame
 from pyjulia4d.quality import (BOUND_MAX_ITER, MARCH_KEYS, PRESETS, QUALITIES, apply_quality, preset_overrides,
                                preset_values, stated_p99)
 from pyjulia4d.render import render
