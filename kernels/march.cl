@@ -1,11 +1,25 @@
-/* march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  The ray o + t d (|d| = 1)
+/* march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  Each work-item
+ * makes its rays from the camera (rays.cl camera_ray) for pixels (x0, y0) + its index in a tile
+ * tile_w wide; -D RAYS_FROM_BUFFERS reads them from origins/dirs instead (the tests' and
+ * benchmarks' arbitrary rays).  The ray o + t d (|d| = 1)
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
  * guard flags (real.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (refine.cl), +inf where nothing was hit. */
 
-__kernel void march(const int n_items, const int tile_w, __global const real4 *origins, __global const real4 *dirs,
+#ifdef RAYS_FROM_BUFFERS
+#define RAY_ARGS __global const real4 *origins, __global const real4 *dirs
+#define RAY_AT(i, ok, dk) do { ok = origins[i]; dk = dirs[i]; } while (0)
+#else
+#define RAY_ARGS const real4 eye, const real4 forward, const real4 right, const real4 up, \
+                 const real tan_half_fov, const int image_w, const int image_h, const int x0, const int y0
+#define RAY_AT(i, ok, dk) do { ok = eye; dk = camera_ray(x0 + (int)((i) % (size_t)tile_w), \
+                                                       y0 + (int)((i) / (size_t)tile_w), forward, right, \
+                                                       up, tan_half_fov, image_w, image_h); } while (0)
+#endif
+
+__kernel void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
@@ -39,13 +53,13 @@ __kernel void march(const int n_items, const int tile_w, __global const real4 *o
     quat o, d;
     lmask valid;
 #if LANES == 1
-    o = origins[i0];
-    d = dirs[i0];
+    RAY_AT(i0, o, d);
     valid = 1;
 #else
     for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
         size_t i = lane_index[k] < (size_t)n_items ? lane_index[k] : i0;
-        real4 ok = origins[i], dk = dirs[i];
+        real4 ok, dk;
+        RAY_AT(i, ok, dk);
         ((real *)&o.x)[k] = ok.x; ((real *)&o.y)[k] = ok.y;
         ((real *)&o.z)[k] = ok.z; ((real *)&o.w)[k] = ok.w;
         ((real *)&d.x)[k] = dk.x; ((real *)&d.y)[k] = dk.y;

@@ -38,15 +38,19 @@ def precision_defines(scene: Scene) -> tuple[str, ...]:
     return ("REAL_DOUBLE",) if scene.render.float == "double" else ()
 
 
-def scene_config(scene: Scene) -> KernelConfig:
-    """The pieces and switches of one scene's render program."""
+def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
+    """The pieces and switches of one scene's render program.  The march makes its rays
+    from the camera; ``ray_buffers`` (-D RAYS_FROM_BUFFERS) builds it to read given rays
+    instead (the tests' and benchmarks' arbitrary rays)."""
     m = scene.march
     pieces = list(iteration_pieces(scene))
     defines = list(precision_defines(scene))
     pieces.append("refine")
     if m.refine == "itp":
         defines.append("REFINE_ITP")
-    pieces += [f"march_{m.method}", "march", "rays", f"normals_{scene.normals.method}", "shade"]
+    if ray_buffers:
+        defines.append("RAYS_FROM_BUFFERS")
+    pieces += [f"march_{m.method}", "rays", "march", f"normals_{scene.normals.method}", "shade"]
     if scene.shading.specular > 0:
         defines.append("SPECULAR")
     if not isinstance(scene.shading.light, str):
@@ -65,12 +69,12 @@ def packet_block(lanes: int) -> tuple[int, int]:
     return PACKET_BLOCKS.get(lanes, (lanes, 1))
 
 
-def march_config(scene: Scene, lanes: int) -> KernelConfig:
+def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
     """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
     per work-item (-D LANES, kernels/real.cl): the same pieces as scene_config up to
     march.cl; rays, shading and the other normals stay one per work-item in the scene's
     program."""
-    cfg = scene_config(scene)
+    cfg = scene_config(scene, ray_buffers)
     pieces = cfg.pieces[: cfg.pieces.index("march") + 1]
     if scene.normals.method == "jacobian":
         pieces += ("normals_jacobian",)

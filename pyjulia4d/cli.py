@@ -53,6 +53,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; README lists every key and its valid range)")
     r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
+    r.add_argument("--channels", metavar="LIST",
+                   help="EXR channel groups to compute and write, comma-separated from RGBA, Z (depth and "
+                        "its bracket), N (normal), P (4D position); default all.  Z alone skips normals "
+                        "and shading and keeps 8 bytes per pixel: the way to render huge depth maps")
     r.add_argument("--force", action="store_true",
                    help="render settings whose estimated work is refused as hopeless (hours)")
 
@@ -83,11 +87,12 @@ def _render(args: argparse.Namespace) -> int:
         scene = Scene.from_toml(args.scene, overrides)
         default_out = Path(args.scene).stem + ".png"
     out = check_output_path(default_out if args.output is None else args.output)
+    outputs = _outputs(args.channels, out)
     device = select_device(args.device)
 
     from .render import render  # heavy (kernel build); only once the input is known good
 
-    result = render(scene, device=device, progress=True, force=args.force)
+    result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
     from .quality import BOUND_MAX_ITER, stated_p99
 
     # capped rays, the guards that fired and the certified depth bracket are part of the
@@ -107,6 +112,30 @@ def _render(args: argparse.Namespace) -> int:
         f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
     return 0
+
+
+# --channels: EXR channel groups and the render outputs behind them (render.RenderResult)
+CHANNEL_GROUPS = {"RGBA": ("color", "alpha"), "Z": ("depth", "bracket"), "N": ("normal",),
+                  "P": ("position",)}
+
+
+def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
+    """The render outputs behind --channels (None: all the format holds)."""
+    if out.suffix.lower() == ".png":
+        if channels is not None and channels.strip().upper() != "RGBA":
+            raise SceneError("--channels", f"{channels!r}: a PNG holds RGBA only; write .exr for Z, N or P")
+        return ("color", "alpha")
+    if channels is None:
+        return None
+    groups = [g.strip().upper() for g in channels.split(",")]
+    if not all(groups):
+        raise SceneError("--channels", f"{channels!r}: empty name in the list; use names from "
+                                       f"{', '.join(CHANNEL_GROUPS)}")
+    for g in groups:
+        if g not in CHANNEL_GROUPS:
+            raise SceneError("--channels", f"unknown channel group {g!r}; use names from "
+                                           f"{', '.join(CHANNEL_GROUPS)}")
+    return tuple(o for g in groups for o in CHANNEL_GROUPS[g])
 
 
 def _one_line(e: BaseException) -> str:

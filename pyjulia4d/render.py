@@ -1,8 +1,9 @@
-"""Run a scene's kernels: rays -> march -> normals -> shade.
+"""Execute a render plan (plan.py): per tile, march -> normals -> shade, then assemble.
 
-Every per-pixel step is an OpenCL kernel; Python only sets up the frame, picks
-the program and moves whole buffers.  ``reference.render`` is the float64 numpy
-twin of this function.
+Every per-pixel step is an OpenCL kernel (the march makes its own rays); Python only
+enqueues tiles and copies back the outputs the plan keeps.  Two tiles are in flight: the
+kernels of one run while the host files the other, with no finish() between them.
+``reference.render`` is the float64 numpy twin of this module's ``render``.
 """
 from __future__ import annotations
 
@@ -16,10 +17,10 @@ import pyopencl as cl
 import pyopencl.array as cla
 from tqdm import tqdm
 
-from . import build, workload
-from .camera import camera_frame, light_position, march_radius
+from . import build
 from .devices import has_fp64, select_device
 from .lanes import lanes_for
+from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
 from .scene import Scene, SceneError
 
 STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
@@ -33,14 +34,16 @@ GUARD_SHELL_MISS = 8        # de: within epsilon by the estimate, never inside: 
 @dataclass
 class RenderResult:
     """Image buffers (row 0 at the top) and what the render cost."""
-    color: np.ndarray      # (H, W, 3) float32, background where missed
-    alpha: np.ndarray      # (H, W) float32, 1 on a hit
-    depth: np.ndarray      # (H, W) float32, distance along the unit 4D ray; +inf on a miss
-    normal: np.ndarray     # (H, W, 3) float32, unit, camera coordinates; 0 on a miss
-    position: np.ndarray   # (H, W, 4) float32, the 4D hit point; NaN on a miss
-    status: np.ndarray     # (H, W) int32, STATUS_* per pixel
-    samples: np.ndarray    # (H, W) int32, set tests (fixed) or estimates (de) before the hit
-    bracket: np.ndarray = None  # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
+    # each array is None where the render was not asked to keep it (render(outputs=...))
+    color: np.ndarray | None     # (H, W, 3) float32, background where missed
+    alpha: np.ndarray | None     # (H, W) float32, 1 on a hit
+    depth: np.ndarray | None     # (H, W) float32, distance along the unit 4D ray; +inf on a miss
+    normal: np.ndarray | None    # (H, W, 3) float32, unit, camera coordinates; 0 on a miss
+    position: np.ndarray | None  # (H, W, 4) float32, the 4D hit point; NaN on a miss
+    status: np.ndarray | None    # (H, W) int32, STATUS_* per pixel
+    samples: np.ndarray | None   # (H, W) int32, set tests (fixed) or estimates (de) before the hit
+    bracket: np.ndarray = None   # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
+    counts: dict = field(default_factory=dict)  # pixels by status: "miss", "hit", "capped" (all tiles)
     device_name: str = ""
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
     kernel_seconds: float = 0.0  # the kernels alone
@@ -49,18 +52,23 @@ class RenderResult:
 
     @property
     def hit_fraction(self) -> float:
+        total = sum(self.counts.values())
+        if total:
+            return self.counts.get("hit", 0) / total
         return float(np.mean(self.status == STATUS_HIT))
 
     def bracket_stats(self) -> dict[str, float]:
         """p50 / p99 / max of the certified bracket width over the pixels hit (refine.cl):
         each hit's surface crossing lies within its width behind its depth.  NaN when
         nothing was hit."""
-        hit = self.status == STATUS_HIT
-        b = np.asarray(self.bracket, np.float64)[hit] if self.bracket is not None else np.empty(0)
+        if self.bracket is None:
+            b = np.empty(0, np.float32)
+        else:  # finite exactly on hits (march.cl), so this needs no status array
+            b = self.bracket[np.isfinite(self.bracket)]
         if b.size == 0:
             return {"p50": math.nan, "p99": math.nan, "max": math.nan}
-        return {"p50": float(np.percentile(b, 50)), "p99": float(np.percentile(b, 99)),
-                "max": float(b.max())}
+        p50, p99 = np.percentile(b, [50, 99])
+        return {"p50": float(p50), "p99": float(p99), "max": float(b.max())}
 
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
         """What a render says about itself: (header entries for PNG/EXR, the tail of the
@@ -93,18 +101,28 @@ class RenderResult:
     @property
     def capped(self) -> int:
         """Pixels whose march ran into the step cap (counted, never hidden)."""
+        if self.counts:
+            return int(self.counts.get("capped", 0))
         return int(np.sum(self.status == STATUS_CAPPED))
 
     def exr_channels(self) -> dict[str, np.ndarray]:
+        """The EXR channels of the outputs kept: RGBA, Z and Z.bracket, N.XYZ, P.XYZW."""
         f = np.float32
-        ch = {"R": self.color[..., 0], "G": self.color[..., 1], "B": self.color[..., 2],
-              "A": self.alpha, "Z": self.depth}
-        if self.bracket is not None:
-            ch["Z.bracket"] = self.bracket
-        for k, name in enumerate("XYZ"):
-            ch[f"N.{name}"] = self.normal[..., k]
-        for k, name in enumerate("XYZW"):
-            ch[f"P.{name}"] = self.position[..., k]
+        ch = {}
+        if self.color is not None:
+            ch.update({"R": self.color[..., 0], "G": self.color[..., 1], "B": self.color[..., 2]})
+        if self.alpha is not None:
+            ch["A"] = self.alpha
+        if self.depth is not None:
+            ch["Z"] = self.depth
+            if self.bracket is not None:
+                ch["Z.bracket"] = self.bracket
+        if self.normal is not None:
+            for k, name in enumerate("XYZ"):
+                ch[f"N.{name}"] = self.normal[..., k]
+        if self.position is not None:
+            for k, name in enumerate("XYZW"):
+                ch[f"P.{name}"] = self.position[..., k]
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
 
 
@@ -142,7 +160,9 @@ def queue_for(device: cl.Device) -> tuple[cl.Context, cl.CommandQueue]:
     key = device.int_ptr
     if key not in _queues:
         ctx = cl.Context([device])
-        _queues[key] = (ctx, cl.CommandQueue(ctx))
+        # profiling: the kernels' own time, summed from their events (render's kernel_seconds)
+        _queues[key] = (ctx, cl.CommandQueue(
+            ctx, properties=cl.command_queue_properties.PROFILING_ENABLE))
     return _queues[key]
 
 
@@ -207,19 +227,19 @@ def march_items(n: int, tile_w: int, lanes: int) -> int:
 
 
 def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
-           items: int | None = None) -> None:
+           items: int | None = None) -> cl.Event | None:
     """Enqueue ``kernel`` over n items, ``lanes`` per work-item (packets of rays) or
-    ``items`` work-items: n_items = n first, then ``args``."""
+    ``items`` work-items: n_items = n first, then ``args``.  Returns the launch's event."""
     if n <= 0:
-        return
+        return None
     loc = local_size(kernel, queue.device)
     items = -(-n // lanes) if items is None else items
-    kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
+    return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
 
 
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
                    point, depth, status, normal, size: tuple[int, int] | None = None,
-                   lanes: int = 1) -> None:
+                   lanes: int = 1) -> cl.Event | None:
     """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
     device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
     image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
@@ -230,150 +250,195 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
     kernel = cl.Kernel(prg, f"normals_{method}")
     if method == "jacobian":
-        launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
-               right, up, fwd, normal.data, lanes=lanes)
-    elif method == "gradient":
-        launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter), pr.scalar(f.bailout),
-               pr.scalar(gradient_step(scene)), right, up, fwd, normal.data)
-    else:
-        launch(queue, kernel, n, point.data, depth.data, status.data, np.int32(w), np.int32(h), eye, right,
-               up, fwd, normal.data)
+        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
+                      pr.scalar(f.bailout), right, up, fwd, normal.data, lanes=lanes)
+    if method == "gradient":
+        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
+                      pr.scalar(f.bailout), pr.scalar(gradient_step(scene)), right, up, fwd, normal.data)
+    return launch(queue, kernel, n, point.data, depth.data, status.data, np.int32(w), np.int32(h), eye,
+                  right, up, fwd, normal.data)
 
 
-# Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
-# which difference neighbours): device memory stays under ~28 MB single / ~48 MB double
-# at any image size, no launch runs for minutes, and the progress bar moves per tile;
-# 262,144 work-items per launch still fill a large GPU.
-TILE = 512
+
+# The device buffers each output needs (march.cl, normals_*.cl, shade.cl); status, flags,
+# depth, bracket and the normals' guard word are read back always (one tile's worth): the
+# streamed counts, guards and bracket statistics come from them.
+_READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket": ("bracket",),
+         "normal": ("normal",), "position": ("point",), "status": ("status",),
+         "samples": ("samples",)}
 
 
-def tiles(width: int, height: int, tile: int = TILE):
-    """(x0, y0, w, h) of the image's tiles, row by row."""
-    for y0 in range(0, height, tile):
-        for x0 in range(0, width, tile):
-            yield x0, y0, min(tile, width - x0), min(tile, height - y0)
+class TileRunner:
+    """The kernels of one plan on one device, with two slots of tile buffers (device and
+    host staging) so that one tile's kernels run while the previous one is filed."""
+
+    SLOTS = 2
+
+    def __init__(self, plan: Plan, dev: cl.Device):
+        self.plan = plan
+        self.ctx, self.queue = queue_for(dev)
+        self.prg = build.program(self.ctx, plan.program)
+        self.march_prg = (self.prg if plan.march_program == plan.program
+                          else build.program(self.ctx, plan.march_program))
+        self.pr = pr = Precision(plan.double)
+        sc, f, m, sh = plan.scene, plan.scene.fractal, plan.scene.march, plan.scene.shading
+        nmax = max(t.n for t in plan.tiles)
+        read = {"status", "flags", "depth", "bracket"} | {b for k in plan.outputs for b in _READ[k]}
+        if plan.normals:
+            read.add("normal")
+        self.read = read
+        self.slots = []
+        for _ in range(self.SLOTS):
+            bufs = {"depth": cla.empty(self.queue, nmax, pr.scalar),
+                    "bracket": cla.empty(self.queue, nmax, pr.scalar),
+                    "point": cla.empty(self.queue, nmax, pr.vec_dtype),
+                    "status": cla.empty(self.queue, nmax, np.int32),
+                    "samples": cla.empty(self.queue, nmax, np.int32),
+                    "flags": cla.empty(self.queue, nmax, np.int32)}
+            if plan.normals:
+                bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
+            if plan.shades:
+                bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
+            self.slots.append((bufs, stage))
+        fr = plan.frame
+        self.eye, self.fwd, self.right, self.up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
+        self.camera = (self.eye, self.fwd, self.right, self.up, pr.scalar(fr.tan_half_fov),
+                       np.int32(sc.image.width), np.int32(sc.image.height))
+        self.march_const = (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(m.epsilon),
+                            pr.scalar(plan.radius), pr.scalar(plan.near), pr.scalar(plan.far),
+                            np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
+        self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(plan.light),
+                            _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
+                            np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
+                            np.float32(sh.shininess))
+        self.march_k = cl.Kernel(self.march_prg, "march")
+        self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
+
+    def enqueue(self, tile: Tile, slot: int) -> tuple[list[cl.Event], list[cl.Event]]:
+        """Queue the tile's kernels and the copies of what is read back into ``slot``:
+        (kernel events, copy events); nothing waits."""
+        plan, pr, q = self.plan, self.pr, self.queue
+        bufs, stage = self.slots[slot]
+        n = tile.n
+        kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
+                          np.int32(tile.ay0), *self.march_const, bufs["depth"].data, bufs["point"].data,
+                          bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
+                          bufs["bracket"].data, items=march_items(n, tile.aw, plan.lanes))]
+        if plan.normals:
+            method = plan.scene.normals.method
+            packet = plan.normals_in_march_program
+            kernels.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, method,
+                                          plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
+                                          bufs["normal"], size=(tile.aw, tile.ah),
+                                          lanes=plan.lanes if packet else 1))
+        if plan.shades:
+            kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
+                                  bufs["point"].data, *self.shade_const, bufs["rgba"].data))
+        copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
+        return kernels, copies
+
+    def collect(self, tile: Tile, slot: int) -> dict[str, np.ndarray]:
+        """The slot's staged arrays of ``tile``, shaped (ah, aw[, 4]) over its box (valid once
+        the slot's copy events have completed)."""
+        _, stage = self.slots[slot]
+        n, shape = tile.n, (tile.ah, tile.aw)
+        out = {}
+        for k in self.read:
+            a = stage[k][:n]
+            if k in ("point", "normal"):
+                out[k] = a.view(self.pr.scalar).reshape(*shape, 4)
+            elif k == "rgba":
+                out[k] = a.view(np.float32).reshape(*shape, 4)
+            else:
+                out[k] = a.reshape(shape)
+        return out
+
+
+def _seconds(events) -> float:
+    """The device time of completed, profiled events."""
+    total = 0
+    for ev in events:
+        if ev is not None:
+            total += ev.profile.end - ev.profile.start
+    return total * 1e-9
 
 
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
-           force: bool = False, tile: int = TILE, lanes: int | None = None) -> RenderResult:
+           force: bool = False, tile: int = TILE, lanes: int | None = None,
+           outputs=None) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
-    (lanes.lanes_for); the tests and the width probe use it."""
+    (lanes.lanes_for); the tests and the width probe use it.  ``outputs`` names the arrays
+    kept (workload.OUTPUTS; None: all): a depth-only render of any size keeps 8 bytes per
+    pixel on the host (depth and its bracket) and two tiles on the device."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
-    workload.check(scene, dev, force=force)  # before any kernel: hopeless, overflowing or too large
     double = scene.render.float == "double"
-    if double and not has_fp64(dev):
-        raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
-    frame = camera_frame(scene)
-    ctx, queue = queue_for(dev)
-    prg = build.program(ctx, build.scene_config(scene))
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
-    march_prg = prg if lanes == 1 else build.program(ctx, build.march_config(scene, lanes))
-    pr = Precision(double)
+    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile)
+    if double and not has_fp64(dev):
+        raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
+    runner = TileRunner(plan, dev)
     W, H = scene.image.width, scene.image.height
-    f, m, sh = scene.fractal, scene.march, scene.shading
-    halo = 1 if scene.normals.method == "zbuffer" else 0
+    keep = plan.outputs
+    shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W),
+              "normal": (H, W, 3), "position": (H, W, 4), "status": (H, W), "samples": (H, W)}
+    img = {k: np.empty(shapes[k], np.int32 if k in ("status", "samples") else np.float32) for k in keep}
+    counts = {"miss": 0, "hit": 0, "capped": 0}
+    guards: dict[str, int] = {}
+    kernel_events: list = []
 
-    # the whole image on the host, float32 (workload.check refuses what would not fit)
-    color = np.empty((H, W, 3), np.float32)
-    alpha = np.empty((H, W), np.float32)
-    depth_img = np.empty((H, W), np.float32)
-    bracket_img = np.empty((H, W), np.float32)
-    normal_img = np.empty((H, W, 3), np.float32)
-    position = np.empty((H, W, 4), np.float32)
-    status_img = np.empty((H, W), np.int32)
-    samples_img = np.empty((H, W), np.int32)
-    guard_img = np.empty((H, W), np.int32)
+    def file(t: Tile, got: dict[str, np.ndarray]) -> None:
+        own, dst = t.own(), t.dst()
+        st = got["status"][own]
+        for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
+            counts[name] += int(np.count_nonzero(st == code))
+        guard = got["flags"][own]
+        if "normal" in got:  # guard flags (kernels/real.cl): the march's buffer and the normals' w
+            guard = guard | got["normal"][own][..., 3].astype(np.int32)
+        for k, v in count_guards(st, got["depth"][own], guard).items():
+            guards[k] = guards.get(k, 0) + v
+        if "color" in keep:
+            img["color"][dst] = got["rgba"][own][..., :3]
+        if "alpha" in keep:
+            img["alpha"][dst] = got["rgba"][own][..., 3] if "rgba" in got else (st == STATUS_HIT)
+        for k, src in (("depth", "depth"), ("bracket", "bracket"), ("status", "status"),
+                       ("samples", "samples")):
+            if k in keep:
+                img[k][dst] = got[src][own]
+        if "normal" in keep:
+            img["normal"][dst] = got["normal"][own][..., :3]
+        if "position" in keep:
+            img["position"][dst] = got["point"][own]
 
-    # device buffers for the largest tile, reused
-    tw_max, th_max = min(tile, W) + 2 * halo, min(tile, H) + 2 * halo
-    nmax = tw_max * th_max
-    origins, dirs, point, normal = (cla.empty(queue, nmax, pr.vec_dtype) for _ in range(4))
-    depth, bracket = (cla.empty(queue, nmax, pr.scalar) for _ in range(2))
-    status, samples, flags = (cla.empty(queue, nmax, np.int32) for _ in range(3))
-    rgba = cla.empty(queue, nmax, cl.cltypes.float4)
-    buffers = {"rgba": rgba, "depth": depth, "bracket": bracket, "normal": normal, "point": point,
-               "status": status, "samples": samples, "flags": flags}
-    stage = {name: np.empty(nmax, buf.dtype) for name, buf in buffers.items()}
-
-    eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
-    c = pr.v4(f.c)
-    near = -1.0 if m.near == "auto" else float(m.near)
-    far = -1.0 if m.far == "auto" else float(m.far)
-    march_const = (c, np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(m.epsilon),
-                   pr.scalar(march_radius(scene)), pr.scalar(near), pr.scalar(far),
-                   np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
-    lp = light_position(scene)
-    light = pr.v4(lp if lp is not None else frame.position)
-    rays_k, shade_k = (cl.Kernel(prg, k) for k in ("generate_rays", "shade"))
-    march_k = cl.Kernel(march_prg, "march")
-
-    queue.finish()
-    kernel_seconds = 0.0
     with tqdm(total=W * H, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
               disable=not progress, desc="render") as bar:
-        for x0, y0, tw, th in tiles(W, H, tile):
-            t0 = time.perf_counter()
-            # the tile with its halo, clipped to the image
-            ax0, ay0 = max(0, x0 - halo), max(0, y0 - halo)
-            ax1, ay1 = min(W, x0 + tw + halo), min(H, y0 + th + halo)
-            aw, ah = ax1 - ax0, ay1 - ay0
-            n = aw * ah
-            launch(queue, rays_k, n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov), np.int32(W),
-                   np.int32(H), np.int32(ax0), np.int32(ay0), np.int32(aw), origins.data, dirs.data)
-            launch(queue, march_k, n, np.int32(aw), origins.data, dirs.data, *march_const, depth.data,
-                   point.data, status.data, samples.data, flags.data, bracket.data,
-                   items=march_items(n, aw, lanes))
-            if scene.normals.method == "jacobian":   # in packets too (build.march_config)
-                launch_normals(queue, march_prg, scene, "jacobian", frame, pr, point, depth, status,
-                               normal, size=(aw, ah), lanes=lanes)
-            else:
-                launch_normals(queue, prg, scene, scene.normals.method, frame, pr, point, depth, status,
-                               normal, size=(aw, ah))
-            launch(queue, shade_k, n, status.data, normal.data, point.data, eye, right, up, fwd, light,
-                    _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
-                    np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-                    np.float32(sh.shininess), rgba.data)
-            queue.finish()
-            kernel_seconds += time.perf_counter() - t0
-
-            # the tile's own pixels, without the halo
-            ys, xs = slice(y0 - ay0, y0 - ay0 + th), slice(x0 - ax0, x0 - ax0 + tw)
-            dst = (slice(y0, y0 + th), slice(x0, x0 + tw))
-
-            # the tile's n items into staging arrays made once (no allocation, no page
-            # faults per tile), all copies queued before one wait
-            for name, buf in buffers.items():
-                cl.enqueue_copy(queue, stage[name][:n], buf.data, is_blocking=False)
-            queue.finish()
-
-            def get(name, k=None):
-                a = stage[name][:n]
-                if k is not None:
-                    return a.view(pr.scalar).reshape(ah, aw, 4)[ys, xs, :k]
-                return a.reshape(ah, aw)[ys, xs]
-
-            col = stage["rgba"][:n].view(np.float32).reshape(ah, aw, 4)[ys, xs]
-            color[dst] = col[..., :3]
-            alpha[dst] = col[..., 3]
-            depth_img[dst] = get("depth")
-            bracket_img[dst] = get("bracket")
-            nrm = get("normal", 4)
-            normal_img[dst] = nrm[..., :3]
-            position[dst] = get("point", 4)
-            status_img[dst] = get("status")
-            samples_img[dst] = get("samples")
-            # guard flags (kernels/real.cl): the march's buffer and the normals' w
-            guard_img[dst] = get("flags") | nrm[..., 3].astype(np.int32)
-            bar.update(tw * th)
+        pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
+        for i, t in enumerate(plan.tiles):
+            slot = i % TileRunner.SLOTS
+            kernels, copies = runner.enqueue(t, slot)
+            if pending is not None:
+                _file_pending(runner, pending, file, kernel_events, bar)
+            pending = (t, slot, kernels, copies)
+        if pending is not None:
+            _file_pending(runner, pending, file, kernel_events, bar)
 
     result = RenderResult(
-        color=color, alpha=alpha, depth=depth_img, normal=normal_img, position=position,
-        status=status_img, samples=samples_img, bracket=bracket_img,
-        device_name=dev.name.strip(), kernel_seconds=kernel_seconds, lanes=lanes,
-        guards=count_guards(status_img, depth_img, guard_img))
+        color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
+        normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
+        samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
+        device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
+        guards=guards)
     result.seconds = time.perf_counter() - t_start
     return result
+
+
+def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -> None:
+    t, slot, kernels, copies = pending
+    cl.wait_for_events([e for e in copies])
+    kernel_events.extend(kernels)
+    file(t, runner.collect(t, slot))
+    bar.update(t.w * t.h)

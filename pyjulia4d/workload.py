@@ -138,7 +138,7 @@ def check_numerics(scene: Scene) -> None:
                           f"that spacing instead where the estimate is smaller (effective "
                           f'epsilon ~{ulp:.1e}, pixels counted as guards["ulp_step"]); raise it '
                           f'or use render.float="double"',
-                          RuntimeWarning, stacklevel=4)
+                          RuntimeWarning, stacklevel=5)
     # the fixed scan counts i = 0 .. z_resolution and post-stepping n = 1 .. post_steps in
     # an OpenCL int: at 2^31 - 1 the loop counter would overflow instead of ending
     for key, v in (("march.z_resolution", m.z_resolution), ("march.post_steps", m.post_steps)):
@@ -146,11 +146,30 @@ def check_numerics(scene: Scene) -> None:
             raise WorkloadError(key, f"must be below {2**31 - 2} (the kernel's int loop counter), got {v}")
 
 
-# Host memory per pixel: the result's float32 arrays (colour 12, alpha 4, depth 4, bracket 4,
-# normal 12, position 16, status 4, samples 4, guards 4 = 64 bytes) plus the copies the
-# PNG/EXR writers make (up to ~52 bytes).  The device holds one tile at a time (render.TILE).
-HOST_BYTES_PER_PIXEL = 128
+# What a render can keep on the host, per pixel (RenderResult's arrays, float32 / int32):
+# bytes each.  "bracket" is always kept: it is the depth's certificate and every render
+# reports its statistics.  The device holds two tiles at a time (plan.TILE), whatever the size.
+OUTPUT_BYTES = {"color": 12, "alpha": 4, "depth": 4, "bracket": 4, "normal": 12, "position": 16,
+                "status": 4, "samples": 4}
+OUTPUTS = tuple(OUTPUT_BYTES)
 HOST_MEMORY_SHARE = 0.5     # of the physical memory
+
+
+def resolve_outputs(outputs) -> frozenset[str]:
+    """The outputs kept: all (None) or the named ones, plus "bracket" (always)."""
+    if outputs is None:
+        return frozenset(OUTPUTS)
+    names = set(outputs)
+    unknown = sorted(names - set(OUTPUTS))
+    if unknown:
+        raise SceneError("outputs", f"unknown output {unknown[0]!r}; one of {', '.join(OUTPUTS)}")
+    return frozenset(names | {"bracket"})
+
+
+def host_bytes_per_pixel(outputs=None) -> int:
+    """Host memory per pixel of a render keeping ``outputs``: the arrays themselves, and as
+    much again for the copies the PNG/EXR writers make (contiguous channels, 8-bit RGBA)."""
+    return 2 * sum(OUTPUT_BYTES[k] for k in resolve_outputs(outputs))
 
 
 def physical_memory() -> int:
@@ -161,25 +180,27 @@ def physical_memory() -> int:
         return 0
 
 
-def check_memory(scene: Scene) -> None:
-    """Refuse an image whose result arrays would not fit in memory (always; not skipped by
-    force: it would fail, not merely take long).  Any size that fits renders, tile by tile."""
+def check_memory(scene: Scene, outputs=None) -> None:
+    """Refuse an image whose kept ``outputs`` (None: all) would not fit in memory (always; not
+    skipped by force: it would fail, not merely take long).  Any size that fits renders, tile
+    by tile, in the same device memory."""
     w, h = scene.image.width, scene.image.height
-    need = float(w) * h * HOST_BYTES_PER_PIXEL
+    per_pixel = host_bytes_per_pixel(outputs)
+    need = float(w) * h * per_pixel
     total = physical_memory()
     if total and need > HOST_MEMORY_SHARE * total:
         key = "image.width" if w >= h else "image.height"
-        most = int(HOST_MEMORY_SHARE * total / HOST_BYTES_PER_PIXEL)
+        most = int(HOST_MEMORY_SHARE * total / per_pixel)
         raise WorkloadError(key, f"{w}x{h} = {float(w) * h:.3g} pixels needs ~{need / 2**30:.3g} GiB "
-                                 f"of memory for the image ({HOST_BYTES_PER_PIXEL} bytes per pixel), over "
+                                 f"of memory for the image ({per_pixel} bytes per pixel), over "
                                  f"half of this machine's {total / 2**30:.3g} GiB; at most ~{most:.3g} pixels")
 
 
-def check(scene: Scene, device=None, force: bool = False) -> Estimate:
+def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estimate:
     """Before any kernel runs: refuse what the precision or the memory cannot hold, refuse work above
     REFUSE_ITERATIONS (unless ``force``), warn above WARN_ITERATIONS.  Returns the estimate."""
     check_numerics(scene)
-    check_memory(scene)
+    check_memory(scene, outputs)
     est = estimate(scene, device)
     text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
             f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
@@ -191,5 +212,5 @@ def check(scene: Scene, device=None, force: bool = False) -> Estimate:
                             f"(--force; render(..., force=True))")
     if est.iterations > WARN_ITERATIONS:
         warnings.warn(f"{est.dominant}: {_value(scene, est.dominant)} may take up to {text}",
-                      RuntimeWarning, stacklevel=3)
+                      RuntimeWarning, stacklevel=4)
     return est

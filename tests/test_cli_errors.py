@@ -64,6 +64,11 @@ BAD_ARGS = {
     "empty-set": (["--set", "="], "--set: missing key in '=', expected SECTION.KEY=VALUE"),
     "unknown-flag": (["--bogus"], "unrecognized arguments: --bogus (see --help)"),
     "missing-value": (["--width"], "argument --width: expected one argument (see --help)"),
+    "channels-png": (["--channels", "Z"], "--channels: 'Z': a PNG holds RGBA only; write .exr for Z, N or P"),
+    "channels-unknown": (["-o", "out.exr", "--channels", "Z,Q"],
+                         "--channels: unknown channel group 'Q'; use names from RGBA, Z, N, P"),
+    "channels-empty": (["-o", "out.exr", "--channels", ""],
+                       "--channels: '': empty name in the list; use names from RGBA, Z, N, P"),
 }
 
 
@@ -165,7 +170,7 @@ class FakeRender:
         self.calls: list[tuple] = []
         self.exc: BaseException | None = None
 
-    def __call__(self, scene, device=None, progress=False, force=False) -> FakeResult:
+    def __call__(self, scene, device=None, progress=False, force=False, outputs=None) -> FakeResult:
         self.calls.append((scene, device, progress))
         if self.exc is not None:
             raise self.exc

@@ -571,7 +571,7 @@ class Result:
     def report(self, stated_p99=None):
         return {}, ""
 
-def render(scene, device=None, progress=False, force=False):
+def render(scene, device=None, progress=False, force=False, outputs=None):
     if phase == "render":
         print("rendering", file=sys.stderr, flush=True)
         time.sleep(60)

@@ -14,7 +14,8 @@ W, H = 48, 36
 
 def run_march(s: Scene, lanes: int = 1):
     """Kernel and reference on the same (float32-representable) rays of a small image."""
-    R = Runner(build.march_config(s, lanes) if lanes > 1 else build.scene_config(s))
+    R = Runner(build.march_config(s, lanes, ray_buffers=True) if lanes > 1
+               else build.scene_config(s, ray_buffers=True))
     o, d = ref.generate_rays(camera_frame(s), W, H)
     o, d = o.astype(R.real).astype(float), d.astype(R.real).astype(float)
     f, m = s.fractal, s.march

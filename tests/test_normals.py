@@ -37,7 +37,8 @@ def test_normals_match_reference(method, lanes, fl, c):
         pytest.skip("packets are single precision")
     s = Scene.default().with_overrides([f"normals.method={method}", f"render.float={fl}",
                                         "fractal.c=" + ",".join(map(str, c))])
-    R = Runner(build.march_config(s, lanes) if lanes > 1 else build.scene_config(s))
+    R = Runner(build.march_config(s, lanes, ray_buffers=True) if lanes > 1
+               else build.scene_config(s, ray_buffers=True))
     fr = camera_frame(s)
     depth, point, status = hits(s, R.real)
     n = len(point)

@@ -1,0 +1,106 @@
+"""The render plan (pyjulia4d/plan.py) and its execution in tiles (render.TileRunner):
+outputs kept on request, device memory independent of the image size, a plan that travels."""
+import pickle
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from harness import device
+from pyjulia4d import workload
+from pyjulia4d.lanes import lanes_for
+from pyjulia4d.plan import TILE, make_plan, make_tiles
+from pyjulia4d.render import TileRunner, render
+from pyjulia4d.scene import Scene, SceneError
+
+SMALL = ["image.width=96", "image.height=72"]
+
+
+def test_tiles_cover_the_image_once():
+    for w, h, t, halo in [(96, 72, 16, 0), (97, 71, 16, 1), (5, 3, 512, 1), (1030, 520, 512, 0)]:
+        seen = np.zeros((h, w), int)
+        for tile in make_tiles(w, h, t, halo):
+            seen[tile.dst()] += 1
+            rows, cols = tile.own()
+            # the box holds the tile, reaches at most `halo` past it and stays in the image
+            assert rows.start >= 0 and cols.start >= 0 and rows.stop <= tile.ah and cols.stop <= tile.aw
+            assert 0 <= tile.ax0 <= tile.x0 and tile.x0 - tile.ax0 <= halo
+            assert tile.ax0 + tile.aw <= w and tile.ay0 + tile.ah <= h
+        assert (seen == 1).all()
+
+
+@pytest.mark.parametrize("normals", ["jacobian", "zbuffer"])
+def test_depth_only_gives_the_same_depth(normals):
+    # the depth-only render runs neither normals nor shading, yet its depth, bracket, counts
+    # and march guards are those of the full render, bit for bit
+    s = Scene.default().with_overrides(SMALL + [f"normals.method={normals}"])
+    full = render(s, tile=32)
+    part = render(s, tile=32, outputs=["depth"])
+    for k in ("color", "alpha", "normal", "position", "status", "samples"):
+        assert getattr(part, k) is None, k
+    np.testing.assert_array_equal(part.depth, full.depth)
+    np.testing.assert_array_equal(part.bracket, full.bracket)
+    assert part.counts == full.counts and part.hit_fraction == full.hit_fraction
+    assert part.bracket_stats() == full.bracket_stats()
+    for k in ("ulp_step", "shell_miss", "eye_hit"):
+        assert part.guards[k] == full.guards[k], k
+    assert set(part.exr_channels()) == {"Z", "Z.bracket"}
+    # counts streamed per tile agree with the full status image
+    assert full.counts["hit"] == int(np.sum(full.status == 1))
+    assert full.capped == int(np.sum(full.status == 2))
+
+
+def test_alpha_without_shading():
+    s = Scene.default().with_overrides(SMALL)
+    full = render(s)
+    a = render(s, outputs=["alpha", "normal"])
+    np.testing.assert_array_equal(a.alpha, full.alpha)
+    np.testing.assert_array_equal(a.normal, full.normal)
+    assert a.color is None
+
+
+def test_unknown_output_is_refused():
+    with pytest.raises(SceneError, match=r"^outputs: unknown output 'colour'"):
+        render(Scene.default().with_overrides(SMALL), outputs=["colour"])
+
+
+@pytest.mark.filterwarnings("ignore:image.width")
+def test_device_memory_does_not_grow_with_the_image():
+    # two tiles' buffers whatever the size: a 4096 x 4096 plan allocates what a 1024 x 600 one does
+    dev = device()
+    sizes = []
+    for w, h in [(1024, 600), (4096, 4096)]:
+        s = Scene.default().with_overrides([f"image.width={w}", f"image.height={h}"])
+        runner = TileRunner(make_plan(s, dev, lanes_for(dev, "auto", False), outputs=["depth"]), dev)
+        sizes.append(sum(b.nbytes for bufs, _ in runner.slots for b in bufs.values()))
+    assert sizes[0] == sizes[1] <= TileRunner.SLOTS * TILE * TILE * 56
+
+
+def test_host_memory_follows_the_outputs():
+    s = Scene.default().with_overrides(["image.width=20000", "image.height=20000"])
+    # depth only: depth and bracket, and as much again for the writer
+    assert workload.host_bytes_per_pixel(["depth"]) == 16
+    workload.check_memory(s, ["depth"])  # 6.4 GB: fits a machine of 16 GB or more
+    if workload.physical_memory() and workload.physical_memory() < 1e12:
+        with pytest.raises(SceneError, match="^image.width: 20000x20000"):
+            workload.check_memory(s)
+
+
+def test_plan_pickles():
+    # a tile can be sent elsewhere as it is: the plan is plain values
+    s = Scene.default().with_overrides(SMALL)
+    p = make_plan(s, "CPU", 16, outputs=["depth"])
+    q = pickle.loads(pickle.dumps(p))
+    assert q.tiles == p.tiles and q.scene == s and q.outputs == p.outputs
+    np.testing.assert_array_equal(q.frame.right, p.frame.right)
+
+
+def test_cli_depth_only_exr(tmp_path):
+    import OpenEXR
+
+    out = tmp_path / "d.exr"
+    r = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "-o", str(out), "--width", "40",
+                        "--height", "30", "--channels", "Z"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert sorted(OpenEXR.File(str(out)).channels()) == ["Z", "Z.bracket"]
