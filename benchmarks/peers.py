@@ -1,20 +1,47 @@
-"""pyjulia4d beside POV-Ray's julia_fractal: pixels per CPU-second on the same scene.
+"""pyjulia4d beside POV-Ray's julia_fractal and Mandelbulber2: pixels per CPU-second on the same scene.
 
 The scene is pyjulia4d's default (c = -0.2 + 0.8i, quaternion sqr, 12 iterations, the eye
 at (1.8, 1.6, -2.2) looking at the origin, 40 degrees vertical field of view, a light at the
 eye), written as POV-Ray 3.7 SDL (seed 003's julia_fractal: `max_iteration 12`, POV-Ray's
 default `precision 20`; a shadowless light, since pyjulia4d traces no shadow rays; the
-horizontal angle POV-Ray wants from the vertical one).  Runs alternate, --repeats each:
+horizontal angle POV-Ray wants from the vertical one) and as a Mandelbulber2 2.20 settings
+file (formula 5 "quaternion", julia_mode, N 12, bailout 4 as pyjulia4d's escape radius;
+that formula is 3D, z -> (x^2-y^2-z^2, 2xy, 2xz) + c, which is the quaternion square on the
+w = 0 slice exactly, since a k component that starts at 0 with c's at 0 stays 0.
+Mandelbulber is z-up and right-handed where pyjulia4d and POV-Ray are y-up and left-handed,
+so points go over as (x, y, z) -> (x, z, y); its quaternion then reads x + z i + y j, so c
+goes over with i and j swapped (julia_c = (c0, c2, c1)): swapping i and j (with k -> -k) is
+an automorphism of the quaternions, so the set lands exactly where (x, z, y) puts it.  Its
+fov is 2 tan(vertical angle / 2); one directional light from the camera (main_light_alpha
+= beta = 0, relative), no shadows, no ambient occlusion, glow, fog, reflections, DOF or
+anti-aliasing; a black background and a 16-bit PNG with alpha).  Runs alternate, --repeats
+each:
 
 * POV-Ray (Debian's `povray`, never a dependency): its own report of the trace's CPU
   seconds ("Trace Time ... using N thread(s) with X CPU-seconds total"), which leaves
   out start-up and parsing;
+* Mandelbulber2 (Debian's `mandelbulber2` 2.20, never a dependency; headless with
+  `QT_QPA_PLATFORM=offscreen mandelbulber2 --nogui --format png16alpha --res WxH
+  --output STEM --override KEY=V#... FILE.fract`): it reports only wall-clock time, so
+  its CPU seconds are getrusage(RUSAGE_CHILDREN) around the process, minus those of the
+  same command at 8x6 pixels run just before (start-up, loading and the OpenCL build are
+  left out by that difference; writing the larger PNG stays in).  Each kind is run once
+  at 8x6 first, the OpenCL ones at the full size too, to warm caches (PoCL builds a
+  kernel per work-group size into its disk cache).  Its CPU path (its own threads, double
+  precision) and, where its OpenCL path starts, that too (`opencl_enabled=1`, device type
+  cpu: the system's PoCL through the ICD loader; its defaults: mode full, single
+  precision).  Each at two surface thresholds: its default (detail_level 1: the distance
+  estimate below one pixel's footprint, about 5e-3 at this distance and size) and a
+  constant 1e-3, pyjulia4d's march.epsilon (constant_DE_threshold) - the finer one gives
+  nearly pyjulia4d's silhouette;
 * pyjulia4d: a child process renders once to build and warm up, then the scene; the CPU
   seconds of that render (user + system of the whole process, PoCL's threads included,
   getrusage) - start-up, imports and the build left out; `march.quality` presets too.
 
-Reports pixels per CPU-second, the ratio to POV-Ray, and the share of pixels hit (POV-Ray's
-from the alpha of its PNG).  POV-Ray is skipped with a message where it is not installed.
+Reports pixels per CPU-second, the ratio to POV-Ray, the ratio of pyjulia4d's default to
+each row, and the share of pixels hit (POV-Ray's and Mandelbulber2's from the alpha of
+their PNGs).  POV-Ray and Mandelbulber2 are each skipped with a message where they are not
+installed (Mandelbulber2's OpenCL rows too where its OpenCL does not start).
 Writes benchmarks/results/peers.md (appends a section per run).
 
     python benchmarks/peers.py [--size 640x480] [--repeats 3]
@@ -24,7 +51,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -71,6 +100,62 @@ print(json.dumps({"cpu": cpu() - c0, "wall": time.perf_counter() - t0, "hit": r.
                   "device": r.device_name}))
 """
 
+# Mandelbulber2 2.20 settings ("only modified parameters"; the rest keep their defaults)
+MB_SETTINGS = """# Mandelbulber settings file
+# version 2.20
+# only modified parameters
+[main_parameters]
+ambient_occlusion_enabled false;
+antialiasing_enabled false;
+background_3_colors_enable false;
+background_color_1 0000 0000 0000;
+background_color_2 0000 0000 0000;
+background_color_3 0000 0000 0000;
+bailout {bailout};
+basic_fog_enabled false;
+camera {camera};
+camera_top {top};
+DOF_enabled false;
+fov {fov};
+formula_1 5;
+glow_enabled false;
+image_height {h};
+image_width {w};
+julia_c {julia_c};
+julia_mode true;
+main_light_alpha 0;
+main_light_beta 0;
+main_light_position_relative true;
+main_light_visibility 0;
+mat1_specular 1;
+mat1_surface_color {color};
+mat1_surface_gradient_enable false;
+N {max_iter};
+raytraced_reflections false;
+shadows_enabled false;
+target {target};
+use_default_bailout false;
+volumetric_fog_enabled false;
+[fractal_1]
+[fractal_2]
+[fractal_3]
+[fractal_4]
+[fractal_5]
+[fractal_6]
+[fractal_7]
+[fractal_8]
+[fractal_9]
+"""
+
+MB_CPU = "opencl_enabled=0"
+MB_OPENCL = "opencl_enabled=1#opencl_platform=0#opencl_device_type=3"  # 3: "cpu" (PoCL)
+MB_FINE = "constant_DE_threshold=1#DE_thresh=0.001"                   # pyjulia4d's march.epsilon
+MB_VARIANTS = {"Mandelbulber2 2.20 CPU, threshold 1 px (default)": (MB_CPU, False),
+               "Mandelbulber2 2.20 CPU, threshold 1e-3": (MB_CPU + "#" + MB_FINE, False),
+               "Mandelbulber2 2.20 OpenCL (PoCL), threshold 1 px (default)": (MB_OPENCL, True),
+               "Mandelbulber2 2.20 OpenCL (PoCL), threshold 1e-3": (MB_OPENCL + "#" + MB_FINE, True)}
+MB_TINY = (8, 6)  # the start-up run: its CPU seconds are taken from the full render's
+
 VARIANTS = {"pyjulia4d default": [], "pyjulia4d march.quality=draft": ["march.quality=draft"],
             "pyjulia4d march.quality=normal": ["march.quality=normal"]}
 
@@ -101,6 +186,85 @@ def run_povray(w: int, h: int, tmp: Path) -> dict:
     return {"cpu": float(m.group(1)), "hit": float(np.mean(alpha > 0))}
 
 
+def mb_settings(w: int, h: int) -> str:
+    """pyjulia4d's default scene as a Mandelbulber2 settings file (see the docstring: y-up
+    left-handed (x, y, z) -> z-up right-handed (x, z, y), c's i and j swapped)."""
+    from pyjulia4d.scene import Scene
+
+    s = Scene.default()
+    cam, f = s.camera, s.fractal
+    if (f.c[3] != 0 or cam.position[3] != 0 or cam.target[3] != 0 or cam.up[3] != 0
+            or tuple(s.slice.normal) != (0, 0, 0, 1) or s.slice.distance != 0 or s.shading.light != "eye"):
+        raise ValueError("the default scene is no longer a w = 0 slice with c's k at 0 and a light "
+                         "at the eye: Mandelbulber2's 3D quaternion formula cannot render it")
+
+    def num(x) -> str:
+        return repr(float(x))
+
+    def vec(v) -> str:  # pyjulia4d (x, y, z) -> Mandelbulber2 (x, z, y); for c: i <-> j
+        return f"{num(v[0])} {num(v[2])} {num(v[1])}"
+
+    color = " ".join(f"{round(min(max(x, 0.0), 1.0) * 65535):04x}" for x in s.shading.color)
+    return MB_SETTINGS.format(bailout=num(f.bailout), camera=vec(cam.position), top=vec(cam.up),
+                              target=vec(cam.target), fov=num(2 * math.tan(math.radians(cam.fov) / 2)),
+                              w=w, h=h, julia_c=vec(f.c), color=color, max_iter=f.max_iter)
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def _mb_render(src: Path, w: int, h: int, over: str, out: Path, env: dict) -> tuple[float, str]:
+    """One mandelbulber2 --nogui render to out.png: (CPU seconds of the process, its output)."""
+    out.with_suffix(".png").unlink(missing_ok=True)
+    c0 = _children_cpu()
+    p = subprocess.run(["mandelbulber2", "--nogui", "--format", "png16alpha", "--res", f"{w}x{h}",
+                        "--output", str(out), "--override", over, str(src)],
+                       capture_output=True, text=True, cwd=src.parent, env=env, timeout=3600)
+    cpu = _children_cpu() - c0
+    log = (p.stdout + p.stderr).replace("\r", "\n")
+    if p.returncode != 0 or not out.with_suffix(".png").exists():
+        last = [ln for ln in log.splitlines() if ln.strip()] or ["?"]
+        raise RuntimeError(f"mandelbulber2 failed (exit {p.returncode}): {last[-1].strip()}")
+    return cpu, log
+
+
+def mb_env(tmp: Path) -> dict:
+    return {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_RUNTIME_DIR": str(tmp)}
+
+
+def mb_warm(w: int, h: int, tmp: Path, over: str, opencl: bool) -> str | None:
+    """Warm-up renders at MB_TINY and, with OpenCL, at w x h too (PoCL compiles a kernel per
+    work-group size, into its disk cache); None if they rendered (with OpenCL where asked),
+    else why not."""
+    src = tmp / "julia.fract"
+    src.write_text(mb_settings(w, h))
+    for size in [MB_TINY, (w, h)] if opencl else [MB_TINY]:
+        try:
+            _, log = _mb_render(src, *size, over, tmp / "mb_warm", mb_env(tmp))
+        except RuntimeError as e:
+            return str(e)
+        if opencl and "OpenCl - rendering" not in log:
+            errs = [ln.strip() for ln in log.splitlines() if "opencl" in ln.lower() or "error" in ln.lower()]
+            return "its OpenCL path did not start" + (f" ({errs[-1]})" if errs else "")
+    return None
+
+
+def run_mandelbulber(w: int, h: int, tmp: Path, over: str) -> dict:
+    """CPU seconds of a w x h render less those of the same render at MB_TINY just before."""
+    src = tmp / "julia.fract"
+    src.write_text(mb_settings(w, h))
+    env = mb_env(tmp)
+    tiny, _ = _mb_render(src, *MB_TINY, over, tmp / "mb_tiny", env)
+    full, _ = _mb_render(src, w, h, over, tmp / "mb", env)
+    from PIL import Image
+
+    alpha = np.asarray(Image.open(tmp / "mb.png").convert("RGBA"))[..., 3]
+    return {"cpu": max(full - tiny, 0.0), "cpu_process": full, "cpu_startup": tiny,
+            "hit": float(np.mean(alpha > 0))}
+
+
 def run_pyjulia4d(over: list[str]) -> dict:
     p = subprocess.run([sys.executable, "-c", CHILD, *over], capture_output=True, text=True, cwd=ROOT,
                        timeout=3600)
@@ -120,29 +284,59 @@ def main(argv=None) -> int:
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
+    have_mb = shutil.which("mandelbulber2") is not None
+    if not have_mb:
+        print("mandelbulber2 not installed (Debian: apt-get install mandelbulber2): Mandelbulber2 skipped",
+              file=sys.stderr)
     runs: dict[str, list[dict]] = {}
     device = "?"
     with tempfile.TemporaryDirectory() as td:
+        mb_variants = {}
+        if have_mb:  # warm up each kind once (PoCL's kernel cache); drop what does not start
+            for name, (over, opencl) in MB_VARIANTS.items():
+                why = mb_warm(w, h, Path(td), over, opencl)
+                if why is None:
+                    mb_variants[name] = over
+                else:
+                    print(f"{name} skipped: {why}", file=sys.stderr)
         for _ in range(a.repeats):  # alternate, so the shared machine's load falls on all alike
             if have_pov:
                 runs.setdefault("POV-Ray 3.7 julia_fractal (precision 20)", []).append(run_povray(w, h, Path(td)))
+            for name, over in mb_variants.items():
+                runs.setdefault(name, []).append(run_mandelbulber(w, h, Path(td), over))
             for name, over in VARIANTS.items():
                 r = run_pyjulia4d(over + size)
                 device = r["device"]
                 runs.setdefault(name, []).append(r)
     px = w * h
+
+    def rate_of(rs: list[dict]) -> float:
+        cpu = statistics.median(r["cpu"] for r in rs)
+        return px / cpu if cpu > 0 else float("inf")  # a tiny image can report 0.000 s
+
     pov = runs.get("POV-Ray 3.7 julia_fractal (precision 20)")
-    pov_cpu = statistics.median(r["cpu"] for r in pov) if pov else 0.0
-    pov_rate = px / pov_cpu if pov_cpu > 0 else None   # a tiny image can report 0.000 s
+    pov_rate = rate_of(pov) if pov else None
+    pj_rate = rate_of(runs["pyjulia4d default"])
     lines = [f"\n## {utc_now()}, {w}x{h}, pyjulia4d on {device}, "
              f"commit {git_commit()}, median of {a.repeats} alternating runs\n",
-             "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pixels hit |", "|---|---|---|---|---|"]
+             "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pyjulia4d default / this "
+             "| pixels hit |", "|---|---|---|---|---|---|"]
     for name, rs in runs.items():
         cpu = statistics.median(r["cpu"] for r in rs)
-        rate = px / cpu if cpu > 0 else float("inf")
-        ratio = f"{rate / pov_rate:.2f}" if pov_rate else "-"
-        lines.append(f"| {name} | {cpu:.3f} | {rate:.3g} | {ratio} | {100 * statistics.median(r['hit'] for r in rs):.1f} % |")
+        rate = rate_of(rs)
+        ratio = f"{rate / pov_rate:.2f}" if pov_rate and math.isfinite(pov_rate) and rate > 0 else "-"
+        pj = f"{pj_rate / rate:.2f}" if math.isfinite(rate) and math.isfinite(pj_rate) and rate > 0 else "-"
+        lines.append(f"| {name} | {cpu:.3f} | {rate:.3g} | {ratio} | {pj} "
+                     f"| {100 * statistics.median(r['hit'] for r in rs):.1f} % |")
         print(lines[-1], flush=True)
+    mb_rows = {n: rs for n, rs in runs.items() if n.startswith("Mandelbulber2")}
+    if mb_rows:
+        notes = ", ".join(f"{n.removeprefix('Mandelbulber2 2.20 ')} {statistics.median(r['cpu_process'] for r in rs):.3f}"
+                          f" - {statistics.median(r['cpu_startup'] for r in rs):.3f}" for n, rs in mb_rows.items())
+        lines.append(f"\nMandelbulber2 reports only wall-clock time: its CPU s are those of the process at "
+                     f"{w}x{h} less those of the same command at {MB_TINY[0]}x{MB_TINY[1]} just before "
+                     f"(start-up, loading, OpenCL build; medians, s: {notes}).")
+        print(lines[-1].strip(), flush=True)
     md = a.out / "peers.md"
     append_run(md, "# pyjulia4d beside its peers\n\nWritten by `python benchmarks/peers.py` (see its "
                "docstring: the scene, what is timed, what is left out).\n", "\n".join(lines) + "\n")
