@@ -34,7 +34,7 @@ kernels, each run on the same march output.
 
 A second phase times ITP against bisection interleaved (alternating renders of the two
 at equal post_steps, so both see the same machine load) and counts the set tests each
-refinement takes with a float32 twin of kernels/refine.cl (``refine_tests``) started
+refinement takes with a float32 twin of kernels/march/refine.cl (``refine_tests``) started
 from the march's own brackets.
 
 Writes to --out (default benchmarks/results/): error_vs_time.csv, error_vs_time.md,
@@ -213,7 +213,7 @@ def git_head() -> str:
 # ------------------------------------------------------------------ normals
 
 class NormalKernels:
-    """The normal kernels of kernels/normals_*.cl run on one march output, so all three
+    """The normal kernels of kernels/normals/*.cl run on one march output, so all three
     methods are measured on exactly the same hit points without re-marching."""
 
     def __init__(self, dev):
@@ -222,7 +222,7 @@ class NormalKernels:
 
     def __call__(self, scene: Scene, res, method: str) -> np.ndarray:
         pr = Precision(scene.render.float == "double")
-        cfg = build.KernelConfig(build.iteration_pieces(scene) + (f"normals_{method}",),
+        cfg = build.KernelConfig(build.iteration_pieces(scene) + (f"normals/{method}",),
                                  build.precision_defines(scene))
         prg = build.program(self.ctx, cfg)
         q = self.queue
@@ -318,7 +318,7 @@ def pareto(rows: list[dict], xkey="kernel_s", ykey="depth_err_p99") -> set[int]:
 # ------------------------------------------------------------ ITP vs bisection
 
 def refine_tests(scene: Scene, r0, steps: int, itp: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Set tests each hit ray's refinement takes, by a float32 twin of kernels/refine.cl
+    """Set tests each hit ray's refinement takes, by a float32 twin of kernels/march/refine.cl
     (bracket arithmetic in float32 like the kernel, so both stop where the bracket cannot
     be split; the level function and the set test in float64 at the float32 points) started
     from ``r0``'s brackets (a render with post_steps 0: [depth, depth + bracket] is the
@@ -619,7 +619,7 @@ def itp_markdown(itp_rows: list[dict]) -> list[str]:
          f"Same march, same guaranteed bracket (h / 2^post_steps). Kernel times: medians of {ITP_REPEATS} renders each "
          "of ITP, bisection and the same march without post-steps, alternated in rotating order so all three see the "
          "same load; refine s = a median less the post-0 median (summed over the scenes; the shared machine's noise "
-         "is of the order of these differences). Set tests per hit ray by a float32 twin of kernels/refine.cl from "
+         "is of the order of these differences). Set tests per hit ray by a float32 twin of kernels/march/refine.cl from "
          "the march's own brackets (ITP also evaluates the level function at the two ends once: + 2), median over "
          "the scenes.", "",
          "| setting | march samples (median) | set tests ITP (+2) | set tests bisect | kernel s post 0 | kernel s ITP | "

@@ -11,6 +11,11 @@ __kernel void probe_iterate(const int n_items, __global const real4 *points, con
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     int escaped;
     inside[i] = julia_inside(points[i], jp);
+#ifdef ALG_HAS_DE
     distance[i] = julia_distance(points[i], jp);
     formula[i] = julia_distance_formula(points[i], jp, &escaped);
+#else
+    distance[i] = NAN;   /* no distance estimate for this algebra and function */
+    formula[i] = NAN;
+#endif
 }

@@ -89,6 +89,7 @@ typedef real4 quat;
 #define QSCALE(s, q) ((s) * (q))
 #define QDOT_UNIFORM(q, v) dot((q), (v))
 #define L_TRUE 1
+#define convert_lreal(m) ((real)(m))
 #else
 #ifdef REAL_DOUBLE
 #error "packets of rays are single precision (LANES > 1 with REAL_DOUBLE)"
@@ -111,6 +112,7 @@ inline lreal QDOT_UNIFORM(quat a, real4 v) { return a.x * v.x + a.y * v.y + a.z 
 inline lreal QLEN(quat q) { return sqrt(QNORM2(q)); }
 inline quat QSCALE(lreal s, quat q) { return QUAT(s * q.x, s * q.y, s * q.z, s * q.w); }
 #define L_TRUE (-1)
+#define convert_lreal(m) CAT(convert_float, LANES)(m)
 inline quat QSEL(quat a, quat b, lmask m)
 {
     return QUAT(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m), select(a.w, b.w, m));

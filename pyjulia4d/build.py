@@ -19,7 +19,7 @@ import pyopencl as cl
 
 from .devices import cache_dir, cannot_compile, compile_error, device_key
 from .resources import kernel_dir
-from .scene import Scene
+from .scene import Scene, march_method
 
 
 @dataclass(frozen=True)
@@ -30,8 +30,19 @@ class KernelConfig:
 
 
 def iteration_pieces(scene: Scene) -> tuple[str, ...]:
+    """real.cl, complex arithmetic, the scene's one function (function/<name>.cl: a complex
+    function and its derivative) and one algebra (algebra/<name>.cl: the map q -> f(q) + c
+    built from them), the iteration."""
     f = scene.fractal
-    return ("real", f"algebra_{f.algebra}", f"function_{f.function}", "iterate")
+    return ("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}", "iterate")
+
+
+def fractal_defines(scene: Scene) -> tuple[str, ...]:
+    """pwr's complex exponent, compiled in (function/pwr.cl)."""
+    f = scene.fractal
+    if f.function != "pwr":
+        return ()
+    return (f"FUNC_EXPONENT_RE={f.exponent[0]!r}", f"FUNC_EXPONENT_IM={f.exponent[1]!r}")
 
 
 def precision_defines(scene: Scene) -> tuple[str, ...]:
@@ -44,13 +55,13 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     instead (the tests' and benchmarks' arbitrary rays)."""
     m = scene.march
     pieces = list(iteration_pieces(scene))
-    defines = list(precision_defines(scene))
-    pieces.append("refine")
+    defines = list(precision_defines(scene)) + list(fractal_defines(scene))
+    pieces.append("march/refine")
     if m.refine == "itp":
         defines.append("REFINE_ITP")
     if ray_buffers:
         defines.append("RAYS_FROM_BUFFERS")
-    pieces += [f"march_{m.method}", "rays", "march", f"normals_{scene.normals.method}", "shade"]
+    pieces += [f"march/{march_method(scene)}", "rays", "march/march", f"normals/{scene.normals.method}", "shade"]
     if scene.shading.specular > 0:
         defines.append("SPECULAR")
     if not isinstance(scene.shading.light, str):
@@ -72,12 +83,12 @@ def packet_block(lanes: int) -> tuple[int, int]:
 def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
     """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
     per work-item (-D LANES, kernels/real.cl): the same pieces as scene_config up to
-    march.cl; rays, shading and the other normals stay one per work-item in the scene's
+    march/march.cl; rays, shading and the other normals stay one per work-item in the scene's
     program."""
     cfg = scene_config(scene, ray_buffers)
-    pieces = cfg.pieces[: cfg.pieces.index("march") + 1]
+    pieces = cfg.pieces[: cfg.pieces.index("march/march") + 1]
     if scene.normals.method == "jacobian":
-        pieces += ("normals_jacobian",)
+        pieces += ("normals/jacobian",)
     if lanes == 1:
         return KernelConfig(pieces, cfg.defines)
     bw, bh = packet_block(lanes)
@@ -86,7 +97,7 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
 
 def probe_config(scene: Scene) -> KernelConfig:
     """The iteration alone, wrapped for the tests (kernels/probe.cl)."""
-    return KernelConfig(iteration_pieces(scene) + ("probe",), precision_defines(scene))
+    return KernelConfig(iteration_pieces(scene) + ("probe",), precision_defines(scene) + fractal_defines(scene))
 
 
 def source(config: KernelConfig) -> str:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import Scene, SceneError
+from .scene import POLYNOMIAL_DEGREE, Scene, SceneError, march_method
 
 
 def cross4(a, b, c) -> np.ndarray:
@@ -107,19 +107,24 @@ def light_position(scene: Scene) -> np.ndarray | None:
     return to_world(scene, scene.shading.light)
 
 
-def bounding_radius(c, bailout: float, max_iter: int) -> float:
+def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) -> float:
     """Radius of a 4-ball that provably holds every point with |q_n| <= bailout for
-    n = 0..max_iter (the set the fixed scan finds).
+    n = 0..max_iter (the set the fixed scan finds), for q -> q^degree + c.
 
-    With R = 1/2 + sqrt(1/4 + |c|), |q| = r > R gives |q^2 + c| >= r^2 - |c| > r, so
-    |q_n| >= g^n(r), g(r) = r^2 - |c|.  A point that stays within the bailout b after N
-    steps therefore has |q_0| <= g^-N(b) = h^N(b), h(s) = sqrt(s + |c|), and also
-    |q_0| <= b.  The bound shrinks from b towards R as N grows.
+    With R the root of r^D - |c| = r, |q| = r > R gives |q^D + c| >= r^D - |c| > r, so
+    |q_n| >= g^n(r), g(r) = r^D - |c|.  A point that stays within the bailout b after N
+    steps therefore has |q_0| <= g^-N(b) = h^N(b), h(s) = (s + |c|)^(1/D), and also
+    |q_0| <= b.  The bound shrinks from b towards R as N grows.  |q^D| >= |q|^D holds for
+    quaternions (|q^D| = |q|^D) and for the hypercomplex numbers (the power mean of the
+    split components, algebra/hypercomplex.cl).  ``degree`` None (a function that is no
+    polynomial): the bailout itself, the n = 0 test.
     """
+    if degree is None:
+        return float(bailout)
     cabs = float(np.linalg.norm(c))
     s = float(bailout)
     for _ in range(min(int(max_iter), 200)):  # h^N converges to R geometrically
-        s_next = math.sqrt(s + cabs)
+        s_next = (s + cabs) ** (1.0 / degree) if degree != 2 else math.sqrt(s + cabs)
         if abs(s_next - s) < 1e-15:
             break
         s = s_next
@@ -131,7 +136,7 @@ def march_radius(scene: Scene) -> float:
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
     estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
     f = scene.fractal
-    r = bounding_radius(f.c, f.bailout, f.max_iter)
-    if scene.march.method == "de":
+    r = bounding_radius(f.c, f.bailout, f.max_iter, POLYNOMIAL_DEGREE.get(f.function))
+    if march_method(scene) == "de":
         r += 4.0 * scene.march.epsilon
     return r

@@ -58,12 +58,12 @@ class RenderResult:
         return float(np.mean(self.status == STATUS_HIT))
 
     def bracket_stats(self) -> dict[str, float]:
-        """p50 / p99 / max of the certified bracket width over the pixels hit (refine.cl):
+        """p50 / p99 / max of the certified bracket width over the pixels hit (march/refine.cl):
         each hit's surface crossing lies within its width behind its depth.  NaN when
         nothing was hit."""
         if self.bracket is None:
             b = np.empty(0, np.float32)
-        else:  # finite exactly on hits (march.cl), so this needs no status array
+        else:  # finite exactly on hits (march/march.cl), so this needs no status array
             b = self.bracket[np.isfinite(self.bracket)]
         if b.size == 0:
             return {"p50": math.nan, "p99": math.nan, "max": math.nan}
@@ -139,13 +139,13 @@ def count_guards(status, depth, guard) -> dict[str, int]:
         return int(np.count_nonzero(m if on is None else m & on))
 
     return {
-        # de step below the spacing of t raised to one ulp (march_de.cl): effective epsilon = ulp(t)
+        # de step below the spacing of t raised to one ulp (march/de.cl): effective epsilon = ulp(t)
         "ulp_step": fired(GUARD_ULP_STEP),
         # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
         "normal_fallback": fired(GUARD_NORMAL_FALLBACK, hit),
-        # Jacobian iteration stopped before q_n underflowed to 0 (normals_jacobian.cl)
+        # Jacobian iteration stopped before q_n underflowed to 0 (normals/jacobian.cl)
         "jacobian_tiny": fired(GUARD_JACOBIAN_TINY, hit),
-        # de: within epsilon of the set by the estimate, yet no point inside: a miss (march_de.cl)
+        # de: within epsilon of the set by the estimate, yet no point inside: a miss (march/de.cl)
         "shell_miss": fired(GUARD_SHELL_MISS),
         # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
         "eye_hit": int(np.count_nonzero(hit & (np.asarray(depth).ravel() == 0))),
@@ -219,7 +219,7 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
 
 def march_items(n: int, tile_w: int, lanes: int) -> int:
     """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
-    per block of pixels (kernels/march.cl)."""
+    per block of pixels (kernels/march/march.cl)."""
     if lanes == 1:
         return n
     bw, bh = build.packet_block(lanes)
@@ -260,7 +260,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
 
 
 
-# The device buffers each output needs (march.cl, normals_*.cl, shade.cl); status, flags,
+# The device buffers each output needs (march/march.cl, normals_*.cl, shade.cl); status, flags,
 # depth, bracket and the normals' guard word are read back always (one tile's worth): the
 # streamed counts, guards and bracket statistics come from them.
 _READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket": ("bracket",),

@@ -47,15 +47,44 @@ class SceneError(ValueError):
 # ---------------------------------------------------------------- sections
 
 
+# The 4D algebras and the iterated functions f (q -> f(q) + c) of POV-Ray's julia_fractal
+# (seed 003_8ca5f9108f52d3d6.txt), in its order.  Quaternions take sqr and cube only,
+# as in POV-Ray; the hypercomplex numbers take every function.
+ALGEBRAS = ("quaternion", "hypercomplex")
+FUNCTIONS = ("sqr", "cube", "exp", "reciprocal", "sin", "asin", "sinh", "asinh", "cos", "acos",
+             "cosh", "acosh", "tan", "atan", "tanh", "atanh", "ln", "pwr")
+FUNCTIONS_OF = {"quaternion": ("sqr", "cube"), "hypercomplex": FUNCTIONS}
+# The polynomial maps, by degree: they escape to infinity like |q|^degree, which gives the
+# bounding ball and the distance estimate (camera.bounding_radius, iterate.cl).
+POLYNOMIAL_DEGREE = {"sqr": 2, "cube": 3}
+
+
 @dataclass(frozen=True)
 class Fractal:
-    """[fractal]: the Julia set of z -> z^2 + c over the quaternions."""
+    """[fractal]: the Julia set of q -> f(q) + c in a 4D algebra."""
 
     algebra: str = "quaternion"
     function: str = "sqr"
     c: Vec4 = (-0.2, 0.8, 0.0, 0.0)
     max_iter: int = 12
     bailout: float = 4.0  # escape radius (POV-Ray's default)
+    exponent: tuple[float, float] = (2.0, 0.0)  # pwr's complex exponent x + iy
+
+
+def has_distance_estimate(f: Fractal) -> bool:
+    """Whether the march may step by a distance estimate: quaternion sqr and cube, whose
+    norm is multiplicative, so |q'_n| follows the orbit (seed 001 §3.1, eq. 8).  The other
+    pairs are marched by the fixed scan (march.method = "auto")."""
+    return f.algebra == "quaternion" and f.function in POLYNOMIAL_DEGREE
+
+
+def march_method(scene: "Scene") -> str:
+    """march.method with "auto" resolved: "de" where the pair has a distance estimate,
+    else "fixed"."""
+    m = scene.march.method
+    if m != "auto":
+        return m
+    return "de" if has_distance_estimate(scene.fractal) else "fixed"
 
 
 @dataclass(frozen=True)
@@ -83,7 +112,7 @@ class March:
     method, z_resolution, post_steps and epsilon from a measured preset (quality.py)."""
 
     quality: str = "custom"
-    method: str = "de"
+    method: str = "auto"
     z_resolution: int = 250
     post_steps: int = 4
     refine: str = "itp"
@@ -308,12 +337,14 @@ _SECTIONS: dict[str, type] = {
 # Every key's check and valid range, in one place (README's table is tested against it).
 _CHECKS: dict[str, dict[str, Checker]] = {
     "fractal": {
-        "algebra": _Choice("quaternion"),
-        "function": _Choice("sqr"),
+        "algebra": _Choice(*ALGEBRAS),
+        "function": _Choice(*FUNCTIONS),
         "c": _Vector((4,), -1e3, 1e3),
         "max_iter": _Integer(1, 1_000_000),
         # above ~9.6e8 single precision is refused at render time (workload.py)
         "bailout": _Real(1e-3, 1e76),
+        # pwr's exponent; |x|, |y| <= 16: higher powers overflow float32 within an iteration
+        "exponent": _Vector((2,), -16.0, 16.0),
     },
     "camera": {
         "position": _Vector((3, 4), -COORD, COORD),
@@ -328,7 +359,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
     },
     "march": {
         "quality": _Choice(*QUALITIES),
-        "method": _Choice("fixed", "de"),
+        "method": _Choice("auto", "fixed", "de"),
         # the kernel's int loop counter: from 2^31 - 2 on refused at render time (workload.py)
         "z_resolution": _Integer(1, _INT_MAX),
         "post_steps": _Integer(0, 1000),
@@ -503,6 +534,28 @@ def _check_camera(cam: Camera) -> None:
         raise SceneError("camera.up", "parallel to the view direction or to camera.limbo")
 
 
+def _check_fractal(scene: "Scene") -> None:
+    """The algebra x function pairs that exist, and the methods each can use."""
+    f, m = scene.fractal, scene.march
+    allowed = FUNCTIONS_OF[f.algebra]
+    if f.function not in allowed:
+        raise SceneError("fractal.function", f"{f.function!r} is not defined for the {f.algebra} algebra "
+                         f"(as in POV-Ray's julia_fractal: {' and '.join(allowed)} only); use "
+                         f"fractal.algebra=hypercomplex for it")
+    if has_distance_estimate(f):
+        return
+    pair = f"{f.algebra} {f.function}"
+    if m.quality != "custom":
+        raise SceneError("march.quality", f"the presets march by distance estimate, which {pair} has "
+                         f"none of; use march.quality=custom (the fixed scan)")
+    if m.method == "de":
+        raise SceneError("march.method", f"de needs a distance estimate, which {pair} has none of; "
+                         f"use fixed or auto")
+    if scene.normals.method == "gradient":
+        raise SceneError("normals.method", f"gradient differences the distance estimate, which {pair} "
+                         f"has none of; use jacobian or zbuffer")
+
+
 @dataclass(frozen=True)
 class Scene:
     """A fully validated scene; build with :meth:`default`, :meth:`from_dict` or :meth:`from_toml`."""
@@ -581,6 +634,7 @@ class Scene:
             parts[section] = _SECTIONS[section](**kwargs)
         scene = cls(**parts)
         _check_camera(scene.camera)
+        _check_fractal(scene)
         m = scene.march
         if m.quality != "custom" and any(getattr(m, k) != v for k, v in preset_values(m.quality).items()):
             # a march key set after the preset: the resolved scene says what really runs

@@ -35,7 +35,7 @@ Three oracles, from exact to merely converged:
 Ground-truth normals: radial for c = 0, otherwise the float64 analytic Jacobian
 normal grad |q_n|^2 = 2 J^T q_n (seed 004 "method 3", ``reference.normal_jacobian``)
 at the ground-truth hit point, projected to camera coordinates exactly like
-kernels/normals_jacobian.cl.
+normals/jacobian.cl.
 """
 from __future__ import annotations
 
@@ -342,7 +342,7 @@ DE_MAX_STEPS = 100000
 
 def de_depth(scene: Scene, epsilon: float = DE_EPSILON, post_steps: int = DE_POST_STEPS,
              max_steps: int = DE_MAX_STEPS, device=None):
-    """The double-precision kernels' distance-estimate march (march_de.cl) with a tiny
+    """The double-precision kernels' distance-estimate march (march/de.cl) with a tiny
     ``epsilon`` and ``post_steps`` ITP steps, its depth polished in float64 (``_polish``).
     Returns (depth (+inf where no verified crossing), hit (verified crossings only),
     record): rays it hit, rays whose crossing float64 verified, capped rays, guards, time."""
@@ -382,7 +382,7 @@ def earliest(o, d, t_scan, t_de, tol: float = 1e-6) -> tuple[np.ndarray, dict]:
 # ------------------------------------------------------------ normals
 
 def jacobian_normals(points, scene: Scene):
-    """Float64 analytic normal (seed 004 method 3; kernels/normals_jacobian.cl) at 4D
+    """Float64 analytic normal (seed 004 method 3; normals/jacobian.cl) at 4D
     points (..., 4), unit, in camera coordinates; 0 where degenerate or NaN."""
     f = scene.fractal
     fr = camera_frame(scene)

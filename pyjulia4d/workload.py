@@ -22,7 +22,7 @@ import warnings
 from dataclasses import dataclass
 
 from .camera import camera_frame, march_radius
-from .scene import Scene, SceneError
+from .scene import Scene, SceneError, march_method
 
 # Set-test throughput, iterations of f per second, measured by benchmarks/throughput.py
 # (benchmarks/results/throughput.md, commit 19393ea) inside the march of the default scene on
@@ -78,9 +78,9 @@ def estimate(scene: Scene, device=None) -> Estimate:
     (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
     f, m = scene.fractal, scene.march
     pixels = scene.image.width * scene.image.height
-    # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (refine.cl)
+    # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (march/refine.cl)
     refine = m.post_steps + 3 if m.refine == "itp" else m.post_steps
-    if m.method == "fixed":
+    if march_method(scene) == "fixed":
         per_ray = m.z_resolution + 1 + refine
         march_key = "march.z_resolution"
     else:
@@ -129,7 +129,7 @@ def check_numerics(scene: Scene) -> None:
                             f"{lim:.2g}{alt}")
     # a preset's epsilon (final: 5e-7) is below the spacing of t for cameras ~8 units away;
     # its stated bound was measured with that, and the ulp_step guard counts it: no warning
-    if m.method == "de" and scene.render.float == "single" and m.quality == "custom":
+    if march_method(scene) == "de" and scene.render.float == "single" and m.quality == "custom":
         t_far = float(sum(x * x for x in camera_frame(scene).position)) ** 0.5 + march_radius(scene)
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:

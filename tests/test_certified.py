@@ -1,4 +1,4 @@
-"""Certified depth (kernels/refine.cl, march_de.cl, march_fixed.cl): on scenes where the
+"""Certified depth (kernels/march/refine.cl, march/de.cl, march/fixed.cl): on scenes where the
 distance estimate's epsilon-shell lies in front of the max_iter-truncated set (max_iter 20,
 c near the boundary of the connectedness locus, a 4D camera), every hit's bracket
 [depth, depth + bracket] must hold the surface crossing of the set as defined (inside when

@@ -20,7 +20,7 @@ from harness import Runner
 from pyjulia4d import build, catalogue as cat, reference as ref, workload
 from pyjulia4d.camera import camera_frame
 from pyjulia4d.render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, render
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.scene import Scene, SceneError, march_method
 
 CASES = cat.catalogue()
 IDS = [c.name for c in CASES]
@@ -40,7 +40,7 @@ def check_outputs(res, s):
     assert set(np.unique(st)) <= {STATUS_MISS, STATUS_HIT, STATUS_CAPPED}
     hit = st == STATUS_HIT
     m = s.march
-    cap = m.z_resolution + 1 if m.method == "fixed" else m.max_steps
+    cap = m.z_resolution + 1 if march_method(s) == "fixed" else m.max_steps
     assert np.all((res.samples >= 0) & (res.samples <= cap))
     assert not np.any(np.isnan(res.depth))
     assert np.all(np.isfinite(res.depth[hit])) and np.all(res.depth[hit] >= 0)
@@ -55,7 +55,7 @@ def check_outputs(res, s):
     # every hit's depth is certified: a bracket of finite width >= 0 behind it, +inf elsewhere
     assert np.all(np.isfinite(res.bracket[hit])) and np.all(res.bracket[hit] >= 0)
     assert np.all(np.isposinf(res.bracket[~hit]))
-    assert g["shell_miss"] == 0 or m.method == "de"
+    assert g["shell_miss"] == 0 or march_method(s) == "de"
     assert g["eye_hit"] == int(np.sum(hit & (res.depth == 0)))
     assert all(0 <= v <= st.size for v in g.values())
 

@@ -1,4 +1,4 @@
-"""march.cl with march_fixed.cl / march_de.cl / refine.cl against reference.march, on
+"""march.cl with march/fixed.cl / march/de.cl / march/refine.cl against reference.march, on
 identical rays, one ray per work-item and in packets of rays (kernels/real.cl, "Lanes")."""
 import numpy as np
 import pytest

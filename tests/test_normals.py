@@ -1,4 +1,4 @@
-"""normals_jacobian.cl, normals_gradient.cl and normals_zbuffer.cl against the reference,
+"""normals/jacobian.cl, normals/gradient.cl and normals/zbuffer.cl against the reference,
 on identical hit points."""
 import numpy as np
 import pytest

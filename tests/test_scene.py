@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError, valid_range
+from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError, valid_range, march_method
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -24,7 +24,7 @@ def test_defaults() -> None:
     assert s.fractal.c == (-0.2, 0.8, 0.0, 0.0)
     assert s.fractal.max_iter == 12 and s.fractal.bailout == 4.0
     assert s.camera.position == (1.8, 1.6, -2.2, 0.0) and s.camera.fov == 40.0
-    assert s.march.method == "de" and s.march.near == "auto" and s.march.max_steps == 4096
+    assert s.march.method == "auto" and march_method(s) == "de" and s.march.near == "auto" and s.march.max_steps == 4096
     assert s.normals.method == "jacobian" and s.shading.light == "eye"
     assert (s.image.width, s.image.height) == (640, 480)
     assert s.render.float == "single"
@@ -119,7 +119,9 @@ BAD = [
     ("fractal.max_iter=true", "fractal.max_iter"),
     ("fractal.max_iter=0", "fractal.max_iter"),
     ("fractal.algebra=octonion", "fractal.algebra"),
-    ("fractal.function=cube", "fractal.function"),
+    ("fractal.function=quartic", "fractal.function"),
+    ("fractal.function=sin", "fractal.function"),   # quaternions: sqr and cube only
+    ("fractal.exponent=1,2,3", "fractal.exponent"),
     ("fractal.bailout=0", "fractal.bailout"),
     ("fractal.bailout=nan", "fractal.bailout"),
     ("fractal.c=1,2,3", "fractal.c"),

@@ -82,7 +82,7 @@ def test_distance_estimate_depth(renderer, post):
     dep, wid = res.depth.ravel()[both].astype(float), res.bracket.ravel()[both].astype(float)
     cos = np.abs(b[both] + t_true[both]) / rho
     slack = (1.5e-6 / cos + 1e-6) if res.device_name != "numpy float64 reference" else 1e-9
-    # certified (refine.cl): the crossing lies in [depth, depth + bracket]
+    # certified (march/refine.cl): the crossing lies in [depth, depth + bracket]
     assert np.all(dep <= t_true[both] + slack)
     assert np.all(t_true[both] <= dep + wid + slack)
     # the bracket is the last step, max(d, eps) with d ~ eps near the ball, narrowed by

@@ -1,9 +1,9 @@
-/* march_de.cl: distance-estimate marching (seed 001 §3.2, eq. 9), on a lane type
+/* march/de.cl: distance-estimate marching (seed 001 §3.2, eq. 9), on a lane type
  * (real.cl):
  *     r_{n+1} = r_n + max(d(r_n), epsilon),
  * until a point is inside the truncated set (d = 0: its orbit never escaped, the
  * scene's own definition), which with the previous point - outside, since its orbit
- * escaped - is the certified bracket that refine.cl narrows.  The estimate falling
+ * escaped - is the certified bracket that march/refine.cl narrows.  The estimate falling
  * below epsilon does not end the march: it measures the distance to the limit set, not
  * to the max_iter-truncated one the picture shows, and at max_iter 20 points with d <
  * epsilon lie in front of the surface (their orbits escape at iteration 15-18); there

@@ -1,7 +1,7 @@
-/* march_fixed.cl: fixed z-resolution scan (seed 000 §3), on a lane type (real.cl).
+/* march/fixed.cl: fixed z-resolution scan (seed 000 §3), on a lane type (real.cl).
  * Samples t_i = near + i (far - near) / z_resolution, i = 0 .. z_resolution; the first
  * sample inside the set ends a ray's scan, and [t_{i-1}, t_i] - the previous sample
- * verified outside, this one inside - is the certified bracket refined by refine.cl.
+ * verified outside, this one inside - is the certified bracket refined by march/refine.cl.
  * A hit at the first sample has no outside sample before it: the depth is near itself,
  * width 0 (the first inside point at or after near, exactly).  Lanes outside ``live``
  * (rays that miss the bounding sphere) are left alone.

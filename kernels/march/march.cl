@@ -1,4 +1,4 @@
-/* march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  Each work-item
+/* march/march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  Each work-item
  * makes its rays from the camera (rays.cl camera_ray) for pixels (x0, y0) + its index in a tile
  * tile_w wide; -D RAYS_FROM_BUFFERS reads them from origins/dirs instead (the tests' and
  * benchmarks' arbitrary rays).  The ray o + t d (|d| = 1)
@@ -6,7 +6,7 @@
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
  * guard flags (real.cl), 0 when none fired; bracket the width of the certified
- * bracket behind each hit's depth (refine.cl), +inf where nothing was hit. */
+ * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit. */
 
 #ifdef RAYS_FROM_BUFFERS
 #define RAY_ARGS __global const real4 *origins, __global const real4 *dirs

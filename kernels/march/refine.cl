@@ -1,4 +1,4 @@
-/* refine.cl: refine a certified bracket [a, b] on a ray: o + a d verified outside the
+/* march/refine.cl: refine a certified bracket [a, b] on a ray: o + a d verified outside the
  * truncated set, o + b d verified inside (julia_level's inside flag, the scene's own
  * definition, iterate.cl), so the surface crossing lies in [a, b].  The march returns
  * the outside end a as the depth and b - a as the bracket width: the crossing lies

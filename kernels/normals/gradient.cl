@@ -1,4 +1,4 @@
-/* normals_gradient.cl: central-difference gradient of the distance estimate
+/* normals/gradient.cl: central-difference gradient of the distance estimate
  * (seed 001 §4.1.2, eq. 15, the 6-point gradient; seed 004 "method 1"), taken
  * along the camera's right, up and forward axes so the result is already the
  * normal of the 3D section the rays see.  It differences the estimate formula

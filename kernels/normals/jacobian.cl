@@ -1,19 +1,24 @@
-/* normals_jacobian.cl: the analytic normal (seed 004 "method 3", seed 002).
+/* normals/jacobian.cl: the analytic normal (seed 004 "method 3", seed 002).
  * The surface is the level set |q_n|^2 = bailout^2, so the normal is
  *     grad |q_n|^2 = 2 J^T q_n,   J_{k+1} = f'(q_k) J_k,  J_0 = I,
- * with J carried column by column through julia_f_jvp().  The gradient is only
+ * with J carried column by column through julia_f_jvp() (in the algebra's coordinates:
+ * J_0's columns are ALG_IN of the unit vectors, and J^T q_n is taken with ALG_DOT, the
+ * bilinear form of the algebra's norm, so the result is the 4D gradient).  The gradient is only
  * needed up to scale, so J is rescaled whenever it grows large: no overflow at
  * any max_iter.  The 4D gradient is projected onto the 3D space the rays span
  * and returned in camera coordinates (x right, y up, z towards the eye). */
 
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
-    quat q = p;
-    quat j0 = QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0), j1 = QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0);
-    quat j2 = QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0), j3 = QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1);
+    quat q = ALG_IN(p);
+    real4 c = ALG_C(jp.c);
+    quat j0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
+    quat j1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
+    quat j2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));
+    quat j3 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1));
     lmask live = L_TRUE;
     for (int n = 0; n < jp.max_iter && L_ANY(live); ++n) {
-        lreal m2 = QNORM2(q);
+        lreal m2 = ALG_NORM2(q);
         live &= m2 <= jp.bailout2;
         /* Inside points of c = 0 go to 0 like p^(2^n): q underflows to exactly 0 within a
          * few dozen iterations (float32 and float64 alike) and grad |q_n|^2 = 2 J^T q_n
@@ -31,7 +36,7 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
         j1 = QSEL(j1, julia_f_jvp(q, j1), live);
         j2 = QSEL(j2, julia_f_jvp(q, j2), live);
         j3 = QSEL(j3, julia_f_jvp(q, j3), live);
-        q = QSEL(q, julia_f(q, jp.c), live);
+        q = QSEL(q, julia_f(q, c), live);
         lreal s = fmax(fmax(QLEN(j0), QLEN(j1)), fmax(QLEN(j2), QLEN(j3)));
         /* rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
@@ -44,7 +49,7 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
             j3 = QSEL(j3, QSCALE(inv, j3), rescale);
         }
     }
-    return QUAT(QDOT(q, j0), QDOT(q, j1), QDOT(q, j2), QDOT(q, j3));
+    return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), ALG_DOT(q, j3));
 }
 
 /* 4D vector -> camera coordinates (right, up, -forward), normalised: (*nx, *ny, *nz).

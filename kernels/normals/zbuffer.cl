@@ -1,4 +1,4 @@
-/* normals_zbuffer.cl: normals from Z-buffer neighbours (seed 000 §5.1, eqs. 7-9;
+/* normals/zbuffer.cl: normals from Z-buffer neighbours (seed 000 §5.1, eqs. 7-9;
  * seed 001 §4.1.1, eqs. 12-14): the normal of the plane through the hit point and
  * its neighbours' hit points, in camera coordinates (so perspective is handled).
  * Along each image axis: the central difference of seed 000 when both neighbours

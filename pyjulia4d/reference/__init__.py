@@ -3,7 +3,10 @@
 Each name here is the name of a kernel function or kernel in kernels/*.cl, with
 the same formula, the same loop bounds and the same guards, vectorised over a
 batch of points or rays instead of one per work-item.  It is slow and exact to
-float64: the tests hold the kernels to it, and it can render a small scene.
+float64: the tests hold the kernels to it, and it can render a small scene.  The
+algebras and functions mirror kernels/algebra/ and kernels/function/ file for file
+(reference/algebra/, reference/function/), assembled by reference/formula.py; every
+function taking ``formula`` defaults to the quaternion square.
 """
 from __future__ import annotations
 
@@ -11,11 +14,11 @@ import time
 
 import numpy as np
 
-from .camera import Frame, camera_frame, light_position, march_radius
-from .render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
+from ..camera import Frame, camera_frame, light_position, march_radius
+from ..render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
                      STATUS_CAPPED,
                      STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
-from .scene import Scene
+from ..scene import Scene, march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
 
@@ -24,98 +27,72 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-# ------------------------------------------------------- algebra_quaternion.cl
-
-def alg_mul(a, b):
-    """Hamilton product (seed 000_1dc675fe64448cc1.txt eq. 3)."""
-    a1, a2, a3, a4 = np.moveaxis(a, -1, 0)
-    b1, b2, b3, b4 = np.moveaxis(b, -1, 0)
-    return np.stack([a1 * b1 - a2 * b2 - a3 * b3 - a4 * b4,
-                     a1 * b2 + a2 * b1 + a3 * b4 - a4 * b3,
-                     a1 * b3 - a2 * b4 + a3 * b1 + a4 * b2,
-                     a1 * b4 + a2 * b3 - a3 * b2 + a4 * b1], axis=-1)
-
-
-def alg_sqr(q):
-    """q^2 (seed 000 eq. 4)."""
-    x, y, z, w = np.moveaxis(q, -1, 0)
-    return np.stack([x * x - y * y - z * z - w * w, 2 * x * y, 2 * x * z, 2 * x * w], axis=-1)
-
-
-def alg_sqr_jvp(q, h):
-    """d(q^2)[h] = q h + h q."""
-    x, y, z, w = np.moveaxis(q, -1, 0)
-    a, b, c, d = np.moveaxis(h, -1, 0)
-    return 2 * np.stack([x * a - y * b - z * c - w * d, x * b + a * y, x * c + a * z,
-                         x * d + a * w], axis=-1)
-
-
-# ----------------------------------------------------------- function_sqr.cl
-
-def julia_f(q, c):
-    return alg_sqr(q) + c
-
-
-def julia_f_jvp(q, h):
-    return alg_sqr_jvp(q, h)
-
-
-def JULIA_DF2(m2):
-    return 4.0 * m2
-
-
-JULIA_DEGREE = 2.0
+# ------------------------------------ algebra/*.cl, function/*.cl (formula.py)
+# The quaternion square's pieces stay importable here (ref.alg_mul, ref.alg_sqr, ...).
+from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
+from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
 
 
 # ------------------------------------------------------------------ iterate.cl
 
-def julia_inside(p, c, max_iter, bailout):
+def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """|q_n| <= bailout for n = 0..max_iter (seed 003; seed 000 eq. 5)."""
-    q = np.array(p, dtype=np.float64)
-    c = np.asarray(c, np.float64)
+    F = formula
+    q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
+    c = F.ALG_C(np.asarray(c, np.float64))
     out = np.ones(q.shape[:-1], bool)
     b2 = bailout * bailout
-    for _ in range(max_iter):
-        out &= _dot(q, q) <= b2
-        if not out.any():
-            return out
-        q[out] = julia_f(q[out], c)
-    return out & (_dot(q, q) <= b2)
+    with np.errstate(all="ignore"):   # inf / NaN iterates count as escaped, as in the kernel
+        for _ in range(max_iter):
+            out &= F.ALG_NORM2(q) <= b2
+            if not out.any():
+                return out
+            q[out] = F.julia_f(q[out], c)
+        return out & (F.ALG_NORM2(q) <= b2)
 
 
-def julia_level(p, c, max_iter, bailout):
+def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """F = |q_N|^2 / bailout^2 - 1 (N = max_iter), <= 0 exactly where julia_inside; an orbit
-    escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(2^(N-n)) - 1, capped at 1e30
-    (iterate.cl; seed 002).  Returns (F, inside)."""
-    q = np.array(p, dtype=np.float64)
-    c = np.asarray(c, np.float64)
+    escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(D^(N-n)) - 1 (D = the growth
+    degree), capped at 1e30 (iterate.cl; seed 002).  Returns (F, inside)."""
+    F = formula
+    q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
+    c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
-    m2 = _dot(q, q)
+    m2 = F.ALG_NORM2(q)
     n = np.zeros(m2.shape, np.int64)
     live = np.ones(m2.shape, bool)
-    for _ in range(max_iter):
-        live &= m2 <= b2
-        if not live.any():
-            break
-        q[live] = julia_f(q[live], c)
-        m2[live] = _dot(q[live], q[live])
-        n[live] += 1
+    with np.errstate(all="ignore"):
+        for _ in range(max_iter):
+            live &= m2 <= b2
+            if not live.any():
+                break
+            q[live] = F.julia_f(q[live], c)
+            m2[live] = F.ALG_NORM2(q[live])
+            n[live] += 1
     inside = m2 <= b2
     k = max_iter - n
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        e = np.ldexp(np.log(m2 / b2), np.minimum(k, 60).astype(np.int32))
+        kk = np.minimum(k, 60)
+        if F.growth == 2:
+            e = np.ldexp(np.log(m2 / b2), kk.astype(np.int32))
+        else:
+            e = np.log(m2 / b2) * float(F.growth) ** kk
+        # the kernel's fmin(e, 69) takes 69 for a NaN e (an orbit gone to NaN)
+        e = np.where(np.isnan(e), 69.0, e)
         out = np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
     return np.where(inside, m2 / b2 - 1.0, out), inside
 
 
-def julia_distance_formula(p, c, max_iter, bailout):
+def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """d = |q_n| ln|q_n| / (2|q_n'|) (seed 001_01b4b6353b5280e3.txt eq. 8) at the last
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
     (d, escaped)."""
-    q = np.array(p, dtype=np.float64)
-    c = np.asarray(c, np.float64)
+    F = formula
+    q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
+    c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
-    m2 = _dot(q, q)
+    m2 = F.ALG_NORM2(q)
     dm2 = np.ones_like(m2)
     e = np.zeros(m2.shape, np.int64)
     live = np.ones(m2.shape, bool)
@@ -123,43 +100,44 @@ def julia_distance_formula(p, c, max_iter, bailout):
         live &= m2 <= b2
         if not live.any():
             break
-        dm2[live] *= JULIA_DF2(m2[live])
+        dm2[live] *= F.JULIA_DF2(m2[live])
         big = live & (dm2 > 1e16)
         if big.any():
             mant, k = np.frexp(dm2[big])
             dm2[big] = mant
             e[big] += k
-        q[live] = julia_f(q[live], c)
-        m2[live] = _dot(q[live], q[live])
+        q[live] = F.julia_f(q[live], c)
+        m2[live] = F.ALG_NORM2(q[live])
     escaped = m2 > b2
     mq = np.maximum(m2, REAL_MIN)
     ratio = np.sqrt(mq / np.maximum(dm2, REAL_MIN)) * np.exp2(-(e / 2.0))
-    return ratio * np.log(mq) / (2.0 * JULIA_DEGREE), escaped
+    return ratio * np.log(mq) / 4.0, escaped
 
 
-def julia_distance(p, c, max_iter, bailout):
+def julia_distance(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """The estimate the march steps by: 0 where the point never escaped."""
-    d, escaped = julia_distance_formula(p, c, max_iter, bailout)
+    d, escaped = julia_distance_formula(p, c, max_iter, bailout, formula)
     return np.where(escaped, d, 0.0)
 
 
-# ------------------------------------------------------------------- refine.cl
+# ------------------------------------------------------------------- march/refine.cl
 
-def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None):
+def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None,
+                   formula: Formula = QUATERNION_SQR):
     """Narrow certified brackets [a (outside), b (inside)] on rays o + t d with ``steps``
     set tests: ITP on the level function julia_level (``itp``) or bisection (seed 000
     §7.1 eq. 11-12, every point classified); both stop where the bracket cannot be split.
     Both guarantee width <= (b - a) / 2^steps, ITP with at most one more set test.
     Returns (a, b - a): the outside end is the depth, the crossing lies within the width
-    behind it (refine.cl).  ``tests`` (int array, optional) gets the set tests each ray took
+    behind it (march/refine.cl).  ``tests`` (int array, optional) gets the set tests each ray took
     (ITP's two end-point level evaluations not counted)."""
     a = np.array(a, np.float64)
     b = np.array(b, np.float64)
     pt = lambda k, t: o[k] + t[:, None] * d[k]
     if itp:
         k = np.arange(len(a))
-        fa, _ = julia_level(pt(k, a), c, max_iter, bailout)
-        fb, _ = julia_level(pt(k, b), c, max_iter, bailout)
+        fa, _ = julia_level(pt(k, a), c, max_iter, bailout, formula)
+        fb, _ = julia_level(pt(k, b), c, max_iter, bailout, formula)
         ya, yb = -np.maximum(fa, REAL_MIN), -np.minimum(fb, 0.0)
         w0 = b - a
         eps = np.ldexp(w0, -(steps + 1))
@@ -185,7 +163,7 @@ def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None
             xt = np.where(delta <= np.abs(xhk - xf), xf + sigma * delta, xhk)
             x = np.where(np.abs(xt - xhk) <= r, xt, xhk - sigma * r)
             x = np.where((x > ak) & (x < bk), x, xhk)
-            f, ins = julia_level(pt(k, x), c, max_iter, bailout)
+            f, ins = julia_level(pt(k, x), c, max_iter, bailout, formula)
             y = -f
             b[k] = np.where(ins, x, bk)
             yb[k] = np.where(ins, np.maximum(y, 0.0), ybk)
@@ -193,16 +171,16 @@ def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None
             ya[k] = np.where(ins, yak, np.minimum(y, -REAL_MIN))
         else:
             x = xh[k]
-            ins = julia_inside(pt(k, x), c, max_iter, bailout)
+            ins = julia_inside(pt(k, x), c, max_iter, bailout, formula)
             b[k] = np.where(ins, x, b[k])
             a[k] = np.where(ins, a[k], x)
     return a, b - a
 
 
-# ---------------------------------------------------- march_fixed.cl / march_de.cl
+# ---------------------------------------------------- march/fixed.cl / march/de.cl
 
 def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
-                itp=True):
+                itp=True, formula: Formula = QUATERNION_SQR):
     """Fixed z-resolution scan (seed 000 §3): the first inside sample and the one before it
     are the certified bracket, refined by refine_bracket; a hit at the first sample is near
     itself, width 0.  Returns (t, status, samples, flags, width)."""
@@ -219,7 +197,7 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
         if idx.size == 0:
             break
         ti = near[idx] + i * h[idx]
-        inside = julia_inside(o[idx] + ti[:, None] * d[idx], c, max_iter, bailout)
+        inside = julia_inside(o[idx] + ti[:, None] * d[idx], c, max_iter, bailout, formula)
         got = idx[inside]
         t[got] = ti[inside]
         status[got] = STATUS_HIT
@@ -231,17 +209,18 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
     if k.size:
         # the kernel's t_prev is near + (i - 1) h, computed as such (not t - h)
         t_prev = near[k] + (samples[k] - 2) * h[k]
-        t[k], width[k] = refine_bracket(o[k], d[k], t_prev, t[k], post_steps, c, max_iter, bailout, itp)
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev, t[k], post_steps, c, max_iter, bailout, itp,
+                                        formula=formula)
     return t, status, samples, np.zeros(n, np.int32), width
 
 
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
-             itp=True):
+             itp=True, formula: Formula = QUATERNION_SQR):
     """r_{n+1} = r_n + max(d(r_n), eps) (seed 001 §3.2 eq. 9) until a point is inside (its
     orbit never escaped); with the previous point, the certified bracket refined by
     refine_bracket.  A step that rounds away (t + step == t) becomes one ulp of t
     (GUARD_ULP_STEP); a ray that came within epsilon by the estimate and never got inside
-    is a miss flagged GUARD_SHELL_MISS (march_de.cl).  Returns (t, status, samples, flags, width)."""
+    is a miss flagged GUARD_SHELL_MISS (march/de.cl).  Returns (t, status, samples, flags, width)."""
     n = len(o)
     t = near.copy()
     t_prev = near.copy()
@@ -263,7 +242,7 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         flags[gone[shell[gone]]] |= GUARD_SHELL_MISS
         active[gone] = False
         idx = idx[~out]
-        dist, escaped = julia_distance_formula(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout)
+        dist, escaped = julia_distance_formula(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout, formula)
         hit = ~escaped
         got = idx[hit]
         status[got] = STATUS_HIT
@@ -282,22 +261,24 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         flags[stall] |= GUARD_ULP_STEP
     k = np.nonzero(bracketed)[0]
     if k.size:
-        t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp)
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp,
+                                        formula=formula)
     t[status != STATUS_HIT] = np.inf
     return t, status, samples, flags, width
 
 
-# --------------------------------------------------------------------- march.cl
+# --------------------------------------------------------------------- march/march.cl
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
-          z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None):
+          z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
+          formula: Formula = QUATERNION_SQR):
     """Clip each ray to the bounding 4-ball, then march; returns (depth, point, status, samples).
-    ``flags`` (int array, optional) gets the march's guard flags (march.cl's flags buffer),
+    ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
     ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere)."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = _dot(o, d)
-    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye (march.cl)
+    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye (march/march.cl)
     perp = o - b[:, None] * d
     disc = radius * radius - _dot(perp, perp)
     s = np.sqrt(np.maximum(disc, 0.0))
@@ -317,7 +298,7 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
         fn = march_fixed if method == "fixed" else march_de
         depth[k], status[k], samples[k], fl, wd = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
                                                      epsilon, z_resolution, post_steps, max_steps,
-                                                     refine == "itp")
+                                                     refine == "itp", formula)
         if flags is not None:
             flags[k] |= fl
         if bracket is not None:
@@ -362,7 +343,7 @@ def _unit_or_zero(n):
 def to_camera_unit(n, guard=None):
     """Normalise (the caller projects with _to_camera); a zero or non-finite vector becomes
     the view axis (0, 0, 1), flagged GUARD_NORMAL_FALLBACK in ``guard``
-    (normals_jacobian.cl / normals_gradient.cl)."""
+    (normals/jacobian.cl / normals/gradient.cl)."""
     l = np.linalg.norm(n, axis=-1, keepdims=True)
     ok = (l > 0) & np.isfinite(l)
     if guard is not None:
@@ -370,18 +351,20 @@ def to_camera_unit(n, guard=None):
     return np.where(ok, n / np.where(ok, l, 1), np.array([0.0, 0.0, 1.0]))
 
 
-def normal_jacobian(p, c, max_iter, bailout, guard=None):
+def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUATERNION_SQR):
     """grad |q_n|^2 = 2 J^T q_n with J carried by the chain rule (seed 004 method 3).
     J is rescaled both ways (no underflow on orbits drawn to an attracting cycle), and the
     iteration stops while q is a normal number, |q|^2 >= sqrt(REAL_MIN): inside points of
     c ~ 0 go to exactly 0 otherwise, and the normal with them (GUARD_JACOBIAN_TINY)."""
-    q = np.array(p, np.float64)
-    c = np.asarray(c, np.float64)
-    J = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4)).copy()  # J[..., k, :] = column k
+    F = formula
+    q = F.ALG_IN(np.array(p, np.float64)).copy()
+    c = F.ALG_C(np.asarray(c, np.float64))
+    # J[..., k, :] = column k, in the algebra's coordinates: ALG_IN of the unit vectors
+    J = np.broadcast_to(F.ALG_IN(np.eye(4)), q.shape[:-1] + (4, 4)).copy()
     live = np.ones(q.shape[:-1], bool)
     tiny = np.zeros(q.shape[:-1], bool)
     for _ in range(max_iter):
-        m2 = _dot(q, q)
+        m2 = F.ALG_NORM2(q)
         live &= m2 <= bailout * bailout
         stop = live & (m2 < np.sqrt(REAL_MIN))
         tiny |= stop
@@ -389,9 +372,10 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None):
         if not live.any():
             break
         ql = q[live]
-        J[live] = julia_f_jvp(ql[:, None, :], J[live])
-        q[live] = julia_f(ql, c)
-        s = np.linalg.norm(J[live], axis=-1).max(axis=-1)
+        with np.errstate(all="ignore"):
+            J[live] = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
+            q[live] = F.julia_f(ql, c)
+            s = np.linalg.norm(J[live], axis=-1).max(axis=-1)
         big = (s > 1e12) | ((s < 1e-12) & (s > 0))
         if big.any():
             Jl = J[live]
@@ -399,40 +383,43 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None):
             J[live] = Jl
     if guard is not None:
         guard |= np.where(tiny, GUARD_JACOBIAN_TINY, 0)
-    return np.einsum("...kj,...j->...k", J, q)
+    with np.errstate(all="ignore"):
+        return F.ALG_DOT(J, q[..., None, :])
 
 
-def normals_jacobian(point, status, c, max_iter, bailout, frame: Frame, guard=None):
+def normals_jacobian(point, status, c, max_iter, bailout, frame: Frame, guard=None,
+                     formula: Formula = QUATERNION_SQR):
     """Unit normals of the hits, 0 elsewhere; ``guard`` (int array, optional) gets the flags."""
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
         g = np.zeros(int(hit.sum()), np.int64)
-        out[hit] = to_camera_unit(_to_camera(normal_jacobian(point[hit], c, max_iter, bailout, g), frame), g)
+        out[hit] = to_camera_unit(_to_camera(normal_jacobian(point[hit], c, max_iter, bailout, g, formula), frame), g)
         if guard is not None:
             guard[hit] |= g
     return out
 
 
-def de_field(p, c, max_iter, bailout):
-    return julia_distance_formula(p, c, max_iter, bailout)[0]
+def de_field(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
+    return julia_distance_formula(p, c, max_iter, bailout, formula)[0]
 
 
-def normal_gradient(p, c, max_iter, bailout, h, frame: Frame):
+def normal_gradient(p, c, max_iter, bailout, h, frame: Frame, formula: Formula = QUATERNION_SQR):
     """6-point central difference of the estimate (seed 001 §4.1.2 eq. 15) along the camera axes."""
-    f = lambda x: de_field(x, c, max_iter, bailout)
+    f = lambda x: de_field(x, c, max_iter, bailout, formula)
     r, u, w = frame.right, frame.up, frame.forward
     return np.stack([f(p + h * r) - f(p - h * r), f(p + h * u) - f(p - h * u),
                      f(p - h * w) - f(p + h * w)], axis=-1)
 
 
-def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame, guard=None):
+def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame, guard=None,
+                     formula: Formula = QUATERNION_SQR):
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
         g = np.zeros(int(hit.sum()), np.int64)
         with np.errstate(invalid="ignore"):
-            out[hit] = to_camera_unit(normal_gradient(point[hit], c, max_iter, bailout, h, frame), g)
+            out[hit] = to_camera_unit(normal_gradient(point[hit], c, max_iter, bailout, h, frame, formula), g)
         if guard is not None:
             guard[hit] |= g
     return out
@@ -480,7 +467,7 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=Non
     l = np.linalg.norm(n, axis=-1, keepdims=True)
     bad = ~((l > 0) & np.isfinite(l))
     n = np.where(bad, view, n)
-    # the hit is the eye itself (camera inside the set): the view axis (normals_zbuffer.cl)
+    # the hit is the eye itself (camera inside the set): the view axis (normals/zbuffer.cl)
     lv = np.linalg.norm(n, axis=-1, keepdims=True)
     n = np.where(bad & ~((lv > 0) & np.isfinite(lv)), np.array([0.0, 0.0, 1.0]), n)
     n = n / np.linalg.norm(n, axis=-1, keepdims=True)
@@ -530,6 +517,7 @@ def render(scene: Scene) -> RenderResult:
     frame = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
     f, m, sh = scene.fractal, scene.march, scene.shading
+    F = formula_of(f)
     origins, dirs = generate_rays(frame, w, h)
     near = -1.0 if m.near == "auto" else float(m.near)
     far = -1.0 if m.far == "auto" else float(m.far)
@@ -537,12 +525,13 @@ def render(scene: Scene) -> RenderResult:
     bracket = np.full(len(origins), np.inf)
     depth, point, status, samples = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
-                                          m.post_steps, m.max_steps, m.method, guard, m.refine, bracket)
+                                          m.post_steps, m.max_steps, march_method(scene), guard, m.refine, bracket,
+                                          F)
     if scene.normals.method == "jacobian":
-        normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard)
+        normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard, F)
     elif scene.normals.method == "gradient":
         step = gradient_step(scene)
-        normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard)
+        normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard, F)
     else:
         normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
     rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,

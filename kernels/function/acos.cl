@@ -1,0 +1,6 @@
+/* function/acos.cl: f(z) = acos z, f'(z) = -1/sqrt(1 - z^2) (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "acos"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_acos(z); }
+inline cplx cfun_d(cplx z) { return c_neg(c_recip(c_sqrt(c_sub(C((lreal)1, (lreal)0), c_sqr(z))))); }

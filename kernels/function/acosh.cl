@@ -1,0 +1,6 @@
+/* function/acosh.cl: f(z) = acosh z, f'(z) = 1/(sqrt(z - 1) sqrt(z + 1)) (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "acosh"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_acosh(z); }
+inline cplx cfun_d(cplx z) { return c_recip(c_mul(c_sqrt(C(z.re - (real)1, z.im)), c_sqrt(C(z.re + (real)1, z.im)))); }

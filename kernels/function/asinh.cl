@@ -1,0 +1,6 @@
+/* function/asinh.cl: f(z) = asinh z, f'(z) = 1/sqrt(z^2 + 1) (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "asinh"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_asinh(z); }
+inline cplx cfun_d(cplx z) { return c_recip(c_sqrt(c_add(c_sqr(z), C((lreal)1, (lreal)0)))); }

@@ -1,0 +1,6 @@
+/* function/cosh.cl: f(z) = cosh z, f'(z) = sinh z (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "cosh"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_cosh(z); }
+inline cplx cfun_d(cplx z) { return c_sinh(z); }

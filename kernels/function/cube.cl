@@ -1,0 +1,9 @@
+/* function/cube.cl: f(z) = z^3, f'(z) = 3 z^2 (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "cube"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ * FUNC_POWER tells the algebra the map is the polynomial z^3: quaternions use their own
+ * product for it (algebra/quaternion.cl), and it sets the escape bound.
+ */
+#define FUNC_POWER 3
+inline cplx cfun(cplx z) { return c_mul(c_sqr(z), z); }
+inline cplx cfun_d(cplx z) { return c_scale((lreal)3, c_sqr(z)); }

@@ -1,0 +1,6 @@
+/* function/reciprocal.cl: f(z) = 1/z, f'(z) = -1/z^2 (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "reciprocal"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_recip(z); }
+inline cplx cfun_d(cplx z) { return c_neg(c_sqr(c_recip(z))); }

@@ -1,0 +1,6 @@
+/* function/sin.cl: f(z) = sin z, f'(z) = cos z (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "sin"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_sin(z); }
+inline cplx cfun_d(cplx z) { return c_cos(z); }

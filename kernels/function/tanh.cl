@@ -1,0 +1,6 @@
+/* function/tanh.cl: f(z) = tanh z, f'(z) = 1 - tanh^2 z (seed 003_8ca5f9108f52d3d6.txt, the
+ * julia_fractal function "tanh"), on a complex lane value (algebra/complex.cl).  An
+ * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
+ */
+inline cplx cfun(cplx z) { return c_tanh(z); }
+inline cplx cfun_d(cplx z) { return c_sub(C((lreal)1, (lreal)0), c_sqr(c_tanh(z))); }

@@ -1,0 +1,1 @@
+"""float64 twins of kernels/algebra/*.cl, file for file."""

@@ -1,0 +1,86 @@
+"""The iteration a scene compiles, assembled for the float64 reference the way
+build.iteration_pieces assembles kernels: one algebra module (reference/algebra/) and one
+function module (reference/function/), by the scene's names."""
+from __future__ import annotations
+
+import functools
+import importlib
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Formula:
+    """q -> f(q) + c in an algebra, with the interface iterate.cl uses: ALG_IN, ALG_C,
+    ALG_NORM2, ALG_DOT, julia_f, julia_f_jvp and, where a distance estimate exists,
+    JULIA_DF2."""
+    algebra: str = "quaternion"
+    function: str = "sqr"
+    exponent: tuple[float, float] = (2.0, 0.0)
+    alg: Any = field(init=False, repr=False, compare=False)
+    fn: Any = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        alg = importlib.import_module(f"{__package__}.algebra.{self.algebra}")
+        mod = importlib.import_module(f"{__package__}.function.{self.function}")
+        if self.function == "pwr":
+            p = complex(*self.exponent)
+            fn = _Bound(functools.partial(mod.cfun, p=p), functools.partial(mod.cfun_d, p=p), None)
+        else:
+            fn = _Bound(mod.cfun, mod.cfun_d, getattr(mod, "FUNC_POWER", None))
+        object.__setattr__(self, "alg", alg)
+        object.__setattr__(self, "fn", fn)
+
+    # the algebra's interface
+    def ALG_IN(self, p):
+        return self.alg.ALG_IN(p)
+
+    def ALG_C(self, c):
+        return self.alg.ALG_C(c)
+
+    def ALG_NORM2(self, q):
+        return self.alg.ALG_NORM2(q)
+
+    def ALG_DOT(self, a, b):
+        return self.alg.ALG_DOT(a, b)
+
+    def julia_f(self, q, c):
+        return self.alg.julia_f(q, c, self.fn)
+
+    def julia_f_jvp(self, q, h):
+        return self.alg.julia_f_jvp(q, h, self.fn)
+
+    @property
+    def has_de(self) -> bool:
+        return bool(self.alg.ALG_HAS_DE)
+
+    @property
+    def growth(self) -> int:
+        """JULIA_GROWTH: the degree of a polynomial map, else 2 (iterate.cl)."""
+        return self.fn.FUNC_POWER or 2
+
+    def JULIA_DF2(self, m2):
+        return self.alg.JULIA_DF2(m2, self.fn.FUNC_POWER)
+
+
+@dataclass(frozen=True)
+class _Bound:
+    cfun: Any
+    cfun_d: Any
+    FUNC_POWER: int | None
+
+
+QUATERNION_SQR = Formula()
+
+
+def formula_of(fractal) -> Formula:
+    """The Formula of a scene's [fractal] table."""
+    return Formula(fractal.algebra, fractal.function, tuple(float(x) for x in fractal.exponent))
+
+
+def complex_value(fn_name: str, z, exponent=(2.0, 0.0)):
+    """The function module's f(z) on complex numbers (the tests' handle)."""
+    f = Formula("hypercomplex", fn_name, tuple(exponent)).fn
+    return f.cfun(np.asarray(z, np.complex128)), f.cfun_d(np.asarray(z, np.complex128))

@@ -1,0 +1,11 @@
+"""float64 twin of kernels/function/cos.cl: f(z) = cos z (seed 003_8ca5f9108f52d3d6.txt,
+"cos"), numpy's complex function (its branch cuts)."""
+import numpy as np  # noqa: F401
+
+
+def cfun(z):
+    return np.cos(z)
+
+
+def cfun_d(z):
+    return -np.sin(z)
