@@ -162,7 +162,7 @@ def main(argv=None) -> int:
     for case in cat.catalogue():
         if args.only and case.name not in args.only:
             continue
-        for method in cat.METHODS:
+        for method in case.methods:
             r = measure(case, method, args.scale, args.repeats)
             from pyjulia4d.devices import select_device
             r["device"] = select_device(None).name.strip()

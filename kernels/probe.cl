@@ -19,3 +19,16 @@ __kernel void probe_iterate(const int n_items, __global const real4 *points, con
     formula[i] = NAN;
 #endif
 }
+
+/* One step of the map in the algebra's coordinates: q = ALG_IN(p), f(q) + ALG_C(c) and its
+ * derivative along ALG_IN(h) (the tests hold julia_f / julia_f_jvp to the reference). */
+__kernel void probe_step(const int n_items, __global const real4 *points, __global const real4 *dirs,
+                         const real4 c, __global real4 *value, __global real4 *jvp)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    quat q = ALG_IN(points[i]);
+    value[i] = julia_f(q, ALG_C(c));
+    jvp[i] = julia_f_jvp(q, ALG_IN(dirs[i]));
+}

@@ -117,10 +117,13 @@ def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) ->
     |q_0| <= b.  The bound shrinks from b towards R as N grows.  |q^D| >= |q|^D holds for
     quaternions (|q^D| = |q|^D) and for the hypercomplex numbers (the power mean of the
     split components, algebra/hypercomplex.cl).  ``degree`` None (a function that is no
-    polynomial): the bailout itself, the n = 0 test.
+    polynomial): the bailout itself, the n = 0 test, widened by 2^-20 (far above float32's
+    rounding of a point's norm): such sets can fill the ball up to its sphere (tan, asin,
+    reciprocal stay bounded almost everywhere), and a scan must start outside them, so that
+    the hit on the sphere is bracketed and its normal is the sphere's.
     """
     if degree is None:
-        return float(bailout)
+        return float(bailout) * (1.0 + 2.0 ** -20)
     cabs = float(np.linalg.norm(c))
     s = float(bailout)
     for _ in range(min(int(max_iter), 200)):  # h^N converges to R geometrically

@@ -1,9 +1,11 @@
-"""A named catalogue of extreme cases: the places where quaternion Julia
-rendering is known to break, each with what it stresses, what pyjulia4d must do,
+"""A named catalogue of extreme cases: the places where 4D Julia rendering is known
+to break (the quaternion square's, and the singular points of the hypercomplex
+functions: zero divisors, overflow, poles), each with what it stresses, what pyjulia4d must do,
 and how close the float32 render must come to the float64 one.
 
 Every case is a list of scene overrides on top of the default scene, runnable with
-either march method (``scene(case, "fixed" | "de", "single" | "double")``).  Images
+its march methods (``scene(case, "fixed" | "de", "single" | "double")``; the
+hypercomplex cases have no distance estimate, so the fixed scan only).  Images
 are tiny (the costly cases a handful of pixels) so that tests/test_extreme.py runs
 the whole catalogue, both methods and both precisions, in well under a minute;
 benchmarks/extreme_cases.py runs the same scenes and writes the error table.
@@ -46,6 +48,7 @@ class Case:
     per_method: dict = field(default_factory=dict)  # method -> extra overrides
     both_hit_min: int = 1          # pixels both renders must hit (0: a case that may see nothing)
     fixed_depth_tol: float = 0.0   # depth_tol for the fixed scan where it differs (0: the same)
+    methods: tuple[str, ...] = METHODS  # the march methods the case runs with (no de without an estimate)
 
     def depth_tol_for(self, method: str) -> float:
         return self.fixed_depth_tol if method == "fixed" and self.fixed_depth_tol else self.depth_tol
@@ -213,6 +216,46 @@ def _build() -> list[Case]:
              "60 post-steps: the bracket h / 2^60 is far below float32 (and float64) spacing",
              "terminates; depth converges to float precision and stays there",
              0.02, 1e-4, "", cheap),
+        # The hypercomplex numbers have zero divisors: h = a e1 + b e2 with a = 0 or b = 0
+        # (x = -w, y = z or x = w, y = -z; algebra/hypercomplex.cl), where 1/h and ln h are
+        # infinite in one component.  An eye on x = 0, y = z looking at the origin sends the
+        # centre ray (an odd image size has one: u = v = 0) along them.
+        Case("hc_reciprocal_zero_divisors", ("fractal.algebra=hypercomplex", "fractal.function=reciprocal",
+                                            "fractal.c=0.3,0.1,0,0", "camera.position=0,1.5,1.5,0",
+                                            "camera.target=0,0,0,0", "fractal.max_iter=10"),
+             "1/h on the zero divisors (a = 0 exactly along the view axis): inf in one component",
+             "the orbit escapes there (inf and NaN fail the bailout test): a hole around the "
+             "centre, no NaN in any output, terminates",
+             0.05, 1e-3, "", (25, 19), methods=("fixed",)),
+        Case("hc_ln_zero_divisors", ("fractal.algebra=hypercomplex", "fractal.function=ln",
+                                    "fractal.c=0.5,0.2,0,0", "camera.position=0,1.5,1.5,0",
+                                    "camera.target=0,0,0,0", "fractal.max_iter=10"),
+             "ln h on the zero divisors: -inf in one component",
+             "escapes there, no NaN in any output, terminates",
+             0.05, 1e-3, "", (25, 19), methods=("fixed",)),
+        Case("hc_exp_overflow", ("fractal.algebra=hypercomplex", "fractal.function=exp",
+                                "fractal.bailout=1000", "fractal.c=-0.5,0.3,0,0", "fractal.max_iter=20",
+                                "camera.position=2500,2000,-3000,0", "camera.fov=50"),
+             "e^h with bailout 1e3: e^|a| overflows float32 (above 88.7) and float64 (above 709) "
+             "before an orbit reaches the bailout",
+             "inf components escape; no NaN in any output; terminates",
+             0.05, 1e-3, "", cheap, methods=("fixed",), both_hit_min=0),
+        Case("hc_cosh_overflow", ("fractal.algebra=hypercomplex", "fractal.function=cosh",
+                                 "fractal.bailout=1000", "fractal.c=0.2,0.1,0,0", "fractal.max_iter=20",
+                                 "camera.position=2500,2000,-3000,0", "camera.fov=50"),
+             "cosh h with bailout 1e3: cosh and sinh overflow on every sample with a component "
+             "beyond 89 (float32) or 710 (float64)",
+             "inf components escape; no NaN in any output; terminates (the set is hairy and thin "
+             "at this scale: a 250-step scan sees none of it)",
+             0.05, 1e-3, "", cheap, methods=("fixed",), both_hit_min=0),
+        Case("hc_tan_poles", ("fractal.algebra=hypercomplex", "fractal.function=tan",
+                             "fractal.c=1.5707964,0,0,0", "fractal.max_iter=30",
+                             "camera.position=4.4,3.9,-5.4,0"),
+             "tan h with c on a pole (pi/2): orbits land next to poles, values near 1e7 and beyond",
+             "escapes or stays, never NaN in an output; terminates; chaotic near poles, so "
+             "float32 and float64 orbits part: measured, not asserted",
+             0.05, 1e-3, "chaotic: float32 and float64 orbits separate near the poles", cheap,
+             methods=("fixed",), both_hit_min=0),
     ]
     return cases
 

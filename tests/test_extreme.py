@@ -24,7 +24,7 @@ from pyjulia4d.scene import Scene, SceneError, march_method
 
 CASES = cat.catalogue()
 IDS = [c.name for c in CASES]
-PAIRS = [pytest.param(c, m, id=f"{c.name}-{m}") for c in CASES for m in cat.METHODS]
+PAIRS = [pytest.param(c, m, id=f"{c.name}-{m}") for c in CASES for m in c.methods]
 
 
 @lru_cache(maxsize=None)

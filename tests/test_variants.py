@@ -22,6 +22,12 @@ SCENES = [
     ["march.method=de", "march.refine=bisect", "fractal.c=-0.75,0.15,0,0", "fractal.max_iter=20"],
     ["march.epsilon=1e-8", "march.post_steps=0", "fractal.max_iter=100"],   # ulp steps
     ["camera.position=0.05,0.1,-0.1,0", "camera.target=0,0,1,0"],           # eye inside
+    ["fractal.function=cube", "fractal.c=0.3,0.4,0,0"],
+    ["fractal.algebra=hypercomplex", "fractal.function=sqr", "fractal.max_iter=8"],
+    ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=0.5,0.3,0.2,0",
+     "fractal.max_iter=6", "camera.position=3,2.5,-4,0"],
+    ["fractal.algebra=hypercomplex", "fractal.function=pwr", "fractal.exponent=2.5,0.5",
+     "fractal.max_iter=6"],
 ]
 
 
@@ -47,7 +53,11 @@ def test_packets_give_the_same_pixels(over, lanes):
     # packets add as products where one ray calls dot() (where the depths differ by a few
     # ulp, so may the normals of a max_iter-20 surface)
     eq = a == b
-    assert np.mean(eq) >= 0.75          # measured 79-100 %
+    # measured 79-100 % for quaternions; 67 % for the hypercomplex square (its box-like faces
+    # meet the rays at grazing angles, so an ulp in an iterate moves the depth), and the
+    # functions' vector exp, log, atan2 (PoCL's libm) round differently from the scalar ones
+    hyper = "fractal.algebra=hypercomplex" in over
+    assert np.mean(eq) >= (0.6 if hyper else 0.75)
     dn = np.abs(pk.normal[hit][eq] - one.normal[hit][eq]).max(axis=-1)
     assert np.mean(dn <= 1e-4) >= 0.99, np.percentile(dn, [50, 99, 100])
 
