@@ -223,7 +223,7 @@ class NormalKernels:
     def __call__(self, scene: Scene, res, method: str) -> np.ndarray:
         pr = Precision(scene.render.float == "double")
         cfg = build.KernelConfig(build.iteration_pieces(scene) + (f"normals/{method}",),
-                                 build.precision_defines(scene))
+                                 build.precision_defines(scene) + build.fractal_defines(scene))
         prg = build.program(self.ctx, cfg)
         q = self.queue
         w, h = scene.image.width, scene.image.height

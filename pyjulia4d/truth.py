@@ -34,8 +34,9 @@ Three oracles, from exact to merely converged:
 
 Ground-truth normals: radial for c = 0, otherwise the float64 analytic Jacobian
 normal grad |q_n|^2 = 2 J^T q_n (seed 004 "method 3", ``reference.normal_jacobian``)
-at the ground-truth hit point, projected to camera coordinates exactly like
-normals/jacobian.cl.
+at a point verified outside just in front of the ground-truth crossing
+(``outside_points``: n is the iteration at which it escapes), projected to camera
+coordinates exactly like normals/jacobian.cl.
 """
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ import numpy as np
 from . import reference as ref
 from .camera import bounding_radius, camera_frame
 from .render import STATUS_HIT, render
-from .scene import Scene
+from .scene import Scene, has_distance_estimate
 
 
 # ------------------------------------------------------------------ c = 0
@@ -270,7 +271,8 @@ def _polish(scene: Scene, depth32, hit, inside_fn=None):
     out = t.copy()
     verified = np.zeros(t.size, bool)
     if inside_fn is None:
-        inside_fn = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout)
+        F = ref.formula_of(f)
+        inside_fn = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)
     if k.size:
         tk = t[k]
         delta = 2.0 * _ulp32(tk) + 1e-9
@@ -390,8 +392,31 @@ def jacobian_normals(points, scene: Scene):
     out = np.zeros(p.shape[:-1] + (3,))
     ok = np.all(np.isfinite(p), -1)
     if ok.any():
-        g = ref.normal_jacobian(p[ok], f.c, f.max_iter, f.bailout)
+        g = ref.normal_jacobian(p[ok], f.c, f.max_iter, f.bailout, formula=ref.formula_of(f))
         out[ok] = ref._unit_or_zero(ref._to_camera(g, fr))
+    return out
+
+
+def outside_points(o, d, t, inside_fn, rel: float = 1e-12, tries: int = 8):
+    """Points just in front of the crossings t (+inf: none) on rays o + t d, verified outside
+    (NaN where none is found within rel * 10^tries * max(1, t)).  The surface there is the
+    level set |q_n|^2 = bailout^2 of the iteration n at which these points escape, so the
+    normal is taken there (as the kernels do at their depth, the bracket's outside end),
+    not at the inside point, whose orbit never escapes and whose |q_N|^2 can belong to
+    another level set entirely (the hypercomplex functions)."""
+    t = np.asarray(t, np.float64).ravel()
+    out = np.full((t.size, 4), np.nan)
+    todo = np.nonzero(np.isfinite(t))[0]
+    step = rel * np.maximum(1.0, t)
+    for _ in range(tries):
+        if todo.size == 0:
+            break
+        x = np.maximum(t[todo] - step[todo], 0.0)
+        p = o[todo] + x[:, None] * d[todo]
+        ok = ~inside_fn(p)
+        out[todo[ok]] = p[ok]
+        todo = todo[~ok]
+        step[todo] *= 10.0
     return out
 
 
@@ -408,22 +433,28 @@ class Truth:
     seconds: float = 0.0
 
 
+def is_quaternion_sqr(scene: Scene) -> bool:
+    """The analytic and 2D oracles hold for q -> q^2 + c over the quaternions only."""
+    return scene.fractal.algebra == "quaternion" and scene.fractal.function == "sqr"
+
+
 def is_real_c(scene: Scene) -> bool:
     c = scene.fractal.c
-    return c[1] == 0 and c[2] == 0 and c[3] == 0
+    return is_quaternion_sqr(scene) and c[1] == 0 and c[2] == 0 and c[3] == 0
 
 
 def ground_truth(scene: Scene, n_scan: int = 8000, de_search: bool = True, **converged_kw) -> Truth:
-    """The best oracle for the scene: analytic for c = 0; for real c the 2D oracle, else
-    ``converged_depth``; in both cases (``de_search``) the earlier, per pixel, of that
-    scan's and ``de_depth``'s float64-verified crossings (``earliest``).  The march
+    """The best oracle for the scene: for the quaternion square analytic at c = 0 and the
+    2D oracle at real c; else ``converged_depth`` (every algebra and function); where the
+    pair has a distance estimate (``de_search``) the earlier, per pixel, of that scan's and
+    ``de_depth``'s float64-verified crossings (``earliest``).  The march
     settings of ``scene`` are ignored; only the fractal, camera, slice and image matter."""
     t0 = time.perf_counter()
     f = scene.fractal
     fr = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
     o, d = ref.generate_rays(fr, w, h)
-    if all(x == 0 for x in f.c):
+    if is_quaternion_sqr(scene) and all(x == 0 for x in f.c):
         t = sphere_depth(o, d, sphere_radius(f.max_iter, f.bailout))
         hit = np.isfinite(t)
         pts = o + np.where(hit, t, 0)[:, None] * d
@@ -442,12 +473,13 @@ def ground_truth(scene: Scene, n_scan: int = 8000, de_search: bool = True, **con
         kind = "converged"
         rec = {"converged": cd.converged, "tol": cd.tol, "frac": cd.frac, "confirm": cd.confirm,
                "post_steps": cd.post_steps, "steps": cd.record}
-    if de_search:
+    if de_search and has_distance_estimate(f):
         t_de, _, de_rec = de_depth(scene)
         t, comb = earliest(o, d, t, t_de.ravel())
         rec["de_search"] = de_rec | comb
     hit = np.isfinite(t)
-    pts = np.where(hit[:, None], o + np.where(hit, t, 0)[:, None] * d, np.nan)
+    F = ref.formula_of(f)
+    pts = outside_points(o, d, t, lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F))
     n = jacobian_normals(pts, scene)
     tr = Truth(t.reshape(h, w), hit.reshape(h, w), n.reshape(h, w, 3), kind, rec)
     tr.seconds = time.perf_counter() - t0
