@@ -82,6 +82,7 @@ typedef real4 quat;
 #define QUAT(a, b, c, d) ((real4)((a), (b), (c), (d)))
 #define QNORM2(q) dot((q), (q))
 #define QADD_UNIFORM(q, v) ((q) + (v))
+#define QADD(a, b) ((a) + (b))
 #define QSEL(a, b, m) ((m) ? (b) : (a))
 #define QRAY(o, d, t) ((o) + (t) * (d))
 #define QDOT(a, b) dot((a), (b))
@@ -103,6 +104,7 @@ inline quat quat_make(lreal a, lreal b, lreal c, lreal d) { quat q = {a, b, c, d
 #define QUAT(a, b, c, d) quat_make((a), (b), (c), (d))
 inline lreal QNORM2(quat q) { return q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w; }
 inline quat QADD_UNIFORM(quat q, real4 v) { return QUAT(q.x + v.x, q.y + v.y, q.z + v.z, q.w + v.w); }
+inline quat QADD(quat a, quat b) { return QUAT(a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w); }
 inline quat QRAY(quat o, quat d, lreal t)
 {
     return QUAT(o.x + t * d.x, o.y + t * d.y, o.z + t * d.z, o.w + t * d.w);

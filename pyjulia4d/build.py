@@ -34,7 +34,8 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
     function and its derivative) and one algebra (algebra/<name>.cl: the map q -> f(q) + c
     built from them), the iteration."""
     f = scene.fractal
-    return ("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}", "iterate")
+    power = ("algebra/power",) if f.algebra in ("cquat", "commutative") else ()
+    return ("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power + ("iterate",)
 
 
 def fractal_defines(scene: Scene) -> tuple[str, ...]:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import POLYNOMIAL_DEGREE, Scene, SceneError, march_method
+from .scene import Scene, SceneError, escape_degree, march_method
 
 
 def cross4(a, b, c) -> np.ndarray:
@@ -139,7 +139,7 @@ def march_radius(scene: Scene) -> float:
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
     estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
     f = scene.fractal
-    r = bounding_radius(f.c, f.bailout, f.max_iter, POLYNOMIAL_DEGREE.get(f.function))
+    r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
     if march_method(scene) == "de":
         r += 4.0 * scene.march.epsilon
     return r

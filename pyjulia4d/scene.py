@@ -49,14 +49,25 @@ class SceneError(ValueError):
 
 # The 4D algebras and the iterated functions f (q -> f(q) + c) of POV-Ray's julia_fractal
 # (seed 003_8ca5f9108f52d3d6.txt), in its order.  Quaternions take sqr and cube only,
-# as in POV-Ray; the hypercomplex numbers take every function.
-ALGEBRAS = ("quaternion", "hypercomplex")
+# as in POV-Ray; the hypercomplex numbers take every function; Gintz's CQuats and the
+# naive commutative rules (seed 000 eqs. 14, 15) sqr and cube.
+ALGEBRAS = ("quaternion", "hypercomplex", "cquat", "commutative")
 FUNCTIONS = ("sqr", "cube", "exp", "reciprocal", "sin", "asin", "sinh", "asinh", "cos", "acos",
              "cosh", "acosh", "tan", "atan", "tanh", "atanh", "ln", "pwr")
-FUNCTIONS_OF = {"quaternion": ("sqr", "cube"), "hypercomplex": FUNCTIONS}
+FUNCTIONS_OF = {"quaternion": ("sqr", "cube"), "hypercomplex": FUNCTIONS, "cquat": ("sqr", "cube"),
+                "commutative": ("sqr", "cube")}
 # The polynomial maps, by degree: they escape to infinity like |q|^degree, which gives the
 # bounding ball and the distance estimate (camera.bounding_radius, iterate.cl).
 POLYNOMIAL_DEGREE = {"sqr": 2, "cube": 3}
+# Algebras where |q^D| >= |q|^D, so that the escape bound holds: quaternions (the norm is
+# multiplicative) and the hypercomplex numbers (the power mean of their two complex
+# components).  CQuats and the commutative rules have zero divisors with |q^2| < |q|^2.
+NORM_BOUNDED = ("quaternion", "hypercomplex")
+
+
+def escape_degree(f: "Fractal") -> int | None:
+    """D where |f(q)| >= |q|^D - |c| (camera.bounding_radius), else None."""
+    return POLYNOMIAL_DEGREE.get(f.function) if f.algebra in NORM_BOUNDED else None
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ import pytest
 
 from harness import Runner
 from pyjulia4d import build, reference as ref
-from pyjulia4d.reference.algebra import hypercomplex as hc, quaternion as qa
+from pyjulia4d.reference.algebra import commutative as cm, cquat as cq, hypercomplex as hc, quaternion as qa
 from pyjulia4d.reference.formula import Formula, complex_value
 from pyjulia4d.render import STATUS_HIT, render
 from pyjulia4d.scene import FUNCTIONS, FUNCTIONS_OF, Scene, SceneError
@@ -57,6 +57,49 @@ def test_hypercomplex_table():
     a, b, c = rand4(100, 1), rand4(100, 2), rand4(100, 3)
     np.testing.assert_allclose(m(a, b), m(b, a), atol=1e-12)
     np.testing.assert_allclose(m(m(a, b), c), m(a, m(b, c)), atol=1e-12)
+
+
+def test_cquat_table():
+    # seed 000 eq. 14: i^2 = -1, j^2 = k^2 = 1, ij = ji = -k, ki = ik = -j, jk = kj = i;
+    # commutative, NOT associative, zero divisors (1 + j)(1 - j) = 0
+    m = cq.alg_mul
+    np.testing.assert_array_equal(m(I, I), -ONE)
+    np.testing.assert_array_equal(m(J, J), ONE)
+    np.testing.assert_array_equal(m(K, K), ONE)
+    np.testing.assert_array_equal(m(I, J), -K)
+    np.testing.assert_array_equal(m(K, I), -J)
+    np.testing.assert_array_equal(m(J, K), I)
+    np.testing.assert_array_equal(m(m(I, I), J), -J)
+    np.testing.assert_array_equal(m(I, m(I, J)), J)          # (ii)j != i(ij)
+    np.testing.assert_array_equal(m(ONE + J, ONE - J), 0 * ONE)
+    a, b = rand4(100, 1), rand4(100, 2)
+    np.testing.assert_allclose(m(a, b), m(b, a), atol=1e-12)
+
+
+def test_commutative_table():
+    # seed 000 eq. 15: i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j, jk = kj = i;
+    # commutative, NOT associative
+    m = cm.alg_mul
+    for u in (I, J, K):
+        np.testing.assert_array_equal(m(u, u), -ONE)
+    np.testing.assert_array_equal(m(J, I), K)
+    np.testing.assert_array_equal(m(I, K), J)
+    np.testing.assert_array_equal(m(K, J), I)
+    np.testing.assert_array_equal(m(m(I, I), J), -J)
+    np.testing.assert_array_equal(m(I, m(I, J)), J)          # (ii)j != i(ij)
+    a, b, c = rand4(100, 1), rand4(100, 2), rand4(100, 3)
+    np.testing.assert_allclose(m(a, b), m(b, a), atol=1e-12)
+    assert np.max(np.abs(m(m(a, b), c) - m(a, m(b, c)))) > 0.1
+
+
+@pytest.mark.parametrize("algebra", ["cquat", "commutative"])
+@pytest.mark.parametrize("power", ["sqr", "cube"])
+def test_power_jvp_is_the_derivative(algebra, power):
+    F = Formula(algebra, power)
+    q, h = rand4(100, 8), rand4(100, 9)
+    eps = 1e-6
+    fd = (F.julia_f(q + eps * h, 0) - F.julia_f(q - eps * h, 0)) / (2 * eps)
+    np.testing.assert_allclose(F.julia_f_jvp(q, h), fd, rtol=1e-6, atol=1e-6)
 
 
 def test_hypercomplex_split_is_the_product():

@@ -1,0 +1,20 @@
+/* algebra/power.cl: q -> q^D + c in a commutative algebra given only by its product
+ * alg_mul (algebra/cquat.cl, algebra/commutative.cl), D = FUNC_POWER (function/sqr.cl,
+ * function/cube.cl).  Without associativity the cube needs a bracketing: (q q) q, which
+ * commutativity makes equal to q (q q).  Derivatives by the product rule, commutativity
+ * merging the terms: d(q q)[h] = 2 q h,  d((q q) q)[h] = (2 q h) q + (q q) h. */
+#ifndef FUNC_POWER
+#error "this algebra takes sqr and cube only (scene.FUNCTIONS_OF)"
+#endif
+
+#if FUNC_POWER == 2
+inline quat julia_f(quat q, real4 c) { return QADD_UNIFORM(alg_mul(q, q), c); }
+inline quat julia_f_jvp(quat q, quat h) { return QSCALE((lreal)2, alg_mul(q, h)); }
+#else
+inline quat julia_f(quat q, real4 c) { return QADD_UNIFORM(alg_mul(alg_mul(q, q), q), c); }
+inline quat julia_f_jvp(quat q, quat h)
+{
+    return QADD(alg_mul(QSCALE((lreal)2, alg_mul(q, h)), q), alg_mul(alg_mul(q, q), h));
+}
+#endif
+#define JULIA_GROWTH FUNC_POWER

@@ -1,0 +1,14 @@
+"""float64 twin of kernels/algebra/power.cl: q^D + c in a commutative algebra given by its
+product alg_mul (cquat.py, commutative.py); the cube bracketed (q q) q."""
+from __future__ import annotations
+
+
+def julia_f(alg_mul, q, c, power):
+    qq = alg_mul(q, q)
+    return (qq if power == 2 else alg_mul(qq, q)) + c
+
+
+def julia_f_jvp(alg_mul, q, h, power):
+    if power == 2:
+        return 2 * alg_mul(q, h)
+    return alg_mul(2 * alg_mul(q, h), q) + alg_mul(alg_mul(q, q), h)
