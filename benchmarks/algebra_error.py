@@ -1,7 +1,8 @@
 """Depth error against run time for the algebras and functions beyond the quaternion square.
 
-One scene per algebra x function pair named in the README's "Algebras and functions"
-(quaternion cube, hypercomplex sqr, and the hypercomplex exp, sin, cosh, atan, ln, pwr),
+One scene per algebra beyond the quaternion square and per hypercomplex function named in
+the README's "Algebras and functions" (quaternion cube, CQuat and commutative sqr,
+hypercomplex sqr, and the hypercomplex exp, sin, cosh, atan, ln, pwr),
 each against a float64 ground truth that does not come from the setting under test:
 ``truth.ground_truth`` - for these pairs the double-precision kernels' fixed scan with 20
 post-steps, its z-resolution doubled until two doublings in a row move at most 0.2 % of
@@ -66,6 +67,12 @@ SCENES = {
     "hc_pwr": (HC + ["fractal.function=pwr", "fractal.exponent=2.5,0.5", "fractal.c=-0.5,0.3,0.1,0",
                      "fractal.max_iter=8"],
                "hypercomplex pwr(2.5, 0.5), c = (-0.5, 0.3, 0.1, 0), max_iter 8"),
+    "cquat_sqr": (["fractal.algebra=cquat", "fractal.c=-0.7323,-0.2179,0.1,0", "fractal.max_iter=12",
+                   "camera.position=-2,1,5,0"],
+                  "CQuat sqr, c = -0.7323-0.2179i+0.1j, max_iter 12"),
+    "comm_sqr": (["fractal.algebra=commutative", "fractal.c=-0.7323,-0.2179,0.1,0", "fractal.max_iter=12",
+                  "camera.position=-2,1,5,0"],
+                 "commutative sqr, seed 000 Fig. 7's c = -0.7323-0.2179i+0.1j, max_iter 12"),
 }
 
 FIXED = [(z, p) for z in (70, 250, 1000, 4000) for p in (0, 4, 10)]

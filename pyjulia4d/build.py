@@ -62,12 +62,30 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
         defines.append("REFINE_ITP")
     if ray_buffers:
         defines.append("RAYS_FROM_BUFFERS")
-    pieces += [f"march/{march_method(scene)}", "rays", "march/march", f"normals/{scene.normals.method}", "shade"]
+    pieces += [f"march/{march_method(scene)}", "rays", "march/march", f"normals/{scene.normals.method}"]
+    light = light_defines(scene)
+    if light:
+        pieces.append("shade/light")
+    pieces.append("shade/shade")
+    defines += light
     if scene.shading.specular > 0:
         defines.append("SPECULAR")
     if not isinstance(scene.shading.light, str):
         defines.append("LIGHT_POINT")
     return KernelConfig(tuple(pieces), tuple(defines))
+
+
+def light_defines(scene: Scene) -> tuple[str, ...]:
+    """The switches of shade/light.cl a scene uses (none: the piece is not compiled)."""
+    sh = scene.shading
+    out = []
+    if sh.shadow != "none":
+        out.append(f"SHADOW_{sh.shadow.upper()}")
+    if sh.ao > 0:
+        out.append("AO")
+    if sh.coloring != "flat":
+        out += [f"COLOR_{sh.coloring.upper()}", "COLORMAP"]
+    return tuple(out + ["LIGHT_TERMS"]) if out else ()
 
 
 # The pixel block a packet of rays covers, by lane count (kernels/real.cl BLOCK_W x
@@ -90,6 +108,8 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
     pieces = cfg.pieces[: cfg.pieces.index("march/march") + 1]
     if scene.normals.method == "jacobian":
         pieces += ("normals/jacobian",)
+    if "shade/light" in cfg.pieces:
+        pieces += ("shade/light",)
     if lanes == 1:
         return KernelConfig(pieces, cfg.defines)
     bw, bh = packet_block(lanes)

@@ -188,18 +188,22 @@ def write_png(
     alpha: np.ndarray,
     text: Mapping[str, str] | None = None,
 ) -> None:
-    """8-bit RGBA PNG from ``color`` (H, W, 3) and ``alpha`` (H, W) in [0, 1].
+    """8-bit RGBA PNG from ``color`` (H, W, 3), linear light, and ``alpha`` (H, W) in [0, 1].
 
-    Values are clipped and rounded; no sRGB transfer is applied.  ``text``
-    entries become PNG tEXt chunks.
+    The colour is clipped to [0, 1] and sRGB-encoded (the renderer shades in linear light;
+    an EXR keeps it linear), alpha is linear; both rounded.  ``text`` entries become PNG
+    iTXt chunks.
     """
     from PIL import Image, PngImagePlugin
+
+    from .colormap import linear_to_srgb
 
     color = np.asarray(color)
     alpha = np.asarray(alpha)
     if color.ndim != 3 or color.shape[2] != 3 or alpha.shape != color.shape[:2]:
         raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
-    rgba = np.concatenate([_to_u8(color), _to_u8(alpha)[..., None]], axis=2)
+    rgb = linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0))
+    rgba = np.concatenate([_to_u8(rgb), _to_u8(alpha)[..., None]], axis=2)
     info = PngImagePlugin.PngInfo()
     for k, v in (text or {}).items():
         info.add_itxt(k, str(v))  # iTXt: UTF-8, unlike tEXt's Latin-1

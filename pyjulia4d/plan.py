@@ -95,6 +95,11 @@ class Plan:
         return "color" in self.outputs
 
     @property
+    def light_terms(self) -> bool:
+        """Whether shade/light.cl runs (shadows, ambient occlusion, a colour map): only for shading."""
+        return self.shades and "shade/light" in self.program.pieces
+
+    @property
     def normals_in_march_program(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (build.march_config)."""
         return self.scene.normals.method == "jacobian"

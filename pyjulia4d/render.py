@@ -17,11 +17,11 @@ import pyopencl as cl
 import pyopencl.array as cla
 from tqdm import tqdm
 
-from . import build
+from . import build, colormap
 from .devices import has_fp64, select_device
 from .lanes import lanes_for
 from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
-from .scene import Scene, SceneError
+from .scene import Scene, SceneError, march_method
 
 STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
 # Guard flags (kernels/real.cl): the march's flags buffer and the normals' w component
@@ -299,6 +299,8 @@ class TileRunner:
                 bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
             if plan.shades:
                 bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            if plan.light_terms:
+                bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
             stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
             self.slots.append((bufs, stage))
         fr = plan.frame
@@ -314,6 +316,14 @@ class TileRunner:
                             np.float32(sh.shininess))
         self.march_k = cl.Kernel(self.march_prg, "march")
         self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
+        # shade/light.cl: in the march's packets where the march has them (build.march_config)
+        self.light_k = (cl.Kernel(self.march_prg if plan.lanes > 1 else self.prg, "light_terms")
+                        if plan.light_terms else None)
+        self.light_const = light_arguments(plan, pr) if plan.light_terms else ()
+        lut = (colormap.table(sh.colormap) if sh.coloring != "flat" else np.zeros((2, 4), np.float32))
+        self.lut = cla.to_device(self.queue, lut.view(cl.cltypes.float4).ravel())
+        self.n_lut = np.int32(len(lut))
+        self.no_terms = cla.empty(self.queue, 1, cl.cltypes.float4)
 
     def enqueue(self, tile: Tile, slot: int) -> tuple[list[cl.Event], list[cl.Event]]:
         """Queue the tile's kernels and the copies of what is read back into ``slot``:
@@ -332,9 +342,16 @@ class TileRunner:
                                           plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
                                           bufs["normal"], size=(tile.aw, tile.ah),
                                           lanes=plan.lanes if packet else 1))
+        if plan.light_terms:
+            kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
+                                  bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
+                                  bufs["terms"].data,
+                                  lanes=plan.lanes))
         if plan.shades:
+            terms = bufs["terms"] if plan.light_terms else self.no_terms
             kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
-                                  bufs["point"].data, *self.shade_const, bufs["rgba"].data))
+                                  bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
+                                  self.n_lut, bufs["rgba"].data))
         copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
         return kernels, copies
 
@@ -353,6 +370,33 @@ class TileRunner:
             else:
                 out[k] = a.reshape(shape)
         return out
+
+
+def light_parameters(sc: Scene, radius: float) -> dict:
+    """shade/light.cl's numbers: the shadow rays' step (the march's epsilon, or the fixed
+    scan's spacing across the bounding ball) and cap, the offset of their start off the
+    surface along the normal (two steps, at least 1e-3 of the ball's radius: the hit is
+    the outside end of its bracket, so this starts clear of the surface), the penumbra,
+    occlusion and trap settings."""
+    m, sh = sc.march, sc.shading
+    if march_method(sc) == "de":
+        step, cap = m.epsilon, m.max_steps
+    else:
+        step, cap = 2.0 * radius / m.z_resolution, m.z_resolution + 1
+    return dict(step=step, max_steps=cap, bias=max(2.0 * step, 1e-3 * radius),
+                softness=sh.shadow_softness, ao_distance=sh.ao_distance, ao_strength=sh.ao,
+                trap=tuple(sh.trap) + (0.0,) * (4 - len(sh.trap)))
+
+
+def light_arguments(plan: Plan, pr: Precision) -> tuple:
+    """The light_terms kernel's arguments after the buffers (kernels/shade/light.cl)."""
+    sc, fr = plan.scene, plan.frame
+    f = sc.fractal
+    lp = light_parameters(sc, plan.radius)
+    return (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(sc.march.epsilon),
+            pr.v4(fr.right), pr.v4(fr.up), pr.v4(fr.forward), pr.v4(plan.light), pr.scalar(plan.radius),
+            pr.scalar(lp["step"]), pr.scalar(lp["bias"]), pr.scalar(lp["softness"]), np.int32(lp["max_steps"]),
+            pr.scalar(lp["ao_distance"]), pr.scalar(lp["ao_strength"]), pr.v4(lp["trap"]))
 
 
 def _seconds(events) -> float:

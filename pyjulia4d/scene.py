@@ -145,7 +145,7 @@ class Normals:
 class Shading:
     """[shading]: Phong shading; ``light`` is "eye" or a 4D position."""
 
-    color: Vec3 = (0.95, 0.72, 0.42)
+    color: Vec3 = (0.89, 0.477, 0.147)  # linear light (sRGB (0.95, 0.72, 0.42))
     background: Vec3 = (0.0, 0.0, 0.0)
     ambient: float = 0.08
     diffuse: float = 0.92
@@ -153,6 +153,13 @@ class Shading:
     shininess: float = 40.0
     light: Union[Vec4, Literal["eye"]] = "eye"
     light_color: Vec3 = (1.0, 1.0, 1.0)
+    shadow: str = "none"           # "none" | "hard" | "soft" (shade/light.cl)
+    shadow_softness: float = 16.0  # k of the penumbra min(k d / t): larger is sharper
+    ao: float = 0.0                # ambient occlusion strength, 0 = off
+    ao_distance: float = 0.1       # how far along the normal occlusion is sampled
+    coloring: str = "flat"         # "flat" | "iteration" | "trap" | "w"
+    colormap: str = "viridis"      # a matplotlib colour map (COLORMAPS)
+    trap: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the orbit trap's point (coloring = "trap")
 
 
 @dataclass(frozen=True)
@@ -169,6 +176,13 @@ class Render:
 
     float: str = "single"
     variant: str = "auto"
+
+
+# Colour maps shading.colormap accepts: matplotlib's, named here so that a scene is checked
+# without importing matplotlib (tests/test_shade.py checks each exists there).
+COLORMAPS = ("viridis", "plasma", "inferno", "magma", "cividis", "twilight", "twilight_shifted", "turbo",
+             "cubehelix", "Spectral", "coolwarm", "RdYlBu", "copper", "bone", "hot", "afmhot", "ocean",
+             "terrain", "gist_earth", "gnuplot2", "CMRmap", "YlOrBr", "PuBuGn", "BuPu")
 
 
 # ---------------------------------------------------------------- checkers
@@ -393,6 +407,13 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "shininess": _Real(1e-3, 1e4),
         "light": _OrWord("eye", _Vector((3, 4), -COORD, COORD)),
         "light_color": _Vector((3,), 0.0, 1e3),
+        "shadow": _Choice("none", "hard", "soft"),
+        "shadow_softness": _Real(1.0, 1e3),
+        "ao": _Real(0.0, 1.0),
+        "ao_distance": _Real(1e-4, 10.0),
+        "coloring": _Choice("flat", "iteration", "trap", "w"),
+        "colormap": _Choice(*COLORMAPS),
+        "trap": _Vector((3, 4), -COORD, COORD),
     },
     "image": {
         "width": _Integer(1, _INT_MAX),
@@ -553,9 +574,16 @@ def _check_fractal(scene: "Scene") -> None:
         raise SceneError("fractal.function", f"{f.function!r} is not defined for the {f.algebra} algebra "
                          f"(as in POV-Ray's julia_fractal: {' and '.join(allowed)} only); use "
                          f"fractal.algebra=hypercomplex for it")
+    sh = scene.shading
+    if sh.shadow != "none" and isinstance(sh.light, str):
+        raise SceneError("shading.shadow", f"{sh.shadow!r} needs a positioned light (shading.light = [x, y, z]); "
+                         "the light at the eye casts no visible shadow")
     if has_distance_estimate(f):
         return
     pair = f"{f.algebra} {f.function}"
+    if sh.shadow == "soft":
+        raise SceneError("shading.shadow", f"soft shadows measure the penumbra with the distance estimate, "
+                         f"which {pair} has none of; use hard")
     if m.quality != "custom":
         raise SceneError("march.quality", f"the presets march by distance estimate, which {pair} has "
                          f"none of; use march.quality=custom (the fixed scan)")

@@ -36,8 +36,10 @@ def test_png_rgba8(tmp_path) -> None:
     a = np.asarray(im)
     assert a.dtype == np.uint8
     np.testing.assert_array_equal(a[..., 3], np.rint(alpha * 255))
-    expect = np.rint(np.clip(np.nan_to_num(color), 0, 1) * 255)
-    np.testing.assert_array_equal(a[..., :3], expect)
+    # linear light in, sRGB out (IEC 61966-2-1: 0.0031308 -> 12.92 x, else 1.055 x^(1/2.4) - 0.055)
+    x = np.clip(np.nan_to_num(color).astype(np.float64), 0, 1)
+    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+    np.testing.assert_array_equal(a[..., :3], np.rint(srgb * 255))
     assert im.info["pyjulia4d.scene"] == "[image]\nwidth = 7\n"
     assert [p.name for p in tmp_path.iterdir()] == ["out.png"]
 

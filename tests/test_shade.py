@@ -1,4 +1,6 @@
-"""shade.cl against reference.shade on identical normals and points."""
+"""shade/shade.cl and shade/light.cl against reference.shade / reference.light_terms on
+identical normals and points; whole renders with shadows, occlusion and colour maps against
+the reference render."""
 import numpy as np
 import pyopencl as cl
 import pytest
@@ -34,7 +36,8 @@ def test_shade_matches_reference(over, fl):
       R.vec(fr.position), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward),
       R.vec(lp if lp is not None else fr.position), c4(sh.color), c4(sh.background),
       c4(sh.light_color), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-      np.float32(sh.shininess), out)
+      np.float32(sh.shininess), R.out(1, cl.cltypes.float4), R.buf(np.zeros((2, 4)), np.float32),
+      np.int32(2), out)
     got = out.get().view(np.float32).reshape(n, 4)
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
                      sh.ambient, sh.diffuse, sh.specular, sh.shininess)
@@ -42,3 +45,70 @@ def test_shade_matches_reference(over, fl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
     assert np.all(got[status != 1, 3] == 0) and np.all(got[status == 1, 3] == 1)
+
+
+def test_colormaps_exist_in_matplotlib():
+    import matplotlib
+
+    from pyjulia4d.scene import COLORMAPS
+    for name in COLORMAPS:
+        assert name in matplotlib.colormaps, name
+
+
+def test_colormap_table_is_linear_light():
+    from pyjulia4d import colormap
+    t = colormap.table("viridis")
+    assert t.shape == (256, 4) and t.dtype == np.float32
+    # the PNG writer's sRGB encoding gives the map's own colours back
+    import matplotlib
+    srgb = np.asarray(matplotlib.colormaps["viridis"](np.linspace(0, 1, 256)))[:, :3]
+    np.testing.assert_allclose(colormap.linear_to_srgb(t[:, :3]), srgb, atol=1e-6)
+
+
+LIGHT_SCENES = {
+    "soft+ao": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.ao=0.8"],
+    "hard+trap": ["shading.light=-3,4,-2", "shading.shadow=hard", "shading.coloring=trap",
+                  "shading.colormap=inferno"],
+    "iteration": ["shading.coloring=iteration", "fractal.c=-0.1,0.65,0,0", "fractal.max_iter=8"],
+    "w": ["shading.coloring=w", "camera.position=1.8,1.6,-2.2,0.6", "shading.ao=0.5"],
+    "fixed-hard-ao": ["march.method=fixed", "shading.light=-3,4,-2", "shading.shadow=hard", "shading.ao=0.8"],
+    "hypercomplex": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=0.5,0.8,0.2,0.1",
+                     "fractal.max_iter=6", "camera.position=3.6,3.2,-4.4,0", "shading.light=-5,6,-3",
+                     "shading.shadow=hard", "shading.ao=0.6", "shading.coloring=iteration"],
+}
+
+
+@pytest.mark.parametrize("name", list(LIGHT_SCENES))
+def test_light_terms_in_render_match_reference(name):
+    # kernels (in packets where the march has them) against the float64 reference render:
+    # on pixels both hit with the same depth to 1e-5, the shadow, occlusion and colour terms
+    # follow the surface, so colours agree except where a shadow ray grazes the set
+    from pyjulia4d.render import render
+    s = Scene.default().with_overrides(LIGHT_SCENES[name] + ["image.width=40", "image.height=30"])
+    k, r = render(s), ref.render(s)
+    with np.errstate(invalid="ignore"):   # inf - inf on misses
+        both = (k.status == 1) & (r.status == 1) & (np.abs(k.depth - r.depth) < 1e-5)
+    assert both.sum() > 100
+    dc = np.abs(k.color[both] - r.color[both]).max(axis=-1)
+    assert np.median(dc) < 1e-3 and np.mean(dc < 0.02) > 0.95, np.percentile(dc, [50, 95, 100])
+    assert np.all(np.isfinite(k.color))
+
+
+def test_scene_without_light_terms_compiles_none():
+    src = build.source(build.scene_config(Scene.default()))
+    assert '"shade/light.cl"' not in src
+    src = build.source(build.scene_config(Scene.default().with_overrides(["shading.ao=0.5"])))
+    assert '"shade/light.cl"' in src and "#define" in src
+
+
+@pytest.mark.parametrize("over,key", [
+    (["shading.shadow=hard"], "shading.shadow"),                       # light at the eye
+    (["shading.light=1,2,3", "shading.shadow=soft", "fractal.algebra=hypercomplex"], "shading.shadow"),
+    (["shading.colormap=jet2"], "shading.colormap"),
+    (["shading.ao=2"], "shading.ao"),
+])
+def test_light_settings_refused(over, key):
+    from pyjulia4d.scene import SceneError
+    with pytest.raises(SceneError) as e:
+        Scene.default().with_overrides(over)
+    assert str(e.value).startswith(key + ": ")

@@ -31,6 +31,7 @@ def _dot(a, b):
 # The quaternion square's pieces stay importable here (ref.alg_mul, ref.alg_sqr, ...).
 from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
 from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
+from .. import colormap  # noqa: E402
 
 
 # ------------------------------------------------------------------ iterate.cl
@@ -478,37 +479,6 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=Non
 
 # --------------------------------------------------------------------- shade.cl
 
-def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
-          ambient, diffuse, specular, shininess):
-    """Lambert (light at the eye by default, seed 001 §4) + ambient + Blinn-Phong; RGBA."""
-    hit = status == STATUS_HIT
-    rgba = np.zeros((len(status), 4))
-    rgba[:, :3] = background
-    if not hit.any():
-        return rgba
-    p = _to_camera(point[hit] - frame.position, frame)
-    lp = np.linalg.norm(p, axis=-1, keepdims=True)
-    # the hit is the eye itself (depth 0, camera inside the set): the view axis (shade.cl)
-    p = np.where(lp > 0, p / np.where(lp > 0, lp, 1), np.array([0.0, 0.0, -1.0]))
-    v = -p
-    if light_pos is None:
-        l = v
-    else:
-        l = _to_camera(np.asarray(light_pos) - point[hit], frame)
-        l /= np.linalg.norm(l, axis=-1, keepdims=True)
-    n = normal[hit]
-    lam = np.maximum(_dot(n, l), 0.0)
-    rgb = np.asarray(color)[None, :] * (ambient + diffuse * lam)[:, None]
-    if specular > 0:
-        hv = l + v
-        hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
-        spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
-        rgb = rgb + specular * spec[:, None]
-    rgba[hit, :3] = rgb * np.asarray(light_color)[None, :]
-    rgba[hit, 3] = 1.0
-    return rgba
-
-
 # -------------------------------------------------------------------- pipeline
 
 def render(scene: Scene) -> RenderResult:
@@ -534,8 +504,11 @@ def render(scene: Scene) -> RenderResult:
         normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard, F)
     else:
         normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
+    from .shade import light_terms_of_scene, shade
+    terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
+    lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
     rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
-                 sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess)
+                 sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut)
     res = RenderResult(color=rgba[:, :3].reshape(h, w, 3), alpha=rgba[:, 3].reshape(h, w),
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
@@ -544,3 +517,6 @@ def render(scene: Scene) -> RenderResult:
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res
+
+
+from .shade import light_terms, shade  # noqa: E402,F401  (kernels/shade/: ref.shade, ref.light_terms)

@@ -1,15 +1,20 @@
-/* shade.cl: Lambert diffuse with the light at the eye by default, so every visible
+/* shade/shade.cl: Lambert diffuse with the light at the eye by default, so every visible
  * point is lit (seed 001 §4), or at a positioned light (-D LIGHT_POINT); Blinn-Phong
  * specular (-D SPECULAR; seed 000 §5.2); ambient; background colour on a miss.
- *     rgb = light_color (color (ambient + diffuse max(n.l, 0)) + specular max(n.h, 0)^shininess)
- * All vectors in camera coordinates; output is float RGBA whatever the precision. */
+ *     rgb = light_color (base (ambient ao + diffuse vis max(n.l, 0)) + vis specular max(n.h, 0)^shininess)
+ * with vis (the light's visibility: shadows) and ao (ambient occlusion) from
+ * shade/light.cl's terms (-D LIGHT_TERMS; else 1), and base the scene's colour or, with
+ * -D COLORMAP, the colour map's entry for the hit's colour value (terms.z, linear
+ * interpolation in a table of n_lut colours).  All vectors in camera coordinates; linear
+ * light; output is float RGBA whatever the precision. */
 
 __kernel void shade(const int n_items, __global const int *status, __global const real4 *normal,
                     __global const real4 *point, const real4 eye, const real4 right,
                     const real4 up, const real4 forward, const real4 light_pos,
                     const float4 color, const float4 background, const float4 light_color,
                     const float ambient, const float diffuse, const float specular,
-                    const float shininess, __global float4 *rgba)
+                    const float shininess, __global const float4 *terms, __global const float4 *lut,
+                    const int n_lut, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -32,11 +37,24 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
     float3 l = v;
 #endif
     float lambert = fmax(dot(n, l), 0.0f);
-    float3 rgb = color.xyz * (ambient + diffuse * lambert);
+#ifdef LIGHT_TERMS
+    float4 tm = terms[i];
+    float vis = tm.x, ao = tm.y;
+#else
+    float vis = 1.0f, ao = 1.0f;
+#endif
+#ifdef COLORMAP
+    float x = clamp(tm.z, 0.0f, 1.0f) * (float)(n_lut - 1);
+    int k = min((int)x, n_lut - 2);
+    float3 base = mix(lut[k].xyz, lut[k + 1].xyz, x - (float)k);
+#else
+    float3 base = color.xyz;
+#endif
+    float3 rgb = base * (ambient * ao + diffuse * vis * lambert);
 #ifdef SPECULAR
     if (lambert > 0.0f) {
         float3 hv = normalize(l + v);
-        rgb += specular * pow(fmax(dot(n, hv), 0.0f), shininess);
+        rgb += vis * specular * pow(fmax(dot(n, hv), 0.0f), shininess);
     }
 #endif
     rgba[i] = (float4)(rgb * light_color.xyz, 1.0f);

@@ -1,0 +1,213 @@
+"""float64 twins of kernels/shade/light.cl and kernels/shade/shade.cl."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..camera import Frame
+from ..render import STATUS_HIT
+from .formula import QUATERNION_SQR, Formula
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+def _to_camera(g, frame: Frame):
+    return np.stack([g @ frame.right, g @ frame.up, -(g @ frame.forward)], axis=-1)
+
+
+def _distance_formula(x, c, max_iter, bailout, F):
+    from . import julia_distance_formula
+    return julia_distance_formula(x, c, max_iter, bailout, F)
+
+
+def _inside(x, c, max_iter, bailout, F):
+    from . import julia_inside
+    return julia_inside(x, c, max_iter, bailout, F)
+
+
+def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,
+               F: Formula = QUATERNION_SQR):
+    """Visibility of the light along o + t l (shade/light.cl shadow_ray): steps of max(d, step)
+    by the estimate where F has one (soft: min(k 2d / t)), else samples every step; 0 at the
+    first inside point; the ray clipped to the bounding ball and to tmax."""
+    n = len(o)
+    b = _dot(o, l)
+    perp = o - b[:, None] * l
+    disc = radius * radius - _dot(perp, perp)
+    s = np.sqrt(np.maximum(disc, 0.0))
+    t = np.maximum(-b - s, step)
+    t1 = np.minimum(-b + s, tmax)
+    active = (disc > 0) & (t1 > t)
+    vis = np.ones(n)
+    for _ in range(max_steps):
+        k = np.nonzero(active)[0]
+        if k.size == 0:
+            break
+        x = o[k] + t[k, None] * l[k]
+        if F.has_de:
+            d, esc = _distance_formula(x, c, max_iter, bailout, F)
+            inside = ~esc
+            if soft:
+                vis[k] = np.where(esc, np.minimum(vis[k], softness * 2 * d / t[k]), vis[k])
+            t[k] = t[k] + np.maximum(d, step)
+        else:
+            inside = _inside(x, c, max_iter, bailout, F)
+            t[k] = t[k] + step
+        vis[k[inside]] = 0.0
+        active[k] = ~inside & (t[k] < t1[k])
+    return np.clip(vis, 0.0, 1.0)
+
+
+def ambient_occlusion(p, nw, c, max_iter, bailout, dist, strength, F: Formula = QUATERNION_SQR):
+    """1 - strength * the w-weighted occlusion of five points p + h_i n (shade/light.cl)."""
+    occ = np.zeros(len(p))
+    wsum, w = 0.0, 1.0
+    for i in range(1, 6):
+        h = dist * i / 5
+        x = p + h * nw
+        if F.has_de:
+            d, esc = _distance_formula(x, c, max_iter, bailout, F)
+            d = np.where(esc, d, 0.0)
+            occ += w * np.maximum(h - 2 * d, 0.0) / h
+        else:
+            occ += w * _inside(x, c, max_iter, bailout, F)
+        wsum += w
+        w *= 0.5
+    return np.clip(1 - strength * occ / wsum, 0.0, 1.0)
+
+
+def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR):
+    """Smooth escape count of p iterated up to 4 max_iter, as (nu - max_iter) / (3 max_iter);
+    1 where it never escapes (shade/light.cl orbit_value, COLOR_ITERATION)."""
+    q = F.ALG_IN(p).copy()
+    cc = F.ALG_C(np.asarray(c, np.float64))
+    b2 = bailout * bailout
+    m2 = F.ALG_NORM2(q)
+    n = np.zeros(len(q))
+    live = m2 <= b2
+    with np.errstate(all="ignore"):
+        for _ in range(4 * max_iter):
+            if not live.any():
+                break
+            q[live] = F.julia_f(q[live], cc)
+            m2[live] = F.ALG_NORM2(q[live])
+            n[live] += 1
+            live &= m2 <= b2
+        ratio = np.log(np.maximum(m2, b2)) / np.log(max(b2, 1.0000001))
+        nu = n + 1 - np.log(np.maximum(ratio, 1.0)) / np.log(F.growth)
+    v = np.clip((nu - max_iter) / (3 * max_iter), 0.0, 1.0)
+    return np.where(m2 > b2, v, 1.0)
+
+
+def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR):
+    """1 - exp(-3 min_n |q_n - trap|) over the orbit while inside the bailout (COLOR_TRAP)."""
+    q = F.ALG_IN(p).copy()
+    cc = F.ALG_C(np.asarray(c, np.float64))
+    tq = F.ALG_IN(np.asarray(trap, np.float64))
+    b2 = bailout * bailout
+    m2 = F.ALG_NORM2(q)
+    live = m2 <= b2
+    best = F.ALG_NORM2(q - tq)
+    with np.errstate(all="ignore"):
+        for _ in range(max_iter):
+            if not live.any():
+                break
+            q[live] = F.julia_f(q[live], cc)
+            m2 = F.ALG_NORM2(q)
+            live &= m2 <= b2
+            best = np.where(live, np.minimum(best, F.ALG_NORM2(q - tq)), best)
+    return 1 - np.exp(-3 * np.sqrt(best))
+
+
+def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame: Frame, light_pos,
+                radius, step, bias, softness, max_steps, ao_distance, ao_strength, trap,
+                shadow="none", ao=False, coloring="flat", F: Formula = QUATERNION_SQR):
+    """(visibility, ambient factor, colour value, 0) per item, (1, 1, 0, 0) off hits."""
+    n = len(status)
+    out = np.tile(np.array([1.0, 1.0, 0.0, 0.0]), (n, 1))
+    hit = status == STATUS_HIT
+    k = np.nonzero(hit)[0]
+    if k.size == 0:
+        return out
+    p = point[k]
+    nc = normal[k]
+    nw = nc[:, :1] * frame.right + nc[:, 1:2] * frame.up - nc[:, 2:3] * frame.forward
+    if shadow != "none":
+        o = p + bias * nw
+        lv = np.asarray(light_pos, np.float64) - o
+        dist = np.linalg.norm(lv, axis=-1)
+        out[k, 0] = shadow_ray(o, lv / np.maximum(dist, 1e-300)[:, None], dist, c, max_iter, bailout, radius,
+                               step, softness, max_steps, shadow == "soft", F)
+    if ao:
+        out[k, 1] = ambient_occlusion(p + bias * nw, nw, c, max_iter, bailout, ao_distance, ao_strength, F)
+    if coloring == "iteration":
+        dirs = p - np.asarray(eye, np.float64)
+        dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
+        out[k, 2] = orbit_iteration(p + bracket[k, None] * dirs, c, max_iter, bailout, F)
+    elif coloring == "trap":
+        out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F)
+    elif coloring == "w":
+        out[k, 2] = np.clip(0.5 + 0.5 * p[:, 3] / radius, 0.0, 1.0)
+    return out
+
+
+def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
+    """light_terms with the scene's settings (render.light_parameters), or None when the
+    scene uses none of them."""
+    from ..camera import camera_frame, light_position, march_radius
+    from ..render import light_parameters
+    sh = scene.shading
+    if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
+        return None
+    fr = camera_frame(scene)
+    radius = march_radius(scene)
+    lp = light_parameters(scene, radius)
+    f = scene.fractal
+    light = light_position(scene)
+    return light_terms(point, normal, status, bracket, fr.position, f.c, f.max_iter, f.bailout, fr,
+                       light if light is not None else fr.position, radius, lp["step"], lp["bias"],
+                       lp["softness"], lp["max_steps"], lp["ao_distance"], lp["ao_strength"], lp["trap"],
+                       sh.shadow, sh.ao > 0, sh.coloring, F)
+
+
+def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
+          ambient, diffuse, specular, shininess, terms=None, lut=None):
+    """Lambert (light at the eye by default, seed 001 §4) + ambient + Blinn-Phong, with the
+    light's visibility and ambient occlusion from ``terms`` and the base colour from the
+    colour table ``lut`` at terms' colour value (shade/shade.cl); RGBA, linear light."""
+    hit = status == STATUS_HIT
+    rgba = np.zeros((len(status), 4))
+    rgba[:, :3] = background
+    if not hit.any():
+        return rgba
+    p = _to_camera(point[hit] - frame.position, frame)
+    lp = np.linalg.norm(p, axis=-1, keepdims=True)
+    # the hit is the eye itself (depth 0, camera inside the set): the view axis (shade.cl)
+    p = np.where(lp > 0, p / np.where(lp > 0, lp, 1), np.array([0.0, 0.0, -1.0]))
+    v = -p
+    if light_pos is None:
+        l = v
+    else:
+        l = _to_camera(np.asarray(light_pos) - point[hit], frame)
+        l /= np.linalg.norm(l, axis=-1, keepdims=True)
+    n = normal[hit]
+    lam = np.maximum(_dot(n, l), 0.0)
+    vis = terms[hit, 0] if terms is not None else np.ones(len(lam))
+    ao = terms[hit, 1] if terms is not None else np.ones(len(lam))
+    if lut is not None:
+        x = np.clip(terms[hit, 2], 0.0, 1.0) * (len(lut) - 1)
+        k = np.minimum(x.astype(int), len(lut) - 2)
+        fr = (x - k)[:, None]
+        base = lut[k, :3] * (1 - fr) + lut[k + 1, :3] * fr
+    else:
+        base = np.asarray(color)[None, :]
+    rgb = base * (ambient * ao + diffuse * vis * lam)[:, None]
+    if specular > 0:
+        hv = l + v
+        hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
+        spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
+        rgb = rgb + (vis * specular * spec)[:, None]
+    rgba[hit, :3] = rgb * np.asarray(light_color)[None, :]
+    rgba[hit, 3] = 1.0
+    return rgba
