@@ -2,7 +2,7 @@
 
 The scene is pyjulia4d's default (c = -0.2 + 0.8i, quaternion sqr, 12 iterations, the eye
 at (1.8, 1.6, -2.2) looking at the origin, 40 degrees vertical field of view, a light at the
-eye), written as POV-Ray 3.7 SDL (seed 003's julia_fractal: `max_iteration 12`, POV-Ray's
+eye, no shadows, no ambient occlusion: pyjulia4d's default with ``MATCHED``), written as POV-Ray 3.7 SDL (seed 003's julia_fractal: `max_iteration 12`, POV-Ray's
 default `precision 20`; a shadowless light, since pyjulia4d traces no shadow rays; the
 horizontal angle POV-Ray wants from the vertical one) and as a Mandelbulber2 2.20 settings
 file (formula 5 "quaternion", julia_mode, N 12, bailout 4 as pyjulia4d's escape radius;
@@ -84,11 +84,15 @@ julia_fractal {{
 }}
 """
 
+# The peers trace no shadows and light from the camera: pyjulia4d's default scene with the
+# light at the eye, no shadows and no ambient occlusion (matched lighting).
+MATCHED = ["shading.light=eye", "shading.shadow=none", "shading.ao=0"]
+
 CHILD = r"""
 import json, resource, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
-over = sys.argv[1:]
+over = %r + sys.argv[1:]
 s = Scene.default().with_overrides(over)
 render(s)
 def cpu():
@@ -98,7 +102,7 @@ c0, t0 = cpu(), time.perf_counter()
 r = render(s)
 print(json.dumps({"cpu": cpu() - c0, "wall": time.perf_counter() - t0, "hit": r.hit_fraction,
                   "device": r.device_name}))
-"""
+""" % (MATCHED,)
 
 # Mandelbulber2 2.20 settings ("only modified parameters"; the rest keep their defaults)
 MB_SETTINGS = """# Mandelbulber settings file
@@ -163,7 +167,7 @@ VARIANTS = {"pyjulia4d default": [], "pyjulia4d march.quality=draft": ["march.qu
 def pov_scene(w: int, h: int) -> str:
     from pyjulia4d.scene import Scene
 
-    s = Scene.default()
+    s = Scene.default().with_overrides(MATCHED)
     px, py, pz = s.camera.position[:3]
     hfov = math.degrees(2 * math.atan(math.tan(math.radians(s.camera.fov) / 2) * w / h))
     c = s.fractal.c
@@ -191,7 +195,7 @@ def mb_settings(w: int, h: int) -> str:
     left-handed (x, y, z) -> z-up right-handed (x, z, y), c's i and j swapped)."""
     from pyjulia4d.scene import Scene
 
-    s = Scene.default()
+    s = Scene.default().with_overrides(MATCHED)
     cam, f = s.camera, s.fractal
     if (f.c[3] != 0 or cam.position[3] != 0 or cam.target[3] != 0 or cam.up[3] != 0
             or tuple(s.slice.normal) != (0, 0, 0, 1) or s.slice.distance != 0 or s.shading.light != "eye"):

@@ -79,7 +79,9 @@ def light_defines(scene: Scene) -> tuple[str, ...]:
     """The switches of shade/light.cl a scene uses (none: the piece is not compiled)."""
     sh = scene.shading
     out = []
-    if sh.shadow != "none":
+    # the light at the eye lights every point the eye sees: its shadows are invisible, so
+    # none are traced; soft shadows need the estimate (shade/light.cl: hard without one)
+    if sh.shadow != "none" and not isinstance(sh.light, str):
         out.append(f"SHADOW_{sh.shadow.upper()}")
     if sh.ao > 0:
         out.append("AO")

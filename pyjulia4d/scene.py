@@ -147,15 +147,15 @@ class Shading:
 
     color: Vec3 = (0.89, 0.477, 0.147)  # linear light (sRGB (0.95, 0.72, 0.42))
     background: Vec3 = (0.0, 0.0, 0.0)
-    ambient: float = 0.08
+    ambient: float = 0.15
     diffuse: float = 0.92
     specular: float = 0.35
     shininess: float = 40.0
-    light: Union[Vec4, Literal["eye"]] = "eye"
+    light: Union[Vec4, Literal["eye"]] = (-2.0, 5.0, -4.0, 0.0)
     light_color: Vec3 = (1.0, 1.0, 1.0)
-    shadow: str = "none"           # "none" | "hard" | "soft" (shade/light.cl)
+    shadow: str = "soft"           # "none" | "hard" | "soft" (shade/light.cl)
     shadow_softness: float = 16.0  # k of the penumbra min(k d / t): larger is sharper
-    ao: float = 0.0                # ambient occlusion strength, 0 = off
+    ao: float = 0.6                # ambient occlusion strength, 0 = off
     ao_distance: float = 0.1       # how far along the normal occlusion is sampled
     coloring: str = "flat"         # "flat" | "iteration" | "trap" | "w"
     colormap: str = "viridis"      # a matplotlib colour map (COLORMAPS)
@@ -574,16 +574,9 @@ def _check_fractal(scene: "Scene") -> None:
         raise SceneError("fractal.function", f"{f.function!r} is not defined for the {f.algebra} algebra "
                          f"(as in POV-Ray's julia_fractal: {' and '.join(allowed)} only); use "
                          f"fractal.algebra=hypercomplex for it")
-    sh = scene.shading
-    if sh.shadow != "none" and isinstance(sh.light, str):
-        raise SceneError("shading.shadow", f"{sh.shadow!r} needs a positioned light (shading.light = [x, y, z]); "
-                         "the light at the eye casts no visible shadow")
     if has_distance_estimate(f):
         return
     pair = f"{f.algebra} {f.function}"
-    if sh.shadow == "soft":
-        raise SceneError("shading.shadow", f"soft shadows measure the penumbra with the distance estimate, "
-                         f"which {pair} has none of; use hard")
     if m.quality != "custom":
         raise SceneError("march.quality", f"the presets march by distance estimate, which {pair} has "
                          f"none of; use march.quality=custom (the fixed scan)")

@@ -25,7 +25,8 @@ def test_defaults() -> None:
     assert s.fractal.max_iter == 12 and s.fractal.bailout == 4.0
     assert s.camera.position == (1.8, 1.6, -2.2, 0.0) and s.camera.fov == 40.0
     assert s.march.method == "auto" and march_method(s) == "de" and s.march.near == "auto" and s.march.max_steps == 4096
-    assert s.normals.method == "jacobian" and s.shading.light == "eye"
+    assert s.normals.method == "jacobian" and s.shading.light == (-2.0, 5.0, -4.0, 0.0)
+    assert s.shading.shadow == "soft" and s.shading.ao == 0.6
     assert (s.image.width, s.image.height) == (640, 480)
     assert s.render.float == "single"
 

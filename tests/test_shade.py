@@ -11,12 +11,13 @@ from pyjulia4d.camera import camera_frame, light_position
 from pyjulia4d.scene import Scene
 
 
-@pytest.mark.parametrize("over", [[], ["shading.light=2,3,-4"], ["shading.specular=0"],
+@pytest.mark.parametrize("over", [["shading.light=eye"], ["shading.light=2,3,-4"], ["shading.specular=0"],
                                   ["shading.light=-1,2,-3,0.5", "shading.shininess=5",
                                    "shading.light_color=1,0.5,0.2", "shading.background=0.1,0.2,0.3"]])
 @pytest.mark.parametrize("fl", ["single", "double"])
 def test_shade_matches_reference(over, fl):
-    s = Scene.default().with_overrides(over + [f"render.float={fl}"])
+    # shade.cl alone: no light terms (those are test_light_terms_in_render_match_reference's)
+    s = Scene.default().with_overrides(["shading.shadow=none", "shading.ao=0"] + over + [f"render.float={fl}"])
     R = Runner(build.scene_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(5)
@@ -66,10 +67,12 @@ def test_colormap_table_is_linear_light():
 
 
 LIGHT_SCENES = {
+    "default": [],
     "soft+ao": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.ao=0.8"],
     "hard+trap": ["shading.light=-3,4,-2", "shading.shadow=hard", "shading.coloring=trap",
                   "shading.colormap=inferno"],
-    "iteration": ["shading.coloring=iteration", "fractal.c=-0.1,0.65,0,0", "fractal.max_iter=8"],
+    "iteration": ["shading.coloring=iteration", "fractal.c=-0.1,0.65,0,0", "fractal.max_iter=8",
+                  "shading.shadow=none", "shading.ao=0"],
     "w": ["shading.coloring=w", "camera.position=1.8,1.6,-2.2,0.6", "shading.ao=0.5"],
     "fixed-hard-ao": ["march.method=fixed", "shading.light=-3,4,-2", "shading.shadow=hard", "shading.ao=0.8"],
     "hypercomplex": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=0.5,0.8,0.2,0.1",
@@ -95,16 +98,23 @@ def test_light_terms_in_render_match_reference(name):
 
 
 def test_scene_without_light_terms_compiles_none():
-    src = build.source(build.scene_config(Scene.default()))
+    plain = Scene.default().with_overrides(["shading.shadow=none", "shading.ao=0"])
+    src = build.source(build.scene_config(plain))
     assert '"shade/light.cl"' not in src
-    src = build.source(build.scene_config(Scene.default().with_overrides(["shading.ao=0.5"])))
+    src = build.source(build.scene_config(plain.with_overrides(["shading.ao=0.5"])))
     assert '"shade/light.cl"' in src and "#define" in src
 
 
+def test_shadows_compiled_only_where_they_show():
+    # the light at the eye casts no visible shadow: none traced; soft without an estimate is hard
+    assert "SHADOW_SOFT" not in build.scene_config(Scene.default().with_overrides(["shading.light=eye"])).defines
+    s = Scene.default().with_overrides(["fractal.algebra=hypercomplex", "shading.shadow=soft"])
+    assert "SHADOW_SOFT" in build.scene_config(s).defines     # light.cl takes the hard path: no estimate
+
+
 @pytest.mark.parametrize("over,key", [
-    (["shading.shadow=hard"], "shading.shadow"),                       # light at the eye
-    (["shading.light=1,2,3", "shading.shadow=soft", "fractal.algebra=hypercomplex"], "shading.shadow"),
     (["shading.colormap=jet2"], "shading.colormap"),
+    (["shading.shadow=penumbra"], "shading.shadow"),
     (["shading.ao=2"], "shading.ao"),
 ])
 def test_light_settings_refused(over, key):

@@ -9,7 +9,7 @@
  * With a distance estimate (ALG_HAS_DE): steps of max(d, step), 0 at the first point
  * inside; soft shadows (seed 004's penumbra) take min(k d / t) over the way, d the
  * estimate without its 1/2 (Koebe) factor.  Without one: samples every `step` (the
- * scan's own spacing), 0 at the first inside.  At most max_steps points: a ray still
+ * scan's own spacing), 0 at the first inside - hard shadows, whichever was asked for.  At most max_steps points: a ray still
  * going there keeps what it has (lit). */
 #if defined(SHADOW_HARD) || defined(SHADOW_SOFT)
 inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask live, julia_params jp, real radius, real step,

@@ -158,7 +158,8 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     from ..camera import camera_frame, light_position, march_radius
     from ..render import light_parameters
     sh = scene.shading
-    if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
+    shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # build.light_defines
+    if shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
         return None
     fr = camera_frame(scene)
     radius = march_radius(scene)
@@ -168,7 +169,7 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     return light_terms(point, normal, status, bracket, fr.position, f.c, f.max_iter, f.bailout, fr,
                        light if light is not None else fr.position, radius, lp["step"], lp["bias"],
                        lp["softness"], lp["max_steps"], lp["ao_distance"], lp["ao_strength"], lp["trap"],
-                       sh.shadow, sh.ao > 0, sh.coloring, F)
+                       shadow, sh.ao > 0, sh.coloring, F)
 
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,

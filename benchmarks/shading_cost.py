@@ -1,0 +1,70 @@
+"""What each shading term costs: the default scene at 640x480 with and without each term
+of kernels/shade/light.cl (shadows, ambient occlusion, colour maps), alone and together.
+
+Every variant renders once to build (or load) its program, then --repeats times; the
+median render time and the kernels' own time (profiled events) are reported, with the
+ratio to the plain default scene measured in the same run.  Writes
+benchmarks/results/shading_cost.md (a section per run: device, date, commit).
+
+    python benchmarks/shading_cost.py [--size 640x480] [--repeats 5]
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import warnings
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
+
+from pyjulia4d import Scene, render  # noqa: E402
+
+LIGHT = ["shading.light=-3,4,-2"]
+VARIANTS = {
+    "plain (light at the eye)": [],
+    "positioned light": LIGHT,
+    "hard shadows": LIGHT + ["shading.shadow=hard"],
+    "soft shadows": LIGHT + ["shading.shadow=soft"],
+    "ambient occlusion 0.8": ["shading.ao=0.8"],
+    "coloring iteration": ["shading.coloring=iteration"],
+    "coloring trap": ["shading.coloring=trap"],
+    "coloring w": ["shading.coloring=w"],
+    "soft shadows + AO + trap": LIGHT + ["shading.shadow=soft", "shading.ao=0.8", "shading.coloring=trap"],
+    "fixed scan, hard shadows + AO": LIGHT + ["march.method=fixed", "shading.shadow=hard", "shading.ao=0.8"],
+}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="640x480")
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    a = ap.parse_args(argv)
+    warnings.simplefilter("ignore")
+    w, h = (int(x) for x in a.size.split("x"))
+    rows, base, device = [], None, "?"
+    for name, over in VARIANTS.items():
+        s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}"])
+        render(s)
+        runs = [render(s) for _ in range(a.repeats)]
+        sec = statistics.median(r.seconds for r in runs)
+        ks = statistics.median(r.kernel_seconds for r in runs)
+        device = runs[0].device_name
+        base = base or sec
+        rows.append(f"| {name} | {sec:.3f} | {ks:.3f} | {sec / base:.2f} |")
+        print(rows[-1], flush=True)
+    head = (f"\n## {utc_now()}, {device}, commit {git_commit()}, {w}x{h}, median of {a.repeats}\n\n"
+            "| variant | render s | kernels s | / plain |\n|---|---|---|---|\n")
+    append_run(a.out / "shading_cost.md", "# What each shading term costs\n\nWritten by "
+               "`python benchmarks/shading_cost.py`.\n", head + "\n".join(rows) + "\n")
+    print(f"wrote {a.out / 'shading_cost.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
