@@ -103,11 +103,18 @@ def describe_devices() -> str:
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
     out = []
+    chosen = None
+    try:
+        chosen = select_device(None)
+    except DeviceError:
+        pass
     for idx, p, d in rows:
         err = compile_error(d)
-        out.append(f"{idx}  {p.name.strip()} | {d.name.strip()} | {device_type(d)}, "
-                   f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}"
-                   + (f", cannot compile: {err}" if err else ""))
+        mark = "  (default)" if chosen is not None and d.int_ptr == chosen.int_ptr else ""
+        out.append(f"{idx}  {p.name.strip()} {p.version.strip()} | {d.name.strip()} | {device_type(d)}, "
+                   f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}, "
+                   f"driver {d.driver_version.strip()}"
+                   + (f", cannot compile: {err}" if err else "") + mark)
     return "\n".join(out)
 
 
