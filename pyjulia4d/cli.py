@@ -1,4 +1,4 @@
-"""Command line: ``python -m pyjulia4d render|devices``.
+"""Command line: ``python -m pyjulia4d render|devices|import-pov``.
 
 Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
 status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
@@ -61,6 +61,13 @@ def _parser() -> argparse.ArgumentParser:
                    help="render settings whose estimated work is refused as hopeless (hours)")
 
     sub.add_parser("devices", help="list the OpenCL devices")
+
+    i = sub.add_parser("import-pov", help="convert a POV-Ray julia_fractal scene to a scene file")
+    i.add_argument("pov", metavar="FILE.pov", help="POV-Ray 3.7 scene with one julia_fractal")
+    i.add_argument("-o", "--output", metavar="SCENE.toml",
+                   help="scene file to write (default: <FILE stem>.toml in the current directory)")
+    i.add_argument("--width", metavar="W", help="image width, also POV-Ray's image_width (default 640)")
+    i.add_argument("--height", metavar="H", help="image height, also POV-Ray's image_height (default 480)")
     return ap
 
 
@@ -111,6 +118,29 @@ def _render(args: argparse.Namespace) -> int:
         f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}, "
         f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
+    return 0
+
+
+def _import_pov(args: argparse.Namespace) -> int:
+    """import-pov: FILE.pov -> SCENE.toml (pyjulia4d/povray.py); warnings only on success."""
+    from .povray import check_toml_path, import_pov, write_toml
+
+    size = []
+    for key, value in (("image.width", args.width), ("image.height", args.height)):
+        if value is not None:
+            v = value.strip()
+            value = int(v) if v.isascii() and v.lstrip("+-").isdigit() and len(v) < 20 else value
+            Scene.from_dict({"image": {key.partition(".")[2]: value}})  # render's range errors
+        size.append(value)
+    imported = import_pov(args.pov, *size)
+    out = check_toml_path(args.output if args.output is not None else Path(args.pov).stem + ".toml", args.pov)
+    write_toml(out, imported.toml)
+    for w in imported.warnings:
+        _say(f"pyjulia4d: warning: {_one_line(Warning(w))}")
+    s = imported.scene
+    print(f"wrote {out}: {s.fractal.algebra} {s.fractal.function}, c = {list(s.fractal.c)}, "
+          f"max_iter {s.fractal.max_iter}, {s.image.width}x{s.image.height} "
+          f"(render: {PROG} render {out})")
     return 0
 
 
@@ -203,6 +233,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
                 print(describe_devices())
                 return 0
+            if args.command == "import-pov":
+                return _import_pov(args)
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
         _say(f"pyjulia4d: error: {_one_line(e)}")

@@ -50,6 +50,36 @@ class RenderResult:
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
     lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
 
+    def __repr__(self) -> str:
+        h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
+        kept = [k for k in ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket")
+                if getattr(self, k) is not None]
+        return (f"RenderResult({w}x{h}, {100 * self.hit_fraction:.1f}% hit, {self.seconds:.3f} s on "
+                f"{self.device_name or '?'}, {self.lanes} rays per work-item, outputs {', '.join(kept)})")
+
+    def save(self, path, header: dict | None = None) -> None:
+        """Write the image: .png (colour and alpha) or .exr (every output kept), atomically;
+        the header gets this render's report (output.write_image)."""
+        from .output import write_image
+        report, _ = self.report()
+        write_image(path, self, {**report, **(header or {})})
+
+    def _repr_png_(self) -> bytes | None:
+        """The picture, for notebooks (sRGB-encoded 8-bit RGBA)."""
+        if self.color is None:
+            return None
+        import io
+
+        from PIL import Image
+
+        from .colormap import linear_to_srgb
+        rgb = np.rint(linear_to_srgb(np.nan_to_num(self.color)) * 255).astype(np.uint8)
+        a = np.rint(np.clip(np.nan_to_num(self.alpha if self.alpha is not None else 1.0), 0, 1) * 255)
+        rgba = np.dstack([rgb, np.broadcast_to(a, rgb.shape[:2]).astype(np.uint8)])
+        buf = io.BytesIO()
+        Image.fromarray(rgba).save(buf, format="PNG")
+        return buf.getvalue()
+
     @property
     def hit_fraction(self) -> float:
         total = sum(self.counts.values())
@@ -458,8 +488,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         if "position" in keep:
             img["position"][dst] = got["point"][own]
 
-    with tqdm(total=W * H, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
-              disable=not progress, desc="render") as bar:
+    with _progress(W * H, progress) as bar:
         pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
         for i, t in enumerate(plan.tiles):
             slot = i % TileRunner.SLOTS
@@ -478,6 +507,38 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         guards=guards)
     result.seconds = time.perf_counter() - t_start
     return result
+
+
+class _LineProgress:
+    """Progress for a stderr that is not a terminal (a log file, a pipe): whole lines, at most
+    one per ``every`` seconds and none for renders shorter than that - no carriage returns."""
+
+    def __init__(self, total: int, every: float = 10.0):
+        self.total, self.every, self.n = total, every, 0
+        self.t0 = self.last = time.perf_counter()
+
+    def update(self, k: int) -> None:
+        self.n += k
+        now = time.perf_counter()
+        if now - self.last >= self.every and self.n < self.total:
+            self.last = now
+            eta = (now - self.t0) * (self.total - self.n) / max(self.n, 1)
+            print(f"render: {100 * self.n / self.total:.0f}% of {self.total} pixels, "
+                  f"{now - self.t0:.0f} s, about {eta:.0f} s left", file=sys.stderr, flush=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+
+def _progress(total: int, enabled: bool):
+    """A tqdm bar on a terminal, plain lines elsewhere (or nothing when not ``enabled``)."""
+    if enabled and not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
+        return _LineProgress(total)
+    return tqdm(total=total, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
+                disable=not enabled, desc="render")
 
 
 def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -> None:

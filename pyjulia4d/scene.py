@@ -264,8 +264,7 @@ class _Real:
 
 
 class _Integer:
-    """An integer (not a bool) in a range; a float with an integral value (1e9, 250.0) is
-    taken as that integer: exponent notation is how large counts are written."""
+    """An integer (not a float, not a bool) in a range."""
 
     verbatim = False
 
@@ -274,8 +273,6 @@ class _Integer:
         self.valid = f"integer in {self.range}"
 
     def __call__(self, key: str, v: Any) -> int:
-        if isinstance(v, float) and math.isfinite(v) and v.is_integer() and abs(v) < 2.0**63:
-            v = int(v)
         if isinstance(v, bool) or not isinstance(v, int):
             raise SceneError(key, f"expected an integer, got {_show(v)}")
         if v not in self.range:

@@ -520,9 +520,10 @@ def _slow_render_args() -> list[str]:
     if device_type(dev) == "GPU":  # ~300 x faster: full-width tiles, 20 x the samples
         return ["--width", "1024", "--height", "16384", "--set", "march.method=fixed",
                 "--set", "march.z_resolution=20000"]
-    # 16 x 1024-pixel tiles of ~0.75 s each on 2 CPU cores, ~70 s in all (~10 s on 16 cores)
+    # 196 tiles of 16 x 512 pixels, ~40 s in all on 2 CPU cores with packets of rays (the
+    # signal comes after the first progress line, at 10 s)
     return ["--width", "16", "--height", "100000", "--set", "march.method=fixed",
-            "--set", "march.z_resolution=6000"]
+            "--set", "march.z_resolution=50000"]
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
@@ -540,9 +541,10 @@ def test_signal_during_a_real_render(sig: int, tmp_path) -> None:
                                 stdout=subprocess.PIPE, stderr=err, text=True,
                                 preexec_fn=_default_signals)
     try:
-        # the progress bar (redrawn with carriage returns) appears once the render has run
-        # for a second
-        assert _wait_for(lambda: b"\r" in err_path.read_bytes(), 60), err_path.read_text()
+        # stderr is a file, not a terminal: progress comes as whole lines ("render: N% ..."),
+        # the first once the render has run for 10 s, and never a carriage return
+        assert _wait_for(lambda: b"render: " in err_path.read_bytes(), 60), err_path.read_text()
+        assert b"\r" not in err_path.read_bytes()
         assert proc.poll() is None, "the render finished before the signal"
         _signal_and_check(proc, sig, err_path, out)
     finally:
