@@ -86,7 +86,8 @@ def settings(scene: Scene) -> list[tuple[str, list[str]]]:
     if has_distance_estimate(scene.fractal):
         out += [(f"de eps={e:g} post={p}", ["march.method=de", f"march.epsilon={e}", f"march.post_steps={p}"])
                 for e, p in DE]
-        out += [(f"preset {q}", [f"march.quality={q}"]) for q in PRESETS]
+        if scene.fractal.algebra == "quaternion":   # the presets were measured on quaternions
+            out += [(f"preset {q}", [f"march.quality={q}"]) for q in PRESETS]
     return out
 
 

@@ -61,6 +61,30 @@ inline lreal julia_level(quat p, julia_params jp, lmask *inside)
  * d = sqrt(m2 / dm2) ln(m2) / 4.  Where |q'| would overflow, it is carried as a
  * mantissa times 2^e (ldexp), so the estimate stays finite at any max_iter.
  * Sets *escaped.  This is the smooth field the gradient normal differentiates. */
+/* d = |q| ln|q| / (2 |q'|) from m2 = |q|^2 and the squared derivative dm2 * 2^e */
+inline lreal de_value(lreal m2, lreal dm2, lmask e)
+{
+    /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
+    lreal mq = fmax(m2, REAL_MIN);
+    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
+    ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
+    /* the 1/2 of the lower bound G / (2 |G'|) (Koebe), whatever the degree */
+    return ratio * log(mq) / (real)4;
+}
+
+/* dm2 *= factor where live, rescaled as mantissa * 2^e long before float32 overflows */
+#define DE_GROW(dm2, e, factor, live) do { \
+        dm2 = L_SEL(dm2, dm2 * (factor), live); \
+        lmask big_ = (live) & (dm2 > (real)1e16); \
+        if (L_ANY(big_)) { \
+            lmask k_; \
+            lreal mant_ = frexp(dm2, &k_); \
+            dm2 = L_SEL(dm2, mant_, big_); \
+            e = L_SEL(e, e + k_, big_); \
+        } \
+    } while (0)
+
+#ifndef ALG_SPLIT
 inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat q = ALG_IN(p);
@@ -71,27 +95,50 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
     lmask live = m2 <= jp.bailout2;
     int n = 0;
     for (; n < jp.max_iter && L_ANY(live); ++n) {
-        dm2 = L_SEL(dm2, dm2 * JULIA_DF2(m2), live);
-        lmask big = live & (dm2 > (real)1e16);
-        if (L_ANY(big)) {           /* rescale long before float32 overflows (3e38) */
-            lmask k;
-            lreal mant = frexp(dm2, &k);
-            dm2 = L_SEL(dm2, mant, big);
-            e = L_SEL(e, e + k, big);
-        }
+        DE_GROW(dm2, e, JULIA_DF2(m2), live);
         q = QSEL(q, julia_f(q, c), live);
         m2 = ALG_NORM2(q);
         live = m2 <= jp.bailout2;
     }
     COUNT_ITER(jp, n);
     *escaped = m2 > jp.bailout2;
-    /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
-    lreal mq = fmax(m2, REAL_MIN);
-    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
-    ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
-    /* the 1/2 of the lower bound G / (2 |G'|) (Koebe), whatever the degree */
-    return ratio * log(mq) / (real)4;
+    return de_value(m2, dm2, e);
 }
+#else
+/* A split algebra (algebra/hypercomplex.cl): h = a e1 + b e2, and the Julia set of a
+ * polynomial is the product K_a x K_b of the two complex filled Julia sets.  In C^2 the
+ * distance to a product is sqrt(dist(a, K_a)^2 + dist(b, K_b)^2), and the split scales 4D
+ * lengths by sqrt(2) (|a|^2 + |b|^2 = 2 |h|^2), so
+ *     d = sqrt(d_a^2 + d_b^2) / sqrt(2),
+ * each d_a = |a_n| ln|a_n| / (2 |a_n'|) the complex estimate of seed 001 §3.1 (eq. 8;
+ * |a'_{n+1}| = D |a_n|^(D-1) |a'_n|) where the component has provably escaped, |a_n| > 1 +
+ * |c_a| (then |a^D + c_a| > |a|), and 0 where it has not (an under-estimate: safe steps).
+ * The loop is the set test's (|h_n| <= bailout); *escaped is that test's. */
+inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
+{
+    quat q = ALG_IN(p);
+    real4 c = ALG_C(jp.c);
+    lreal m2 = ALG_NORM2(q);
+    lreal da = (lreal)1, db = (lreal)1;
+    lmask ea = 0, eb = 0;
+    lmask live = m2 <= jp.bailout2;
+    int n = 0;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        DE_GROW(da, ea, JULIA_DF2(q.x * q.x + q.y * q.y), live);
+        DE_GROW(db, eb, JULIA_DF2(q.z * q.z + q.w * q.w), live);
+        q = QSEL(q, julia_f(q, c), live);
+        m2 = ALG_NORM2(q);
+        live = m2 <= jp.bailout2;
+    }
+    COUNT_ITER(jp, n);
+    *escaped = m2 > jp.bailout2;
+    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
+    real ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
+    lreal d_a = L_SEL((lreal)0, de_value(ma, da, ea), ma > ra * ra);
+    lreal d_b = L_SEL((lreal)0, de_value(mb, db, eb), mb > rb * rb);
+    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+}
+#endif
 
 /* The distance estimate the march steps by: 0 inside (the point never escaped). */
 inline lreal julia_distance(quat p, julia_params jp)

@@ -84,9 +84,11 @@ class Fractal:
 
 def has_distance_estimate(f: Fractal) -> bool:
     """Whether the march may step by a distance estimate: quaternion sqr and cube, whose
-    norm is multiplicative, so |q'_n| follows the orbit (seed 001 §3.1, eq. 8).  The other
-    pairs are marched by the fixed scan (march.method = "auto")."""
-    return f.algebra == "quaternion" and f.function in POLYNOMIAL_DEGREE
+    norm is multiplicative, so |q'_n| follows the orbit (seed 001 §3.1, eq. 8), and the
+    hypercomplex sqr and cube, whose set is the product of two complex Julia sets with
+    complex estimates (iterate.cl).  The other pairs are marched by the fixed scan
+    (march.method = "auto")."""
+    return f.algebra in ("quaternion", "hypercomplex") and f.function in POLYNOMIAL_DEGREE
 
 
 def march_method(scene: "Scene") -> str:
@@ -574,12 +576,12 @@ def _check_fractal(scene: "Scene") -> None:
         raise SceneError("fractal.function", f"{f.function!r} is not defined for the {f.algebra} algebra "
                          f"(as in POV-Ray's julia_fractal: {' and '.join(allowed)} only); use "
                          f"fractal.algebra=hypercomplex for it")
+    pair = f"{f.algebra} {f.function}"
+    if m.quality != "custom" and f.algebra != "quaternion":
+        raise SceneError("march.quality", f"the presets were measured on quaternion sets; for {pair} set the "
+                         f"march keys (march.quality=custom), measured in README's algebras section")
     if has_distance_estimate(f):
         return
-    pair = f"{f.algebra} {f.function}"
-    if m.quality != "custom":
-        raise SceneError("march.quality", f"the presets march by distance estimate, which {pair} has "
-                         f"none of; use march.quality=custom (the fixed scan)")
     if m.method == "de":
         raise SceneError("march.method", f"de needs a distance estimate, which {pair} has none of; "
                          f"use fixed or auto")

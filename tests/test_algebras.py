@@ -265,3 +265,29 @@ def test_pairs_refused_with_the_key(over, key):
     with pytest.raises(SceneError) as e:
         Scene.default().with_overrides(over)
     assert str(e.value).startswith(f"{key}: ") and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("function,c", [("sqr", (-0.123, 0, -0.745, 0)), ("cube", (0.4, 0, -0.6, 0))])
+def test_hypercomplex_distance_estimate(function, c):
+    # iterate.cl's split estimate d = sqrt(d_a^2 + d_b^2) / sqrt(2): (1) the kernel against the
+    # float64 twin; (2) a lower bound: no point of the ball of radius d around an outside
+    # point is inside the truncated set (200 random points in each of 300 balls)
+    s = scene_of("hypercomplex", function, f"fractal.c={','.join(map(str, c))}", "fractal.max_iter=12")
+    F = ref.formula_of(s.fractal)
+    R = Runner(build.probe_config(s))
+    p = np.random.default_rng(16).uniform(-1.5, 1.5, (8000, 4)).astype(np.float32).astype(np.float64)
+    n = len(p)
+    ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
+    R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(12), R.scalar(4.0), ins, d, f)
+    kd = d.get().astype(np.float64)
+    rd = ref.julia_distance(p, c, 12, 4.0, F)
+    both = (kd > 0) & (rd > 0)
+    assert both.mean() > 0.3 and np.mean((kd > 0) != (rd > 0)) < 2e-3
+    rel = np.abs(kd[both] - rd[both]) / rd[both]
+    assert np.median(rel) < 1e-5 and np.percentile(rel, 99) < 1e-2
+    rng = np.random.default_rng(17)
+    for i in np.nonzero(rd > 1e-4)[0][:300]:
+        u = rng.normal(size=(200, 4))
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        x = p[i] + u * (rd[i] * rng.uniform(0, 1, 200) ** 0.25)[:, None]
+        assert not ref.julia_inside(x, c, 12, 4.0, F).any()

@@ -32,8 +32,15 @@ inline quat julia_f_jvp(quat q, quat h)
     return QUAT(a.re, a.im, b.re, b.im);
 }
 
+#define ALG_SPLIT            /* iterate.cl: the distance estimate of a product of two sets */
 #ifdef FUNC_POWER
 #define JULIA_GROWTH FUNC_POWER
+#define ALG_HAS_DE           /* the polynomials: sqr, cube (iterate.cl) */
+#if FUNC_POWER == 2
+#define JULIA_DF2(m2) ((real)4 * (m2))     /* |f'(z)|^2 = D^2 |z|^(2(D-1)) per component */
+#else
+#define JULIA_DF2(m2) ((real)9 * (m2) * (m2))
+#endif
 #else
 #define JULIA_GROWTH 2   /* only shapes the level function's extrapolation (iterate.cl) */
 #endif

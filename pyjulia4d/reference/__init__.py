@@ -90,6 +90,8 @@ def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNIO
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
     (d, escaped)."""
     F = formula
+    if F.split:
+        return _split_distance_formula(p, c, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
@@ -113,6 +115,48 @@ def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNIO
     mq = np.maximum(m2, REAL_MIN)
     ratio = np.sqrt(mq / np.maximum(dm2, REAL_MIN)) * np.exp2(-(e / 2.0))
     return ratio * np.log(mq) / 4.0, escaped
+
+
+def _de_value(m2, dm2, e):
+    """d = |q| ln|q| / (2 |q'|) from m2, dm2 * 2^e (iterate.cl de_value)."""
+    mq = np.maximum(m2, REAL_MIN)
+    ratio = np.sqrt(mq / np.maximum(dm2, REAL_MIN)) * np.exp2(-(e / 2.0))
+    return ratio * np.log(mq) / 4.0
+
+
+def _split_distance_formula(p, c, max_iter, bailout, F: Formula):
+    """The split algebra's estimate (iterate.cl, ALG_SPLIT): d = sqrt(d_a^2 + d_b^2) / sqrt(2),
+    each component's complex estimate where it has escaped past 1 + |c_component|, else 0."""
+    q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
+    c = F.ALG_C(np.asarray(c, np.float64))
+    b2 = bailout * bailout
+    m2 = F.ALG_NORM2(q)
+    da, db = np.ones_like(m2), np.ones_like(m2)
+    ea, eb = np.zeros(m2.shape, np.int64), np.zeros(m2.shape, np.int64)
+    live = np.ones(m2.shape, bool)
+
+    def grow(dm2, e, factor, live):
+        dm2[live] *= factor[live]
+        big = live & (dm2 > 1e16)
+        if big.any():
+            mant, k = np.frexp(dm2[big])
+            dm2[big] = mant
+            e[big] += k
+
+    for _ in range(max_iter):
+        live &= m2 <= b2
+        if not live.any():
+            break
+        grow(da, ea, F.alg.JULIA_DF2(q[..., 0] ** 2 + q[..., 1] ** 2, F.fn.FUNC_POWER), live)
+        grow(db, eb, F.alg.JULIA_DF2(q[..., 2] ** 2 + q[..., 3] ** 2, F.fn.FUNC_POWER), live)
+        q[live] = F.julia_f(q[live], c)
+        m2[live] = F.ALG_NORM2(q[live])
+    escaped = m2 > b2
+    ma, mb = q[..., 0] ** 2 + q[..., 1] ** 2, q[..., 2] ** 2 + q[..., 3] ** 2
+    ra, rb = 1 + np.hypot(c[0], c[1]), 1 + np.hypot(c[2], c[3])
+    d_a = np.where(ma > ra * ra, _de_value(ma, da, ea), 0.0)
+    d_b = np.where(mb > rb * rb, _de_value(mb, db, eb), 0.0)
+    return np.sqrt(d_a ** 2 + d_b ** 2) / np.sqrt(2.0), escaped
 
 
 def julia_distance(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):

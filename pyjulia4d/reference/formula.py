@@ -54,7 +54,13 @@ class Formula:
 
     @property
     def has_de(self) -> bool:
-        return bool(self.alg.ALG_HAS_DE)
+        de = self.alg.ALG_HAS_DE
+        return bool(self.fn.FUNC_POWER) if de == "polynomial" else bool(de)
+
+    @property
+    def split(self) -> bool:
+        """A split algebra: the estimate is that of a product of two sets (iterate.cl)."""
+        return bool(getattr(self.alg, "ALG_SPLIT", False))
 
     @property
     def growth(self) -> int:

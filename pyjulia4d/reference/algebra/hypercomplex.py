@@ -70,4 +70,10 @@ def julia_f_jvp(q, h, fn):
         return _join(fn.cfun_d(a) * da, fn.cfun_d(b) * db)
 
 
-ALG_HAS_DE = False
+ALG_HAS_DE = "polynomial"   # sqr and cube: the product of two complex estimates
+ALG_SPLIT = True
+
+
+def JULIA_DF2(m2, power):
+    """|f'(z)|^2 = D^2 |z|^(2(D-1)) for one complex component."""
+    return 4.0 * m2 if power == 2 else 9.0 * m2 * m2
