@@ -2,7 +2,7 @@
 
 One scene per algebra beyond the quaternion square and per hypercomplex function named in
 the README's "Algebras and functions" (quaternion cube, CQuat and commutative sqr,
-hypercomplex sqr, and the hypercomplex exp, sin, cosh, atan, ln, pwr),
+hypercomplex sqr and cube, and the hypercomplex exp, sin, cosh, atan, ln, pwr),
 each against a float64 ground truth that does not come from the setting under test:
 ``truth.ground_truth`` - for these pairs the double-precision kernels' fixed scan with 20
 post-steps, its z-resolution doubled until two doublings in a row move at most 0.2 % of
@@ -49,6 +49,8 @@ SCENES = {
                "quaternion cube, c = 0.4+0.3i, max_iter 10"),
     "hc_sqr": (HC + ["fractal.function=sqr", "fractal.c=-0.2,0.8,0,0", "fractal.max_iter=10"],
                "hypercomplex sqr, c = -0.2+0.8i, max_iter 10"),
+    "hc_cube": (HC + ["fractal.function=cube", "fractal.c=0.4,0,-0.6,0", "fractal.max_iter=8"],
+                "hypercomplex cube, c = 0.4-0.6j, max_iter 8"),
     "hc_exp": (HC + ["fractal.function=exp", "fractal.c=0.5,0.8,0.2,0.1", "fractal.max_iter=8",
                      "camera.position=3.6,3.2,-4.4,0"],
                "hypercomplex exp, c = (0.5, 0.8, 0.2, 0.1), max_iter 8"),
