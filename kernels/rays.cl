@@ -6,13 +6,51 @@
  * its rays with camera_ray (nothing per pixel on the device but the outputs); the
  * generate_rays kernel writes them out for the tests and benchmarks. */
 
+/* The ray through the point (x + ox, y + oy) of the image plane, (ox, oy) in [0, 1)^2 the
+ * sample's place in the pixel (0.5, 0.5: its centre). */
+inline real4 camera_ray_at(int x, int y, real ox, real oy, real4 forward, real4 right, real4 up,
+                           real tan_half_fov, int width, int height)
+{
+    real aspect = (real)width / (real)height;
+    real u = ((real)2 * ((real)x + ox) / (real)width - (real)1) * tan_half_fov * aspect;
+    real v = ((real)1 - (real)2 * ((real)y + oy) / (real)height) * tan_half_fov;
+    return normalize(forward + u * right + v * up);
+}
+
 inline real4 camera_ray(int x, int y, real4 forward, real4 right, real4 up, real tan_half_fov,
                         int width, int height)
 {
-    real aspect = (real)width / (real)height;
-    real u = ((real)2 * ((real)x + (real)0.5) / (real)width - (real)1) * tan_half_fov * aspect;
-    real v = ((real)1 - (real)2 * ((real)y + (real)0.5) / (real)height) * tan_half_fov;
-    return normalize(forward + u * right + v * up);
+    return camera_ray_at(x, y, (real)0.5, (real)0.5, forward, right, up, tan_half_fov, width, height);
+}
+
+/* 24 random bits of (x, y, sample): a 32-bit integer hash (Wang's, then xorshift-multiply)
+ * of the three, the same in reference.sample_offset, so a scene gives the same image. */
+inline uint sample_hash(uint x, uint y, uint s)
+{
+    uint h = x * 73856093u ^ y * 19349663u ^ s * 83492791u;
+    h = (h ^ 61u) ^ (h >> 16);
+    h *= 9u;
+    h ^= h >> 4;
+    h *= 0x27d4eb2du;
+    h ^= h >> 15;
+    return h;
+}
+
+/* Stratified jitter (image.samples = n > 1): sample k of n lies in cell (k mod g, k div g) of
+ * a g x g grid over the pixel (g = ceil(sqrt(n))), at a hashed place inside it; n = 1 is the
+ * pixel's centre. */
+inline void sample_offset(int x, int y, int k, int n, real *ox, real *oy)
+{
+    if (n <= 1) {
+        *ox = (real)0.5;
+        *oy = (real)0.5;
+        return;
+    }
+    int g = (int)ceil(sqrt((float)n));
+    uint h1 = sample_hash((uint)x, (uint)y, (uint)(2 * k));
+    uint h2 = sample_hash((uint)x, (uint)y, (uint)(2 * k + 1));
+    *ox = ((real)(k % g) + (real)(h1 >> 8) * (real)(1.0 / 16777216.0)) / (real)g;
+    *oy = ((real)(k / g) + (real)(h2 >> 8) * (real)(1.0 / 16777216.0)) / (real)g;
 }
 
 __kernel void generate_rays(const int n_items, const real4 position, const real4 forward, const real4 right,

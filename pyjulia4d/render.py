@@ -355,14 +355,16 @@ class TileRunner:
         self.n_lut = np.int32(len(lut))
         self.no_terms = cla.empty(self.queue, 1, cl.cltypes.float4)
 
-    def enqueue(self, tile: Tile, slot: int) -> tuple[list[cl.Event], list[cl.Event]]:
-        """Queue the tile's kernels and the copies of what is read back into ``slot``:
+    def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
+                ) -> tuple[list[cl.Event], list[cl.Event]]:
+        """Queue the tile's kernels - rays through sample ``sample`` of ``samples`` of each
+        pixel (rays.cl; one: the centre) - and the copies of what is read back into ``slot``:
         (kernel events, copy events); nothing waits."""
         plan, pr, q = self.plan, self.pr, self.queue
         bufs, stage = self.slots[slot]
         n = tile.n
         kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
-                          np.int32(tile.ay0), *self.march_const, bufs["depth"].data, bufs["point"].data,
+                          np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const, bufs["depth"].data, bufs["point"].data,
                           bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
                           bufs["bracket"].data, items=march_items(n, tile.aw, plan.lanes))]
         if plan.normals:
@@ -488,16 +490,31 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         if "position" in keep:
             img["position"][dst] = got["point"][own]
 
-    with _progress(W * H, progress) as bar:
-        pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
-        for i, t in enumerate(plan.tiles):
-            slot = i % TileRunner.SLOTS
-            kernels, copies = runner.enqueue(t, slot)
-            if pending is not None:
-                _file_pending(runner, pending, file, kernel_events, bar)
-            pending = (t, slot, kernels, copies)
-        if pending is not None:
-            _file_pending(runner, pending, file, kernel_events, bar)
+    S = scene.image.samples
+    aa = S > 1 and bool({"color", "alpha"} & keep)
+    with _progress(W * H * (1 + S if aa else 1), progress) as bar:
+        # the centre of each pixel: every output (depth, normal, position come from it)
+        _run_tiles(runner, plan.tiles, file, kernel_events, bar)
+        if aa:
+            # image.samples more passes of colour and alpha alone, each through its own
+            # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
+            cplan = make_plan(scene, dev, lanes, outputs=["color", "alpha"], force=True, tile=tile)
+            crunner = TileRunner(cplan, dev)
+            acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
+            acc_a = np.zeros((H, W), np.float32)
+
+            def add(t: Tile, got: dict[str, np.ndarray]) -> None:
+                own, dst = t.own(), t.dst()
+                if acc_c is not None:
+                    acc_c[dst] += got["rgba"][own][..., :3]
+                acc_a[dst] += got["rgba"][own][..., 3]
+
+            for k in range(S):
+                _run_tiles(crunner, cplan.tiles, add, kernel_events, bar, sample=k, samples=S)
+            if acc_c is not None:
+                img["color"] = acc_c / S
+            if "alpha" in keep:
+                img["alpha"] = acc_a / S
 
     result = RenderResult(
         color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
@@ -539,6 +556,21 @@ def _progress(total: int, enabled: bool):
         return _LineProgress(total)
     return tqdm(total=total, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
                 disable=not enabled, desc="render")
+
+
+def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample: int = 0,
+               samples: int = 1) -> None:
+    """Every tile through ``runner``, two in flight: tile i + 1's kernels are queued before
+    tile i is filed (``file(tile, arrays)``)."""
+    pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
+    for i, t in enumerate(tiles):
+        slot = i % TileRunner.SLOTS
+        kernels, copies = runner.enqueue(t, slot, sample, samples)
+        if pending is not None:
+            _file_pending(runner, pending, file, kernel_events, bar)
+        pending = (t, slot, kernels, copies)
+    if pending is not None:
+        _file_pending(runner, pending, file, kernel_events, bar)
 
 
 def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -> None:

@@ -170,6 +170,7 @@ class Image:
 
     width: int = 640
     height: int = 480
+    samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
 
 
 @dataclass(frozen=True)
@@ -420,6 +421,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
     "image": {
         "width": _Integer(1, _INT_MAX),
         "height": _Integer(1, _INT_MAX),
+        "samples": _Integer(1, 256),
     },
     "render": {
         "float": _Choice("single", "double"),

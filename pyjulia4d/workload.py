@@ -77,7 +77,9 @@ def estimate(scene: Scene, device=None) -> Estimate:
     """Upper bound of the work of ``scene`` and its predicted time on ``device``
     (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
     f, m = scene.fractal, scene.march
-    pixels = scene.image.width * scene.image.height
+    # image.samples > 1: the centre pass and one colour pass per sample
+    passes = 1 + scene.image.samples if scene.image.samples > 1 else 1
+    pixels = scene.image.width * scene.image.height * passes
     # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (march/refine.cl)
     refine = m.post_steps + 3 if m.refine == "itp" else m.post_steps
     if march_method(scene) == "fixed":

@@ -13,10 +13,15 @@
 #define RAY_AT(i, ok, dk) do { ok = origins[i]; dk = dirs[i]; } while (0)
 #else
 #define RAY_ARGS const real4 eye, const real4 forward, const real4 right, const real4 up, \
-                 const real tan_half_fov, const int image_w, const int image_h, const int x0, const int y0
-#define RAY_AT(i, ok, dk) do { ok = eye; dk = camera_ray(x0 + (int)((i) % (size_t)tile_w), \
-                                                       y0 + (int)((i) / (size_t)tile_w), forward, right, \
-                                                       up, tan_half_fov, image_w, image_h); } while (0)
+                 const real tan_half_fov, const int image_w, const int image_h, const int x0, const int y0, \
+                 const int pixel_sample, const int pixel_samples
+#define RAY_AT(i, ok, dk) do { \
+        int px_ = x0 + (int)((i) % (size_t)tile_w), py_ = y0 + (int)((i) / (size_t)tile_w); \
+        real ox_, oy_; \
+        sample_offset(px_, py_, pixel_sample, pixel_samples, &ox_, &oy_); \
+        ok = eye; \
+        dk = camera_ray_at(px_, py_, ox_, oy_, forward, right, up, tan_half_fov, image_w, image_h); \
+    } while (0)
 #endif
 
 __kernel void march(const int n_items, const int tile_w, RAY_ARGS,

@@ -356,16 +356,42 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
 
 # ---------------------------------------------------------------------- rays.cl
 
+def sample_hash(x, y, s):
+    """rays.cl sample_hash on uint32 arrays."""
+    M = 0xFFFFFFFF
+    x, y, s = (np.asarray(a, np.uint64) for a in (x, y, s))
+    h = ((x * 73856093) & M) ^ ((y * 19349663) & M) ^ ((s * 83492791) & M)
+    h = (h ^ 61) ^ (h >> 16)
+    h = (h * 9) & M
+    h ^= h >> 4
+    h = (h * 0x27D4EB2D) & M
+    h ^= h >> 15
+    return h
+
+
+def sample_offset(x, y, k: int, n: int):
+    """Sample k of n in each pixel (rays.cl sample_offset): (ox, oy) in [0, 1)^2."""
+    if n <= 1:
+        return np.full(np.shape(x), 0.5), np.full(np.shape(x), 0.5)
+    g = int(np.ceil(np.sqrt(np.float32(n))))
+    h1 = sample_hash(x, y, 2 * k)
+    h2 = sample_hash(x, y, 2 * k + 1)
+    return ((k % g + (h1 >> 8).astype(np.float64) / 16777216.0) / g,
+            (k // g + (h2 >> 8).astype(np.float64) / 16777216.0) / g)
+
+
 def generate_rays(frame: Frame, width: int, height: int, x0: int = 0, y0: int = 0,
-                  tile_w: int | None = None, tile_h: int | None = None):
+                  tile_w: int | None = None, tile_h: int | None = None, sample: int = 0, samples: int = 1):
     """Pinhole 4D camera (seed 000 §4): returns (origins, dirs), row-major, row 0 on top,
-    for the tile of tile_w x tile_h pixels at (x0, y0) (default: the whole image)."""
+    for the tile of tile_w x tile_h pixels at (x0, y0) (default: the whole image), through
+    sample ``sample`` of ``samples`` of each pixel (its centre for one)."""
     tw = width - x0 if tile_w is None else tile_w
     th = height - y0 if tile_h is None else tile_h
     y, x = np.mgrid[y0:y0 + th, x0:x0 + tw]
+    ox, oy = sample_offset(x.ravel(), y.ravel(), sample, samples)
     aspect = width / height
-    u = (2 * (x.ravel() + 0.5) / width - 1) * frame.tan_half_fov * aspect
-    v = (1 - 2 * (y.ravel() + 0.5) / height) * frame.tan_half_fov
+    u = (2 * (x.ravel() + ox) / width - 1) * frame.tan_half_fov * aspect
+    v = (1 - 2 * (y.ravel() + oy) / height) * frame.tan_half_fov
     d = frame.forward + u[:, None] * frame.right + v[:, None] * frame.up
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     return np.tile(frame.position, (tw * th, 1)), d
@@ -526,37 +552,48 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=Non
 # -------------------------------------------------------------------- pipeline
 
 def render(scene: Scene) -> RenderResult:
-    """The whole pipeline in float64 numpy (slow: for small images)."""
+    """The whole pipeline in float64 numpy (slow: for small images).  With image.samples = S
+    > 1 the colour and alpha are the mean of S more passes through stratified samples of
+    each pixel (rays.cl sample_offset); everything else comes from the pixel centres."""
     t0 = time.perf_counter()
     frame = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
-    f, m, sh = scene.fractal, scene.march, scene.shading
-    F = formula_of(f)
-    origins, dirs = generate_rays(frame, w, h)
-    near = -1.0 if m.near == "auto" else float(m.near)
-    far = -1.0 if m.far == "auto" else float(m.far)
-    guard = np.zeros(len(origins), np.int64)
-    bracket = np.full(len(origins), np.inf)
-    depth, point, status, samples = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
+    sh = scene.shading
+
+    def one_pass(sample: int, samples: int):
+        f, m = scene.fractal, scene.march
+        F = formula_of(f)
+        origins, dirs = generate_rays(frame, w, h, sample=sample, samples=samples)
+        near = -1.0 if m.near == "auto" else float(m.near)
+        far = -1.0 if m.far == "auto" else float(m.far)
+        guard = np.zeros(len(origins), np.int64)
+        bracket = np.full(len(origins), np.inf)
+        depth, point, status, smp = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
-                                          m.post_steps, m.max_steps, march_method(scene), guard, m.refine, bracket,
-                                          F)
-    if scene.normals.method == "jacobian":
-        normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard, F)
-    elif scene.normals.method == "gradient":
-        step = gradient_step(scene)
-        normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard, F)
-    else:
-        normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
-    from .shade import light_terms_of_scene, shade
-    terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
-    lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
-    rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
-                 sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut)
+                                          m.post_steps, m.max_steps, march_method(scene), guard, m.refine,
+                                          bracket, F)
+        if scene.normals.method == "jacobian":
+            normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard, F)
+        elif scene.normals.method == "gradient":
+            step = gradient_step(scene)
+            normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard, F)
+        else:
+            normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
+        from .shade import light_terms_of_scene, shade
+        terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
+        lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
+        rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
+                     sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut)
+        return rgba, depth, point, status, smp, normal, guard, bracket
+
+    rgba, depth, point, status, smp, normal, guard, bracket = one_pass(0, 1)
+    S = scene.image.samples
+    if S > 1:
+        rgba = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
     res = RenderResult(color=rgba[:, :3].reshape(h, w, 3), alpha=rgba[:, 3].reshape(h, w),
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
-                       samples=samples.reshape(h, w), bracket=bracket.reshape(h, w),
+                       samples=smp.reshape(h, w), bracket=bracket.reshape(h, w),
                        device_name="numpy float64 reference",
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
