@@ -67,6 +67,7 @@ from typing import Any
 import numpy as np
 
 from .scene import FUNCTIONS, Scene, SceneError
+from .scene import _toml_value  # one TOML emitter for scenes and imports
 
 MAX_POV_BYTES = 8 << 20       # larger files are refused unread
 POV_EPSILON = 1e-10           # POV-Ray's EPSILON (slice and camera checks)
@@ -1137,20 +1138,6 @@ def convert(r: _Reader, width: int, height: int) -> tuple[dict, dict, list[str],
     if r.includes:
         header.append("#include files not read: " + ", ".join(r.includes) + ".")
     return data, notes, header, warns
-
-
-def _toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v)
-    if isinstance(v, str):
-        import json
-
-        return json.dumps(v)
-    return "[" + ", ".join(_toml_value(x) for x in v) + "]"
 
 
 def _wrap(text: str, width: int = 88) -> list[str]:

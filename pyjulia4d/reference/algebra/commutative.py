@@ -3,38 +3,11 @@ i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j, jk = kj = i; commutative, not as
 The product is built from the basis table itself (the kernel writes it out)."""
 from __future__ import annotations
 
-import numpy as np
-
 from . import power
+from .table import ALG_C, ALG_DOT, ALG_IN, ALG_NORM2, product  # noqa: F401 (the algebra's interface)
 
-# e_i e_j = SIGN[i][j] e_INDEX[i][j] for the basis 1, i, j, k
-_INDEX = [[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]]
-_SIGN = [[1, 1, 1, 1], [1, -1, 1, 1], [1, 1, -1, 1], [1, 1, 1, -1]]
-
-
-def alg_mul(a, b):
-    a = np.asarray(a, np.float64)
-    b = np.asarray(b, np.float64)
-    out = np.zeros(np.broadcast_shapes(a.shape, b.shape))
-    for i in range(4):
-        for j in range(4):
-            out[..., _INDEX[i][j]] += _SIGN[i][j] * a[..., i] * b[..., j]
-    return out
-
-
-def ALG_IN(p):
-    return np.asarray(p, np.float64)
-
-
-ALG_C = ALG_IN
-
-
-def ALG_NORM2(q):
-    return np.sum(q * q, axis=-1)
-
-
-def ALG_DOT(a, b):
-    return np.sum(a * b, axis=-1)
+SIGN = [[1, 1, 1, 1], [1, -1, 1, 1], [1, 1, -1, 1], [1, 1, 1, -1]]
+alg_mul = product(SIGN)
 
 
 def julia_f(q, c, fn):

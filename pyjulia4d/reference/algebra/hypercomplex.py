@@ -5,21 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-# Basis products e_i e_j = SIGN[i][j] e_{INDEX[i][j]} for 1, i, j, k (seed 003's table:
-# ij = ji = k, jk = kj = -i, ki = ik = -j, ii = jj = -1, kk = +1).
-_INDEX = [[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]]
-_SIGN = [[1, 1, 1, 1], [1, -1, 1, -1], [1, 1, -1, -1], [1, -1, -1, 1]]
+from .table import product
 
-
-def alg_mul(a, b):
-    """The product by the basis table itself (the tests hold the split to it)."""
-    a = np.asarray(a, np.float64)
-    b = np.asarray(b, np.float64)
-    out = np.zeros(np.broadcast_shapes(a.shape, b.shape))
-    for i in range(4):
-        for j in range(4):
-            out[..., _INDEX[i][j]] += _SIGN[i][j] * a[..., i] * b[..., j]
-    return out
+# seed 003's table: ij = ji = k, jk = kj = -i, ki = ik = -j, ii = jj = -1, kk = +1
+SIGN = [[1, 1, 1, 1], [1, -1, 1, -1], [1, 1, -1, -1], [1, -1, -1, 1]]
+# the product by the basis table itself (the tests hold the split to it)
+alg_mul = product(SIGN)
 
 
 def ALG_IN(p):
