@@ -62,7 +62,12 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
         defines.append("REFINE_ITP")
     if ray_buffers:
         defines.append("RAYS_FROM_BUFFERS")
-    pieces += [f"march/{march_method(scene)}", "rays", "march/march", f"normals/{scene.normals.method}"]
+    if scene.clip.planes:
+        defines.append("CLIP")
+    pieces += [f"march/{march_method(scene)}", "rays", "march/march"]
+    if scene.clip.planes:
+        pieces.append("march/clip")
+    pieces.append(f"normals/{scene.normals.method}")
     light = light_defines(scene)
     if light:
         pieces.append("shade/light")

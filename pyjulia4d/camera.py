@@ -143,3 +143,17 @@ def march_radius(scene: Scene) -> float:
     if march_method(scene) == "de":
         r += 4.0 * scene.march.epsilon
     return r
+
+
+def clip_planes(scene: Scene) -> list[tuple[np.ndarray, float]]:
+    """The [clip] half-spaces n . p <= offset (scene space, n any length) in world space: a
+    unit 4D normal m and offset e with m . x <= e for the world points x = R p + distance u
+    of the slice (to_world)."""
+    out = []
+    for nx, ny, nz, off in scene.clip.planes:
+        n = np.array([nx, ny, nz, 0.0])
+        ln = float(np.linalg.norm(n))
+        m = to_world(scene, n / ln, direction=True)
+        shift = scene.slice.distance * unit(scene.slice.normal)
+        out.append((m, float(off) / ln + float(m @ shift)))
+    return out

@@ -20,6 +20,7 @@ from tqdm import tqdm
 from . import build, colormap
 from .devices import has_fp64, select_device
 from .lanes import lanes_for
+from .camera import clip_planes
 from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
 from .scene import Scene, SceneError, march_method
 
@@ -345,6 +346,13 @@ class TileRunner:
                             np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
                             np.float32(sh.shininess))
         self.march_k = cl.Kernel(self.march_prg, "march")
+        # [clip]: the half-spaces in world space, as march.cl and march/clip.cl take them
+        planes = clip_planes(sc)
+        self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
+        self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
+                          (pr.v4([planes[k][1] if k < len(planes) else 0.0 for k in range(4)]),)
+                          if planes else ())
+        self.clip_k = cl.Kernel(self.prg, "clip_normals") if planes and plan.normals else None
         self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
         # shade/light.cl: in the march's packets where the march has them (build.march_config)
         self.light_k = (cl.Kernel(self.march_prg if plan.lanes > 1 else self.prg, "light_terms")
@@ -366,7 +374,7 @@ class TileRunner:
         kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
                           np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const, bufs["depth"].data, bufs["point"].data,
                           bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
-                          bufs["bracket"].data, items=march_items(n, tile.aw, plan.lanes))]
+                          bufs["bracket"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
         if plan.normals:
             method = plan.scene.normals.method
             packet = plan.normals_in_march_program
@@ -374,6 +382,9 @@ class TileRunner:
                                           plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
                                           bufs["normal"], size=(tile.aw, tile.ah),
                                           lanes=plan.lanes if packet else 1))
+            if self.clip_k is not None:
+                kernels.append(launch(q, self.clip_k, n, bufs["flags"].data, bufs["status"].data, self.right,
+                                      self.up, self.fwd, *self.clip_n, bufs["normal"].data))
         if plan.light_terms:
             kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,

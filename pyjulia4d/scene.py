@@ -174,6 +174,14 @@ class Image:
 
 
 @dataclass(frozen=True)
+class Clip:
+    """[clip]: up to 4 half-spaces n . p <= offset of the scene's 3D space that cut the set
+    open (each plane [nx, ny, nz, offset]; the cut face is shaded with the plane's normal)."""
+
+    planes: tuple[tuple[float, float, float, float], ...] = ()
+
+
+@dataclass(frozen=True)
 class Render:
     """[render]: device-side settings."""
 
@@ -331,6 +339,47 @@ class _Vector:
         return tuple(xs)
 
 
+class _Planes:
+    """Up to 4 planes [nx, ny, nz, offset]: a list of 4-number lists (TOML) or, on the
+    command line, "nx,ny,nz,offset;..." ("" or "[]": none)."""
+
+    verbatim = True
+
+    def __init__(self, most: int) -> None:
+        self.most = most
+        self.valid = (f"up to {most} planes [nx, ny, nz, offset], numbers in [-1e6, 1e6], the normal not "
+                      f"all 0 (--set: nx,ny,nz,offset;...)")
+
+    def __call__(self, key: str, v: Any) -> tuple:
+        if isinstance(v, str):
+            text = v.strip()
+            if text in ("", "[]"):
+                v = []
+            else:
+                v = [[_scalar(x) for x in part.split(",")] for part in text.strip("[]").split(";")]
+        if not isinstance(v, (list, tuple)):
+            raise SceneError(key, f"expected a list of planes [nx, ny, nz, offset], got {_show(v)}")
+        if len(v) > self.most:
+            raise SceneError(key, f"at most {self.most} planes, got {len(v)}")
+        out = []
+        for i, plane in enumerate(v):
+            if not isinstance(plane, (list, tuple)) or len(plane) != 4:
+                raise SceneError(key, f"plane {i}: expected [nx, ny, nz, offset], got {_show(plane)}")
+            vals = []
+            for j, x in enumerate(plane):
+                if isinstance(x, bool) or not isinstance(x, (int, float)):
+                    raise SceneError(key, f"plane {i}: element {j}: expected a number, got {_show(x)}")
+                if not math.isfinite(x):
+                    raise SceneError(key, f"plane {i}: element {j}: not a finite number")
+                if abs(x) > COORD:
+                    raise SceneError(key, f"plane {i}: element {j}: must be in [-1e6, 1e6], got {_show(x)}")
+                vals.append(float(x))
+            if max(abs(x) for x in vals[:3]) == 0:
+                raise SceneError(key, f"plane {i}: zero normal")
+            out.append(tuple(vals))
+        return tuple(out)
+
+
 class _OrWord:
     """The literal string ``word``, else what ``inner`` accepts."""
 
@@ -359,6 +408,7 @@ _SECTIONS: dict[str, type] = {
     "normals": Normals,
     "shading": Shading,
     "image": Image,
+    "clip": Clip,
     "render": Render,
 }
 
@@ -422,6 +472,9 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "width": _Integer(1, _INT_MAX),
         "height": _Integer(1, _INT_MAX),
         "samples": _Integer(1, 256),
+    },
+    "clip": {
+        "planes": _Planes(4),
     },
     "render": {
         "float": _Choice("single", "double"),
@@ -603,6 +656,7 @@ class Scene:
     normals: Normals = field(default_factory=Normals)
     shading: Shading = field(default_factory=Shading)
     image: Image = field(default_factory=Image)
+    clip: Clip = field(default_factory=Clip)
     render: Render = field(default_factory=Render)
 
     @classmethod

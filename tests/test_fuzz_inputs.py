@@ -100,6 +100,9 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
         opts = check.options
         vals += [rng.choice(opts).upper(), rng.choice(opts)[:-1], rng.choice(opts) + "x", "1", "0"]
         return [v for v in vals if v.strip() not in opts]
+    if kind == "_Planes":   # "" and "[]" are valid (no planes)
+        vals = [v for v in vals if v.strip() not in ("", "[]")]
+        return vals + ["1,0,0", "0,0,0,1", "1,0,0,nan", "1,0,0,2e6", ";".join(["1,0,0,0"] * 5), "1,0,0,0;x"]
     if word:
         vals += [word.upper(), word + "s", f"[{word}]"]
     if inner_kind == "_Real":
@@ -174,6 +177,9 @@ def _toml_wrong_types(key: str) -> list[str]:
         vals += ["1.0", "[nan, 0, 0, 0]", "[0, inf, 0]", "[true, 1, 1]", '["0", 0, 0, 0]']
     if kind == "_Choice":
         vals = [v for v in vals if v != "[]"] + ['"FIXED"', '""', '" de "']
+    if kind == "_Planes":   # [] is valid (no planes)
+        vals = [v for v in vals if v != "[]"] + ["[[0, 0, 0, 1]]", "[1, 2, 3, 4]", "[[1, 0, 0, nan]]",
+                                                "[[1, 0, 0, true]]"]
     return vals
 
 

@@ -151,3 +151,34 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     prg = build.program(ctx, cfg)                      # rebuilt from source, cache rewritten
     assert prg.get_info(cl.program_info.KERNEL_NAMES)
     assert binary.read_bytes() != b"not a program"
+
+
+@pytest.mark.parametrize("over", [["clip.planes=0,0,-1,0"], ["clip.planes=-1,0,-1,0;0,1,0,0.3", "march.method=fixed"],
+                                  ["clip.planes=0,0,-1,0.1", "fractal.algebra=hypercomplex",
+                                   "fractal.c=-0.123,0,-0.745,0", "camera.position=1.7,5.7,-5.7"]])
+def test_cut_away_planes_match_reference(over):
+    # march.cl's clipped intervals and march/clip.cl's cut-face normals against the float64
+    # twin; the cut face is a hit at its plane's first point, width 0, with the plane's normal
+    from pyjulia4d import reference as ref
+    s = Scene.default().with_overrides(over + ["image.width=40", "image.height=30"])
+    k, r = render(s), ref.render(s)
+    assert np.mean(k.status != r.status) < 0.01
+    both = (k.status == 1) & (r.status == 1)
+    face = both & (r.bracket == 0)
+    assert face.sum() > 10
+    np.testing.assert_allclose(k.depth[face], r.depth[face], rtol=1e-5, atol=1e-6)
+    cos = np.sum(k.normal[face] * r.normal[face], axis=-1)
+    assert np.median(cos) > 0.99999
+    # every hit lies in every kept half-space
+    from pyjulia4d.camera import clip_planes
+    for m, e in clip_planes(s):
+        assert np.all(k.position[k.status == 1] @ m <= e + 1e-4)
+
+
+def test_clip_planes_refused():
+    from pyjulia4d.scene import SceneError
+    for bad, msg in [("0,0,0,1", "plane 0: zero normal"), ("1,2,3", "plane 0: expected"),
+                     ("1,0,0,0;0,1,0,0;0,0,1,0;1,1,0,0;1,0,1,0", "at most 4 planes"),
+                     ("1,0,0,nan", "plane 0: element 3: not a finite number")]:
+        with pytest.raises(SceneError, match="^clip.planes: " + msg):
+            Scene.default().with_overrides([f"clip.planes={bad}"])

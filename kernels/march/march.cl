@@ -24,13 +24,24 @@
     } while (0)
 #endif
 
+/* -D CLIP: up to 4 half-spaces clip_n[k] . p <= clip_off[k] cut the set open (scene.Clip):
+ * each clips [near, far]; a hit at the first point of an interval that a plane started
+ * lies on that plane's cut face, flagged FLAG_CUT_FACE | k << 5 for march/clip.cl. */
+#ifdef CLIP
+#define FLAG_CUT_FACE 16
+#define CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
+                  const real4 clip_n3, const real4 clip_off
+#else
+#define CLIP_ARGS
+#endif
+
 __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
                     __global int *status, __global int *samples, __global int *flags,
-                    __global real *bracket COUNTER_ARG)
+                    __global real *bracket COUNTER_ARG CLIP_ARGS)
 {
     /* LANES neighbouring rays per work-item (real.cl): one ray, or a block of BLOCK_W x
      * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
@@ -87,12 +98,30 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
     lreal far = -b + s;
     if (near_set >= (real)0) near = (lreal)near_set;
     if (far_set >= (real)0) far = (lreal)far_set;
-    lmask live = valid & (disc >= (real)0) & (far >= near);
+    lmask live = valid & (disc >= (real)0);
+#ifdef CLIP
+    lmask cut = 0;                  /* 1 + the plane that set near, 0: the ball did */
+    for (int k = 0; k < n_clip; ++k) {
+        real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
+        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
+        lreal dn = QDOT_UNIFORM(d, nk), on = QDOT_UNIFORM(o, nk) - off;
+        lreal tp = -on / dn;
+        far = L_SEL(far, fmin(far, tp), dn > (real)0);
+        lmask raise = (dn < (real)0) & (tp > near);
+        near = L_SEL(near, tp, raise);
+        cut = L_SEL(cut, (lmask)(k + 1), raise);
+        live &= !((dn == (real)0) & (on > (real)0));
+    }
+#endif
+    live &= far >= near;
     lmask st = STATUS_MISS, n = 0, fl = 0;
     lreal t = INFINITY, width = INFINITY;
     if (L_ANY(live))
         t = march_ray(o, d, near, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
                       &width);
+#ifdef CLIP
+    fl |= L_SEL((lmask)0, (lmask)FLAG_CUT_FACE | ((cut - 1) << 5), (st == STATUS_HIT) & (width == (real)0) & (cut > 0));
+#endif
 #if LANES == 1
     depth[i0] = t;
     point[i0] = st == STATUS_HIT ? o + t * d : (real4)(NAN);

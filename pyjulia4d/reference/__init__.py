@@ -14,13 +14,14 @@ import time
 
 import numpy as np
 
-from ..camera import Frame, camera_frame, light_position, march_radius
+from ..camera import Frame, camera_frame, clip_planes, light_position, march_radius
 from ..render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
                      STATUS_CAPPED,
                      STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
 from ..scene import Scene, march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
+FLAG_CUT_FACE = 16   # march.cl (-D CLIP): a hit on a cut face; the plane's index in bits 5-6
 
 
 def _dot(a, b):
@@ -316,8 +317,11 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
           z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
-          formula: Formula = QUATERNION_SQR):
-    """Clip each ray to the bounding 4-ball, then march; returns (depth, point, status, samples).
+          formula: Formula = QUATERNION_SQR, clip=None):
+    """Clip each ray to the bounding 4-ball (and the ``clip`` half-spaces m . x <= e, world
+    space: camera.clip_planes), then march; returns (depth, point, status, samples).  A hit
+    at the first point of an interval a plane started is on its cut face: flags get
+    FLAG_CUT_FACE | k << 5.
     ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
     ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere)."""
     o = np.asarray(origins, np.float64)
@@ -333,7 +337,18 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
         near = np.full_like(near, near_set)
     if far_set >= 0:
         far = np.full_like(far, far_set)
-    live = (disc >= 0) & (far >= near)
+    live = disc >= 0
+    cut = np.zeros(len(o), np.int64)      # 1 + the plane that set near (march.cl, -D CLIP)
+    for k, (m, off) in enumerate(clip or ()):
+        dn, on = d @ m, o @ m - off
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = -on / dn
+        far = np.where(dn > 0, np.minimum(far, tp), far)
+        raise_ = (dn < 0) & (tp > near)
+        near = np.where(raise_, tp, near)
+        cut = np.where(raise_, k + 1, cut)
+        live &= ~((dn == 0) & (on > 0))
+    live &= far >= near
     n = len(o)
     depth = np.full(n, np.inf)
     status = np.full(n, STATUS_MISS, np.int32)
@@ -346,6 +361,8 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
                                                      refine == "itp", formula)
         if flags is not None:
             flags[k] |= fl
+            face = (status[k] == STATUS_HIT) & (wd == 0) & (cut[k] > 0)
+            flags[k[face]] |= FLAG_CUT_FACE | ((cut[k[face]] - 1) << 5)
         if bracket is not None:
             bracket[:] = np.inf
             bracket[k] = np.where(status[k] == STATUS_HIT, wd, np.inf)
@@ -549,6 +566,18 @@ def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=Non
 
 # --------------------------------------------------------------------- shade.cl
 
+def clip_normals(flags, status, frame: Frame, planes, normal):
+    """march/clip.cl: hits on a cut face take their plane's normal (camera coordinates)."""
+    face = (status == STATUS_HIT) & ((np.asarray(flags) & FLAG_CUT_FACE) != 0)
+    if not face.any():
+        return normal
+    out = normal.copy()
+    k = (np.asarray(flags)[face] >> 5) & 3
+    m = np.array([planes[i][0] for i in k])
+    out[face] = _unit_or_zero(_to_camera(m, frame))
+    return out
+
+
 # -------------------------------------------------------------------- pipeline
 
 def render(scene: Scene) -> RenderResult:
@@ -571,7 +600,7 @@ def render(scene: Scene) -> RenderResult:
         depth, point, status, smp = march(origins, dirs, f.c, f.max_iter, f.bailout, m.epsilon,
                                           march_radius(scene), near, far, m.z_resolution,
                                           m.post_steps, m.max_steps, march_method(scene), guard, m.refine,
-                                          bracket, F)
+                                          bracket, F, planes)
         if scene.normals.method == "jacobian":
             normal = normals_jacobian(point, status, f.c, f.max_iter, f.bailout, frame, guard, F)
         elif scene.normals.method == "gradient":
@@ -579,6 +608,7 @@ def render(scene: Scene) -> RenderResult:
             normal = normals_gradient(point, status, f.c, f.max_iter, f.bailout, step, frame, guard, F)
         else:
             normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
+        normal = clip_normals(guard, status, frame, planes, normal)
         from .shade import light_terms_of_scene, shade
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
@@ -586,6 +616,7 @@ def render(scene: Scene) -> RenderResult:
                      sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut)
         return rgba, depth, point, status, smp, normal, guard, bracket
 
+    planes = clip_planes(scene)
     rgba, depth, point, status, smp, normal, guard, bracket = one_pass(0, 1)
     S = scene.image.samples
     if S > 1:

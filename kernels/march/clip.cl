@@ -1,0 +1,20 @@
+/* march/clip.cl (-D CLIP): the normal of a hit on a cut face (march.cl's FLAG_CUT_FACE) is
+ * its plane's, pointing out of the kept half-space (clip_n[k], the world normal of
+ * n . p <= offset), in camera coordinates like every normal (x right, y up, z towards the
+ * eye); guard flags in w are kept. */
+__kernel void clip_normals(const int n_items, __global const int *flags, __global const int *status,
+                           const real4 right, const real4 up, const real4 forward, const real4 clip_n0,
+                           const real4 clip_n1, const real4 clip_n2, const real4 clip_n3,
+                           __global real4 *normal)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    int f = flags[i];
+    if (status[i] != STATUS_HIT || !(f & FLAG_CUT_FACE))
+        return;
+    int k = (f >> 5) & 3;
+    real4 n = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
+    real3 c = normalize((real3)(dot(n, right), dot(n, up), -dot(n, forward)));
+    normal[i] = (real4)(c.x, c.y, c.z, normal[i].w);
+}
