@@ -174,7 +174,7 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
 #elif defined(COLOR_TRAP)
     val = orbit_value(p, jp, trap);
 #elif defined(COLOR_W)
-    val = clamp((real)0.5 + (real)0.5 * p.w / radius, (real)0, (real)1);
+    val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
 #endif
 #if LANES == 1
     terms[i0] = (float4)((float)vis, (float)amb, (float)val, 0.0f);

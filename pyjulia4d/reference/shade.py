@@ -148,7 +148,7 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
     elif coloring == "trap":
         out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F)
     elif coloring == "w":
-        out[k, 2] = np.clip(0.5 + 0.5 * p[:, 3] / radius, 0.0, 1.0)
+        out[k, 2] = np.clip(0.5 + p[:, 3] / radius, 0.0, 1.0)
     return out
 
 
