@@ -34,6 +34,7 @@ VARIANTS = {
     "coloring iteration": ["shading.coloring=iteration"],
     "coloring trap": ["shading.coloring=trap"],
     "coloring w": ["shading.coloring=w"],
+    "fog 0.8": ["shading.fog=0.8"],
     "soft shadows + AO + trap": LIGHT + ["shading.shadow=soft", "shading.ao=0.8", "shading.coloring=trap"],
     "fixed scan, hard shadows + AO": LIGHT + ["march.method=fixed", "shading.shadow=hard", "shading.ao=0.8"],
 }

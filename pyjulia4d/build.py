@@ -75,6 +75,8 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     defines += light
     if scene.shading.specular > 0:
         defines.append("SPECULAR")
+    if scene.shading.fog > 0:
+        defines.append("FOG")
     if not isinstance(scene.shading.light, str):
         defines.append("LIGHT_POINT")
     return KernelConfig(tuple(pieces), tuple(defines))

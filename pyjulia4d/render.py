@@ -345,6 +345,7 @@ class TileRunner:
                             _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
                             np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
                             np.float32(sh.shininess))
+        self.fog = (np.float32(sh.fog), np.float32(fog_start(plan.frame.position, plan.radius)))
         self.march_k = cl.Kernel(self.march_prg, "march")
         # [clip]: the half-spaces in world space, as march.cl and march/clip.cl take them
         planes = clip_planes(sc)
@@ -394,7 +395,7 @@ class TileRunner:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
                                   bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
-                                  self.n_lut, bufs["rgba"].data))
+                                  self.n_lut, *self.fog, bufs["rgba"].data))
         copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
         return kernels, copies
 
@@ -413,6 +414,11 @@ class TileRunner:
             else:
                 out[k] = a.reshape(shape)
         return out
+
+
+def fog_start(eye, radius: float) -> float:
+    """Where depth cueing starts: the eye's distance to the bounding ball (0 inside it)."""
+    return max(float(np.linalg.norm(eye)) - radius, 0.0)
 
 
 def light_parameters(sc: Scene, radius: float) -> dict:

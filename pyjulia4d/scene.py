@@ -162,6 +162,7 @@ class Shading:
     coloring: str = "flat"         # "flat" | "iteration" | "trap" | "w"
     colormap: str = "viridis"      # a matplotlib colour map (COLORMAPS)
     trap: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the orbit trap's point (coloring = "trap")
+    fog: float = 0.0               # depth cueing: fade to the background by exp(-fog distance)
 
 
 @dataclass(frozen=True)
@@ -467,6 +468,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "coloring": _Choice("flat", "iteration", "trap", "w"),
         "colormap": _Choice(*COLORMAPS),
         "trap": _Vector((3, 4), -COORD, COORD),
+        "fog": _Real(0.0, 100.0),
     },
     "image": {
         "width": _Integer(1, _INT_MAX),

@@ -13,7 +13,8 @@ from pyjulia4d.scene import Scene
 
 @pytest.mark.parametrize("over", [["shading.light=eye"], ["shading.light=2,3,-4"], ["shading.specular=0"],
                                   ["shading.light=-1,2,-3,0.5", "shading.shininess=5",
-                                   "shading.light_color=1,0.5,0.2", "shading.background=0.1,0.2,0.3"]])
+                                   "shading.light_color=1,0.5,0.2", "shading.background=0.1,0.2,0.3"],
+                                  ["shading.fog=0.7", "shading.background=0.3,0.4,0.5"]])
 @pytest.mark.parametrize("fl", ["single", "double"])
 def test_shade_matches_reference(over, fl):
     # shade.cl alone: no light terms (those are test_light_terms_in_render_match_reference's)
@@ -38,10 +39,10 @@ def test_shade_matches_reference(over, fl):
       R.vec(lp if lp is not None else fr.position), c4(sh.color), c4(sh.background),
       c4(sh.light_color), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
       np.float32(sh.shininess), R.out(1, cl.cltypes.float4), R.buf(np.zeros((2, 4)), np.float32),
-      np.int32(2), out)
+      np.int32(2), np.float32(sh.fog), np.float32(1.5), out)
     got = out.get().view(np.float32).reshape(n, 4)
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
-                     sh.ambient, sh.diffuse, sh.specular, sh.shininess)
+                     sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5)
     # the shading itself is float32 in both variants (colour needs no more; shade.cl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
@@ -68,6 +69,7 @@ def test_colormap_table_is_linear_light():
 
 LIGHT_SCENES = {
     "default": [],
+    "fog": ["shading.fog=0.8", "shading.background=0.2,0.2,0.3"],
     "soft+ao": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.ao=0.8"],
     "hard+trap": ["shading.light=-3,4,-2", "shading.shadow=hard", "shading.coloring=trap",
                   "shading.colormap=inferno"],

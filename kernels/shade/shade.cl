@@ -5,8 +5,9 @@
  * with vis (the light's visibility: shadows) and ao (ambient occlusion) from
  * shade/light.cl's terms (-D LIGHT_TERMS; else 1), and base the scene's colour or, with
  * -D COLORMAP, the colour map's entry for the hit's colour value (terms.z, linear
- * interpolation in a table of n_lut colours).  All vectors in camera coordinates; linear
- * light; output is float RGBA whatever the precision. */
+ * interpolation in a table of n_lut colours); -D FOG fades it toward the background with
+ * distance.  All vectors in camera coordinates; linear light; output is float RGBA
+ * whatever the precision. */
 
 __kernel void shade(const int n_items, __global const int *status, __global const real4 *normal,
                     __global const real4 *point, const real4 eye, const real4 right,
@@ -14,7 +15,7 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
                     const float4 color, const float4 background, const float4 light_color,
                     const float ambient, const float diffuse, const float specular,
                     const float shininess, __global const float4 *terms, __global const float4 *lut,
-                    const int n_lut, __global float4 *rgba)
+                    const int n_lut, const float fog, const float fog_start, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -57,5 +58,12 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
         rgb += vis * specular * pow(fmax(dot(n, hv), 0.0f), shininess);
     }
 #endif
-    rgba[i] = (float4)(rgb * light_color.xyz, 1.0f);
+    rgb *= light_color.xyz;
+#ifdef FOG
+    /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the
+     * distance from the eye, fog_start where the bounding ball begins */
+    float k = exp(-fog * fmax((float)length(pv) - fog_start, 0.0f));
+    rgb = mix(background.xyz, rgb, k);
+#endif
+    rgba[i] = (float4)(rgb, 1.0f);
 }

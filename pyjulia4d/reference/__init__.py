@@ -612,8 +612,10 @@ def render(scene: Scene) -> RenderResult:
         from .shade import light_terms_of_scene, shade
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
+        from ..render import fog_start
         rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
-                     sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut)
+                     sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut,
+                     sh.fog, fog_start(frame.position, march_radius(scene)))
         return rgba, depth, point, status, smp, normal, guard, bracket
 
     planes = clip_planes(scene)

@@ -173,7 +173,7 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
 
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
-          ambient, diffuse, specular, shininess, terms=None, lut=None):
+          ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0):
     """Lambert (light at the eye by default, seed 001 §4) + ambient + Blinn-Phong, with the
     light's visibility and ambient occlusion from ``terms`` and the base colour from the
     colour table ``lut`` at terms' colour value (shade/shade.cl); RGBA, linear light."""
@@ -209,6 +209,11 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
         hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
         spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
         rgb = rgb + (vis * specular * spec)[:, None]
-    rgba[hit, :3] = rgb * np.asarray(light_color)[None, :]
+    rgb = rgb * np.asarray(light_color)[None, :]
+    if fog > 0:   # depth cueing toward the background (shade.cl, -D FOG)
+        t = np.linalg.norm(point[hit] - frame.position, axis=-1)   # the 4D distance, as shade.cl
+        k = np.exp(-fog * np.maximum(t - fog_start, 0.0))[:, None]
+        rgb = np.asarray(background)[None, :] * (1 - k) + rgb * k
+    rgba[hit, :3] = rgb
     rgba[hit, 3] = 1.0
     return rgba
