@@ -1,4 +1,5 @@
-"""What each shading term costs: the default scene at 640x480 with and without each term
+"""What each shading term costs: the default scene at 640x480, plain (light at the eye, no
+shadows, no occlusion) and with each term
 of kernels/shade/light.cl (shadows, ambient occlusion, colour maps), alone and together.
 
 Every variant renders once to build (or load) its program, then --repeats times; the
@@ -24,6 +25,8 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
 
+# every variant starts from the plain look (the default scene has soft shadows and occlusion on)
+PLAIN = ["shading.light=eye", "shading.shadow=none", "shading.ao=0"]
 LIGHT = ["shading.light=-3,4,-2"]
 VARIANTS = {
     "plain (light at the eye)": [],
@@ -36,6 +39,7 @@ VARIANTS = {
     "coloring w": ["shading.coloring=w"],
     "fog 0.8": ["shading.fog=0.8"],
     "soft shadows + AO + trap": LIGHT + ["shading.shadow=soft", "shading.ao=0.8", "shading.coloring=trap"],
+    "the default look (soft shadows, AO 0.6)": ["shading.light=-2,5,-4", "shading.shadow=soft", "shading.ao=0.6"],
     "fixed scan, hard shadows + AO": LIGHT + ["march.method=fixed", "shading.shadow=hard", "shading.ao=0.8"],
 }
 
@@ -50,7 +54,7 @@ def main(argv=None) -> int:
     w, h = (int(x) for x in a.size.split("x"))
     rows, base, device = [], None, "?"
     for name, over in VARIANTS.items():
-        s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}"])
+        s = Scene.default().with_overrides(PLAIN + over + [f"image.width={w}", f"image.height={h}"])
         render(s)
         runs = [render(s) for _ in range(a.repeats)]
         sec = statistics.median(r.seconds for r in runs)
