@@ -468,6 +468,10 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     pixel on the host (depth and its bracket) and two tiles on the device."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
+    if scene.camera.fit:   # framing.py: a quick first pass places the camera
+        from .framing import fit_camera
+        scene, _ = fit_camera(scene, lambda s, outs: render(s, device=dev, force=force, lanes=lanes,
+                                                             outputs=outs))
     double = scene.render.float == "double"
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)

@@ -109,6 +109,7 @@ class Camera:
     up: Vec4 = (0.0, 1.0, 0.0, 0.0)
     limbo: Vec4 = (0.0, 0.0, 0.0, 1.0)
     fov: float = 40.0
+    fit: bool = False      # frame the set from a quick first pass (framing.py), keeping the view direction
 
 
 @dataclass(frozen=True)
@@ -340,6 +341,20 @@ class _Vector:
         return tuple(xs)
 
 
+class _Bool:
+    """true or false (TOML booleans; on the command line the words)."""
+
+    verbatim = True
+    valid = "true or false"
+
+    def __call__(self, key: str, v: Any) -> bool:
+        if isinstance(v, bool):
+            return v
+        if isinstance(v, str) and v.strip() in ("true", "false"):
+            return v.strip() == "true"
+        raise SceneError(key, f"expected true or false, got {_show(v)}")
+
+
 class _Planes:
     """Up to 4 planes [nx, ny, nz, offset]: a list of 4-number lists (TOML) or, on the
     command line, "nx,ny,nz,offset;..." ("" or "[]": none)."""
@@ -431,6 +446,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "up": _Vector((3, 4), -COORD, COORD, nonzero=True),
         "limbo": _Vector((3, 4), -COORD, COORD, nonzero=True),
         "fov": _Real(1e-6, 179.9),
+        "fit": _Bool(),
     },
     "slice": {
         "normal": _Vector((4,), -COORD, COORD, nonzero=True),

@@ -1,0 +1,60 @@
+"""camera.fit: frame the set from a quick low-resolution pass, keeping the view direction
+(seed 000 §4 finds near and far the same way: from what a first pass sees).
+
+The pass looks along the scene's view direction at the whole bounding ball (96 x 72 rays,
+depth and position only); the new target is the centroid of the 4D points it hit and the
+new distance the smallest at which every one of them lies within 90 % of the field of
+view, both turned back into the scene's (slice) coordinates.  A pass that hits nothing
+leaves the camera alone.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .camera import camera_frame, march_radius, slice_rotation, unit
+from .scene import Scene
+
+PROBE = (96, 72)
+MARGIN = 0.9
+
+
+def to_scene(scene: Scene, x) -> np.ndarray:
+    """World point -> scene (slice) coordinates: the inverse of camera.to_world."""
+    r = slice_rotation(scene.slice.normal)
+    return r.T @ (np.asarray(x, float) - scene.slice.distance * unit(scene.slice.normal))
+
+
+def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
+    """The scene with camera.position and camera.target refitted (camera.fit then false),
+    and a record of the pass.  ``render_fn(scene, outputs)`` renders (render.render)."""
+    fr = camera_frame(scene)
+    radius = march_radius(scene)
+    tan_v = fr.tan_half_fov
+    tan_h = tan_v * scene.image.width / scene.image.height
+    half = math.atan(min(tan_v, tan_h))
+    d0 = 1.2 * radius / math.sin(half)
+    centre = np.zeros(4)          # the bounding ball is about the world origin (camera.march_radius)
+    eye = centre - d0 * fr.forward
+    w, h = PROBE
+    probe = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, eye)],
+                             "camera.target": [float(v) for v in to_scene(scene, centre)],
+                             "camera.fit": False, "image.width": w, "image.height": h,
+                             "image.samples": 1})
+    res = render_fn(probe, ["position"])
+    pts = res.position[np.all(np.isfinite(res.position), axis=-1)].astype(np.float64)
+    record = {"probe_hits": int(len(pts)), "probe_size": f"{w}x{h}"}
+    if len(pts) == 0:
+        return scene.replace(**{"camera.fit": False}), record
+    c = pts.mean(axis=0)
+    rel = pts - c
+    x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
+    dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),
+               float(np.max(np.abs(y) / (MARGIN * tan_v) - z)), 1e-6)
+    pos = c - dist * fr.forward
+    record.update(distance=dist, target=[float(v) for v in c])
+    fitted = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, pos)],
+                              "camera.target": [float(v) for v in to_scene(scene, c)],
+                              "camera.fit": False})
+    return fitted, record

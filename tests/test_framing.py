@@ -1,0 +1,39 @@
+"""camera.fit (pyjulia4d/framing.py): a quick first pass frames the set, keeping the view
+direction."""
+import numpy as np
+
+from pyjulia4d.camera import camera_frame
+from pyjulia4d.framing import fit_camera, to_scene
+from pyjulia4d.camera import to_world
+from pyjulia4d.render import render
+from pyjulia4d.scene import Scene
+
+SPECK = ["fractal.c=-0.803762,-0.40615,0,0", "fractal.max_iter=8", "camera.position=-2,1,5,8",
+         "image.width=96", "image.height=72"]
+
+
+def test_to_scene_inverts_to_world():
+    s = Scene.default().with_overrides(["slice.normal=0.3,0,0.2,1", "slice.distance=0.1"])
+    x = np.array([0.3, -1.2, 0.7, 0.05])
+    np.testing.assert_allclose(to_world(s, to_scene(s, x)), x, atol=1e-12)
+
+
+def test_fit_frames_a_speck_and_keeps_the_view_direction():
+    s = Scene.default().with_overrides(SPECK)
+    before = render(s)
+    assert before.hit_fraction < 0.05                     # README's example: a speck
+    fitted, rec = fit_camera(s.with_overrides(["camera.fit=true"]), lambda sc, o: render(sc, outputs=o))
+    assert rec["probe_hits"] > 0 and fitted.camera.fit is False
+    np.testing.assert_allclose(camera_frame(fitted).forward, camera_frame(s).forward, atol=1e-9)
+    after = render(fitted)
+    assert 0.15 < after.hit_fraction < 0.8
+    border = np.concatenate([after.alpha[0], after.alpha[-1], after.alpha[:, 0], after.alpha[:, -1]])
+    assert np.mean(border > 0) < 0.02                     # not cut off by the frame
+
+
+def test_fit_through_render():
+    s = Scene.default().with_overrides(["fractal.c=-1,0.2,0,0", "camera.fit=true", "image.width=64",
+                                        "image.height=48"])
+    r = render(s)
+    border = np.concatenate([r.alpha[0], r.alpha[-1], r.alpha[:, 0], r.alpha[:, -1]])
+    assert r.hit_fraction > 0.1 and np.mean(border > 0) < 0.05
