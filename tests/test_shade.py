@@ -70,6 +70,7 @@ def test_colormap_table_is_linear_light():
 LIGHT_SCENES = {
     "default": [],
     "fog": ["shading.fog=0.8", "shading.background=0.2,0.2,0.3"],
+    "fog+trap+cut": ["shading.fog=0.5", "shading.coloring=trap", "clip.planes=0,0,-1,0", "image.samples=2"],
     "soft+ao": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.ao=0.8"],
     "hard+trap": ["shading.light=-3,4,-2", "shading.shadow=hard", "shading.coloring=trap",
                   "shading.colormap=inferno"],
@@ -124,3 +125,24 @@ def test_light_settings_refused(over, key):
     with pytest.raises(SceneError) as e:
         Scene.default().with_overrides(over)
     assert str(e.value).startswith(key + ": ")
+
+
+EVERYTHING = ["shading.light=-3,4,-2", "shading.ao=0.5", "shading.fog=0.3", "clip.planes=0,0,-1,0;1,0,0,0.5",
+              "image.samples=2", "image.width=16", "image.height=12"]
+
+
+@pytest.mark.parametrize("extra", [
+    ["shading.shadow=soft", "shading.coloring=iteration"],
+    ["shading.shadow=hard", "shading.coloring=trap", "march.method=fixed", "normals.method=zbuffer"],
+    ["shading.shadow=soft", "shading.coloring=w", "render.float=double", "normals.method=gradient"],
+    ["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin"],
+    ["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0"],
+    ["shading.shadow=soft", "fractal.algebra=hypercomplex", "fractal.function=cube", "render.variant=scalar"],
+])
+def test_every_switch_together_builds_and_stays_finite(extra):
+    # the -D switches of one scene meet in one program: none may clash (a shared name, a
+    # missing piece); the picture stays finite
+    from pyjulia4d.render import render
+    r = render(Scene.default().with_overrides(EVERYTHING + extra))
+    assert np.all(np.isfinite(r.color)) and np.all(np.isfinite(r.alpha))
+    assert r.hit_fraction > 0

@@ -62,8 +62,8 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
 #ifdef FOG
     /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the
      * distance from the eye, fog_start where the bounding ball begins */
-    float k = exp(-fog * fmax((float)length(pv) - fog_start, 0.0f));
-    rgb = mix(background.xyz, rgb, k);
+    float fade = exp(-fog * fmax((float)length(pv) - fog_start, 0.0f));
+    rgb = mix(background.xyz, rgb, fade);
 #endif
     rgba[i] = (float4)(rgb, 1.0f);
 }
