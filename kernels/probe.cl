@@ -32,3 +32,19 @@ __kernel void probe_step(const int n_items, __global const real4 *points, __glob
     value[i] = julia_f(q, ALG_C(c));
     jvp[i] = julia_f_jvp(q, ALG_IN(dirs[i]));
 }
+
+/* The scene's complex function alone (function/<name>.cl): cfun and cfun_d at complex points
+ * (re, im), for the tests of each function piece against its twin. */
+__kernel void probe_cfun(const int n_items, __global const real *re, __global const real *im,
+                         __global real *f_re, __global real *f_im, __global real *d_re, __global real *d_im)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+#if LANES == 1
+    cplx z = C(re[i], im[i]);
+    cplx f = cfun(z), d = cfun_d(z);
+    f_re[i] = f.re; f_im[i] = f.im;
+    d_re[i] = d.re; d_im[i] = d.im;
+#endif
+}
