@@ -13,13 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import build, workload
-from .workload import OUTPUTS, host_bytes_per_pixel, resolve_outputs  # noqa: F401 (part of the plan's API)
+from .workload import resolve_outputs
 from .camera import Frame, camera_frame, light_position, march_radius
 from .scene import Scene
-
-# EXR channel groups (output.write_exr) and the outputs behind them
-CHANNEL_GROUPS = {"RGBA": ("color", "alpha"), "Z": ("depth", "bracket"), "N": ("normal",),
-                  "P": ("position",)}
 
 # Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
 # which difference neighbours): device memory stays under ~20 MB single / ~36 MB double

@@ -7,6 +7,7 @@ kernels of one run while the host files the other, with no finish() between them
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -519,7 +520,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         if aa:
             # image.samples more passes of colour and alpha alone, each through its own
             # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
-            cplan = make_plan(scene, dev, lanes, outputs=["color", "alpha"], force=True, tile=tile)
+            cplan = dataclasses.replace(plan, outputs=frozenset({"color", "alpha", "bracket"}))
             crunner = TileRunner(cplan, dev)
             acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
             acc_a = np.zeros((H, W), np.float32)

@@ -5,25 +5,9 @@ import numpy as np
 
 from ..camera import Frame
 from ..render import STATUS_HIT
+# imported by the package at its end, once these are defined
+from . import _dot, _to_camera, julia_distance_formula, julia_inside
 from .formula import QUATERNION_SQR, Formula
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
-
-
-def _to_camera(g, frame: Frame):
-    return np.stack([g @ frame.right, g @ frame.up, -(g @ frame.forward)], axis=-1)
-
-
-def _distance_formula(x, c, max_iter, bailout, F):
-    from . import julia_distance_formula
-    return julia_distance_formula(x, c, max_iter, bailout, F)
-
-
-def _inside(x, c, max_iter, bailout, F):
-    from . import julia_inside
-    return julia_inside(x, c, max_iter, bailout, F)
 
 
 def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,
@@ -46,13 +30,13 @@ def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_ste
             break
         x = o[k] + t[k, None] * l[k]
         if F.has_de:
-            d, esc = _distance_formula(x, c, max_iter, bailout, F)
+            d, esc = julia_distance_formula(x, c, max_iter, bailout, F)
             inside = ~esc
             if soft:
                 vis[k] = np.where(esc, np.minimum(vis[k], softness * 2 * d / t[k]), vis[k])
             t[k] = t[k] + np.maximum(d, step)
         else:
-            inside = _inside(x, c, max_iter, bailout, F)
+            inside = julia_inside(x, c, max_iter, bailout, F)
             t[k] = t[k] + step
         vis[k[inside]] = 0.0
         active[k] = ~inside & (t[k] < t1[k])
@@ -67,11 +51,11 @@ def ambient_occlusion(p, nw, c, max_iter, bailout, dist, strength, F: Formula = 
         h = dist * i / 5
         x = p + h * nw
         if F.has_de:
-            d, esc = _distance_formula(x, c, max_iter, bailout, F)
+            d, esc = julia_distance_formula(x, c, max_iter, bailout, F)
             d = np.where(esc, d, 0.0)
             occ += w * np.maximum(h - 2 * d, 0.0) / h
         else:
-            occ += w * _inside(x, c, max_iter, bailout, F)
+            occ += w * julia_inside(x, c, max_iter, bailout, F)
         wsum += w
         w *= 0.5
     return np.clip(1 - strength * occ / wsum, 0.0, 1.0)

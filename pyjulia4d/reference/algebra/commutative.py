@@ -8,14 +8,7 @@ from .table import ALG_C, ALG_DOT, ALG_IN, ALG_NORM2, product  # noqa: F401 (the
 
 SIGN = [[1, 1, 1, 1], [1, -1, 1, 1], [1, 1, -1, 1], [1, 1, 1, -1]]
 alg_mul = product(SIGN)
-
-
-def julia_f(q, c, fn):
-    return power.julia_f(alg_mul, q, c, fn.FUNC_POWER)
-
-
-def julia_f_jvp(q, h, fn):
-    return power.julia_f_jvp(alg_mul, q, h, fn.FUNC_POWER)
+julia_f, julia_f_jvp = power.maps(alg_mul)
 
 
 ALG_HAS_DE = False

@@ -12,3 +12,9 @@ def julia_f_jvp(alg_mul, q, h, power):
     if power == 2:
         return 2 * alg_mul(q, h)
     return alg_mul(2 * alg_mul(q, h), q) + alg_mul(alg_mul(q, q), h)
+
+
+def maps(alg_mul):
+    """(julia_f(q, c, fn), julia_f_jvp(q, h, fn)) of an algebra with product alg_mul."""
+    return (lambda q, c, fn: julia_f(alg_mul, q, c, fn.FUNC_POWER),
+            lambda q, h, fn: julia_f_jvp(alg_mul, q, h, fn.FUNC_POWER))
