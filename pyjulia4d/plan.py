@@ -52,12 +52,16 @@ class Tile:
         return slice(self.y0, self.y0 + self.h), slice(self.x0, self.x0 + self.w)
 
 
-def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0) -> tuple[Tile, ...]:
-    """The image's tiles, row by row, each with its halo box clipped to the image."""
+def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0,
+               region: tuple[int, int, int, int] | None = None) -> tuple[Tile, ...]:
+    """The tiles of the image (or of its ``region`` = (x0, y0, w, h)), row by row, each with
+    its halo box clipped to the image: a pixel's box holds the same neighbours however the
+    image is cut, so a region renders exactly as the same pixels of the whole image."""
+    rx, ry, rw, rh = region if region is not None else (0, 0, width, height)
     out = []
-    for y0 in range(0, height, tile):
-        for x0 in range(0, width, tile):
-            w, h = min(tile, width - x0), min(tile, height - y0)
+    for y0 in range(ry, ry + rh, tile):
+        for x0 in range(rx, rx + rw, tile):
+            w, h = min(tile, rx + rw - x0), min(tile, ry + rh - y0)
             ax0, ay0 = max(0, x0 - halo), max(0, y0 - halo)
             ax1, ay1 = min(width, x0 + w + halo), min(height, y0 + h + halo)
             out.append(Tile(x0, y0, w, h, ax0, ay0, ax1 - ax0, ay1 - ay0))
@@ -80,6 +84,7 @@ class Plan:
     march_program: build.KernelConfig
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
+    region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
 
     @property
     def normals(self) -> bool:
@@ -101,10 +106,27 @@ class Plan:
         return self.scene.normals.method == "jacobian"
 
 
+def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
+    """``region`` = (x0, y0, w, h) as ints, checked to lie in the image (None: the whole)."""
+    if region is None:
+        return None
+    from .scene import SceneError
+    try:
+        x0, y0, w, h = (int(v) for v in region)
+    except (TypeError, ValueError):
+        raise SceneError("region", f"expected (x0, y0, width, height), got {region!r}") from None
+    W, H = scene.image.width, scene.image.height
+    if not (0 <= x0 and 0 <= y0 and w >= 1 and h >= 1 and x0 + w <= W and y0 + h <= H):
+        raise SceneError("region", f"{(x0, y0, w, h)} is not inside the {W}x{H} image")
+    return x0, y0, w, h
+
+
 def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
-              tile: int = TILE) -> Plan:
+              tile: int = TILE, region=None) -> Plan:
     """Check and resolve ``scene`` for ``device`` (a pyopencl Device, "CPU" or "GPU") with
-    ``lanes`` rays per work-item of the march, keeping ``outputs`` (None: all)."""
+    ``lanes`` rays per work-item of the march, keeping ``outputs`` (None: all), over the
+    image or its ``region`` (x0, y0, w, h) alone."""
+    region = check_region(scene, region)
     kept = resolve_outputs(outputs)
     est = workload.check(scene, device, force=force, outputs=kept)
     m = scene.march
@@ -119,5 +141,6 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
         program=build.scene_config(scene),
         march_program=build.march_config(scene, lanes) if lanes > 1 else build.scene_config(scene),
-        tiles=make_tiles(scene.image.width, scene.image.height, tile, halo),
+        tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
+        region=region or (0, 0, scene.image.width, scene.image.height),
         estimate=est)

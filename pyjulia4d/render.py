@@ -460,13 +460,15 @@ def _seconds(events) -> float:
 
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False, tile: int = TILE, lanes: int | None = None,
-           outputs=None) -> RenderResult:
+           outputs=None, region=None) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
     (lanes.lanes_for); the tests and the width probe use it.  ``outputs`` names the arrays
     kept (workload.OUTPUTS; None: all): a depth-only render of any size keeps 8 bytes per
-    pixel on the host (depth and its bracket) and two tiles on the device."""
+    pixel on the host (depth and its bracket) and two tiles on the device.  ``region`` =
+    (x0, y0, w, h) renders those pixels of the image alone, bit for bit as the whole
+    render has them (the distributed renderer's unit of one frame)."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
@@ -476,11 +478,11 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     double = scene.render.float == "double"
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
-    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile)
+    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
     if double and not has_fp64(dev):
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     runner = TileRunner(plan, dev)
-    W, H = scene.image.width, scene.image.height
+    rx, ry, W, H = plan.region
     keep = plan.outputs
     shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W),
               "normal": (H, W, 3), "position": (H, W, 4), "status": (H, W), "samples": (H, W)}
@@ -489,8 +491,13 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     guards: dict[str, int] = {}
     kernel_events: list = []
 
+    def at(t: Tile) -> tuple[slice, slice]:
+        """The tile's pixels in the arrays (which cover the region)."""
+        rows, cols = t.dst()
+        return slice(rows.start - ry, rows.stop - ry), slice(cols.start - rx, cols.stop - rx)
+
     def file(t: Tile, got: dict[str, np.ndarray]) -> None:
-        own, dst = t.own(), t.dst()
+        own, dst = t.own(), at(t)
         st = got["status"][own]
         for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
             counts[name] += int(np.count_nonzero(st == code))
@@ -526,7 +533,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             acc_a = np.zeros((H, W), np.float32)
 
             def add(t: Tile, got: dict[str, np.ndarray]) -> None:
-                own, dst = t.own(), t.dst()
+                own, dst = t.own(), at(t)
                 if acc_c is not None:
                     acc_c[dst] += got["rgba"][own][..., :3]
                 acc_a[dst] += got["rgba"][own][..., 3]

@@ -104,3 +104,24 @@ def test_cli_depth_only_exr(tmp_path):
                         "--height", "30", "--channels", "Z"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     assert sorted(OpenEXR.File(str(out)).channels()) == ["Z", "Z.bracket"]
+
+
+@pytest.mark.parametrize("overrides", [[], ["normals.method=zbuffer"], ["image.samples=2"],
+                                       ["fractal.algebra=hypercomplex", "fractal.function=exp",
+                                        "shading.coloring=iteration"]])
+def test_a_region_renders_as_the_same_pixels_of_the_whole(overrides):
+    """The distributed renderer's unit: a region, cut across the tile grid (tiles start at
+    its corner, not at multiples of the tile size), equals those pixels of the whole
+    render bit for bit, halo-needing Z-buffer normals and supersampling included."""
+    s = Scene.default().with_overrides(["image.width=70", "image.height=50"] + overrides)
+    whole = render(s, device=device(), tile=16)
+    part = render(s, device=device(), tile=16, region=(13, 7, 40, 30))
+    for k in ("color", "alpha", "depth", "normal", "position", "status", "bracket"):
+        assert np.array_equal(getattr(whole, k)[7:37, 13:53], getattr(part, k), equal_nan=True), k
+
+
+@pytest.mark.parametrize("region", [(0, 0, 0, 5), (-1, 0, 5, 5), (60, 0, 20, 5), (0, 0, 70, 51), "abc"])
+def test_a_region_outside_the_image_is_refused(region):
+    s = Scene.default().with_overrides(["image.width=70", "image.height=50"])
+    with pytest.raises(SceneError, match="region"):
+        make_plan(s, "CPU", 1, region=region)
