@@ -1,4 +1,4 @@
-"""Command line: ``python -m pyjulia4d render|devices|import-pov``.
+"""Command line: ``python -m pyjulia4d render|animate|devices|import-pov``.
 
 Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
 status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
@@ -59,6 +59,24 @@ def _parser() -> argparse.ArgumentParser:
                         "and shading and keeps 8 bytes per pixel: the way to render huge depth maps")
     r.add_argument("--force", action="store_true",
                    help="render settings whose estimated work is refused as hopeless (hours)")
+    _cluster_options(r, "tiles of the image")
+
+    a = sub.add_parser("animate", help="render a keyframed scene to numbered frames and a video")
+    a.add_argument("scene", metavar="SCENE.toml", help="scene file with [[keyframe]] tables and [animation]")
+    a.add_argument("-o", "--output", metavar="PATTERN",
+                   help="frame files, one run of # for the frame number: frames/julia_####.png or .exr "
+                        "(default: <scene stem>_####.png)")
+    a.add_argument("--frames", metavar="A:B", help="render frames A to B (inclusive; default all)")
+    a.add_argument("--video", metavar="OUT", help="also encode the frames into OUT.mp4 or OUT.webm")
+    a.add_argument("--width", metavar="W", help="frame width (same as --set image.width=W; not both)")
+    a.add_argument("--height", metavar="H", help="frame height (same as --set image.height=H; not both)")
+    a.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene key (it is then no longer keyframed) or animation.frames, "
+                        "animation.fps, animation.interpolation")
+    a.add_argument("--device", metavar="SPEC", help="OpenCL device of every worker (as for render)")
+    a.add_argument("--channels", metavar="LIST", help="EXR channel groups (as for render)")
+    a.add_argument("--force", action="store_true", help="render frames whose work is refused as hopeless")
+    _cluster_options(a, "whole frames")
 
     sub.add_parser("devices", help="list the OpenCL devices")
 
@@ -69,6 +87,16 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--width", metavar="W", help="image width, also POV-Ray's image_width (default 640)")
     i.add_argument("--height", metavar="H", help="image height, also POV-Ray's image_height (default 480)")
     return ap
+
+
+def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
+    """--workers and --scheduler (pyjulia4d/distributed.py): Dask renders ``units``."""
+    p.add_argument("--workers", metavar="N",
+                   help=f"render {units} on a local Dask cluster of N worker processes (0: in this "
+                        f"process; animate's default: one per GPU, or 1 on a CPU)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help=f"render {units} on an existing Dask cluster, e.g. tcp://HOST:8786 "
+                        f"(dask scheduler; dask worker tcp://HOST:8786 on each node)")
 
 
 def select_device(spec: str | None) -> Any:
@@ -87,19 +115,26 @@ def _render(args: argparse.Namespace) -> int:
         if any(override_key(o) == dotted for o in overrides):
             raise SceneError(dotted, f"given twice, by {flag} and by --set {dotted}; use one")
         overrides.append(f"{dotted}={value}")
-    if args.scene is None:
-        scene = Scene.default().with_overrides(overrides)
+    if args.scene is None:   # the built-in scene; framed (camera.fit) unless a position is set
+        scene = Scene.from_dict({}, overrides)
         default_out = "julia.png"
     else:
         scene = Scene.from_toml(args.scene, overrides)
         default_out = Path(args.scene).stem + ".png"
     out = check_output_path(default_out if args.output is None else args.output)
     outputs = _outputs(args.channels, out)
-    device = select_device(args.device)
+    if args.workers is not None or args.scheduler is not None:  # tiles on a Dask cluster
+        from .distributed import check_workers, render_on_cluster
 
-    from .render import render  # heavy (kernel build); only once the input is known good
+        workers = None if args.workers is None else check_workers(args.workers)
+        result = render_on_cluster(scene, workers, args.scheduler, args.device, outputs, args.force,
+                                   progress=True)
+    else:
+        device = select_device(args.device)
 
-    result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
+        from .render import render  # heavy (kernel build); only once the input is known good
+
+        result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
     from .quality import BOUND_MAX_ITER, stated_p99
 
     # capped rays, the guards that fired and the certified depth bracket are part of the
@@ -111,7 +146,12 @@ def _render(args: argparse.Namespace) -> int:
         tail += (f"; march.quality={q} states no depth-error bound beyond fractal.max_iter "
                  f"{BOUND_MAX_ITER}: the bracket above is this render's own")
         report["pyjulia4d.preset_bound_met"] = "no bound stated"
-    header = {"pyjulia4d.scene": scene.to_toml(), **report}
+    # the scene as rendered: with camera.fit, the camera the framing pass chose
+    rendered = getattr(result, "scene", None) or scene
+    header = {"pyjulia4d.scene": rendered.to_toml(), **report}
+    if scene.camera.fit and rendered is not scene:
+        pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
+        tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
     write_image(out, result, header)
     w, h = scene.image.width, scene.image.height
     print(
@@ -235,6 +275,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return 0
             if args.command == "import-pov":
                 return _import_pov(args)
+            if args.command == "animate":
+                from .animation import run_cli
+
+                return run_cli(args)
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
         _say(f"pyjulia4d: error: {_one_line(e)}")

@@ -51,6 +51,7 @@ class RenderResult:
     kernel_seconds: float = 0.0  # the kernels alone
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
     lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
+    scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
 
     def __repr__(self) -> str:
         h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
@@ -472,9 +473,19 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
+        import warnings
+
         from .framing import fit_camera
-        scene, _ = fit_camera(scene, lambda s, outs: render(s, device=dev, force=force, lanes=lanes,
-                                                             outputs=outs))
+
+        def first_pass(s: Scene, outs) -> RenderResult:
+            with warnings.catch_warnings():   # the render proper says them, once
+                warnings.simplefilter("ignore")
+                return render(s, device=dev, force=True, lanes=lanes, outputs=outs)
+
+        with warnings.catch_warnings():   # refuse before any pass runs; warn after it
+            warnings.simplefilter("ignore")
+            make_plan(scene, dev, lanes or 1, outputs=outputs, force=force, tile=tile, region=region)
+        scene, _ = fit_camera(scene, first_pass)
     double = scene.render.float == "double"
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
@@ -550,7 +561,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
         samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
         device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
-        guards=guards)
+        guards=guards, scene=scene)
     result.seconds = time.perf_counter() - t_start
     return result
 

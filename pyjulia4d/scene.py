@@ -80,6 +80,16 @@ class Fractal:
     max_iter: int = 12
     bailout: float = 4.0  # escape radius (POV-Ray's default)
     exponent: tuple[float, float] = (2.0, 0.0)  # pwr's complex exponent x + iy
+    # "julia": the point is q_0, c the constant; "mandelbrot": the point is c, q_0 = 0 (the
+    # critical point of q^2 and q^3), c unused (kernels/kind/mandelbrot.cl)
+    kind: str = "julia"
+    # the complex rotation g(q) = e^(i theta) q conjugating the map, in degrees (seed 001
+    # §2.3; kernels/kind/rotate.cl); 0 compiles the rotation out
+    theta: float = 0.0
+
+
+# The kinds of set a [fractal] table describes (Fractal.kind).
+KINDS = ("julia", "mandelbrot")
 
 
 def has_distance_estimate(f: Fractal) -> bool:
@@ -109,7 +119,10 @@ class Camera:
     up: Vec4 = (0.0, 1.0, 0.0, 0.0)
     limbo: Vec4 = (0.0, 0.0, 0.0, 1.0)
     fov: float = 40.0
-    fit: bool = False      # frame the set from a quick first pass (framing.py), keeping the view direction
+    # frame the set from a quick first pass (framing.py), keeping the view direction; a scene
+    # read by from_dict/from_toml (or the command line) that gives no camera.position and
+    # no camera.fit gets true (Scene.from_dict)
+    fit: bool = False
 
 
 @dataclass(frozen=True)
@@ -439,6 +452,9 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "bailout": _Real(1e-3, 1e76),
         # pwr's exponent; |x|, |y| <= 16: higher powers overflow float32 within an iteration
         "exponent": _Vector((2,), -16.0, 16.0),
+        "kind": _Choice(*KINDS),
+        # degrees; one turn each way (the map is periodic in theta with period 360)
+        "theta": _Real(-360.0, 360.0),
     },
     "camera": {
         "position": _Vector((3, 4), -COORD, COORD),
@@ -650,6 +666,22 @@ def _check_fractal(scene: "Scene") -> None:
                          f"(as in POV-Ray's julia_fractal: {' and '.join(allowed)} only); use "
                          f"fractal.algebra=hypercomplex for it")
     pair = f"{f.algebra} {f.function}"
+    if f.kind == "mandelbrot":
+        if f.function not in POLYNOMIAL_DEGREE:
+            raise SceneError("fractal.kind", f"mandelbrot starts the orbit at the critical point 0 of sqr and cube; "
+                             f"{f.function} has no critical point there: use fractal.function=sqr or cube")
+        if f.theta != 0:
+            raise SceneError("fractal.theta", "the rotation leaves a Mandelbrot set unchanged (its orbits are "
+                             "the unrotated ones times e^(i theta)): set 0")
+        if scene.shading.coloring in ("iteration", "trap"):
+            raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the Julia orbit of "
+                             f"fractal.c, not a Mandelbrot set's; use flat or w")
+    if f.theta != 0 and f.algebra != "quaternion":
+        raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
+                         f"section 2.3), not {f.algebra}: set 0")
+    if m.quality != "custom" and f.kind != "julia":
+        raise SceneError("march.quality", f"the presets were measured on Julia sets; for a {f.kind} set the "
+                         f"march keys (march.quality=custom)")
     if m.quality != "custom" and f.algebra != "quaternion":
         raise SceneError("march.quality", f"the presets were measured on quaternion sets; for {pair} set the "
                          f"march keys (march.quality=custom), measured in README's algebras section")
@@ -707,6 +739,10 @@ class Scene:
             raw[section][key] = value
             if (section, key) == ("march", "quality"):
                 _apply_quality(raw["march"], keep=set())
+        # No camera position given: nothing says where the set is, so frame it (a default
+        # camera cuts off or shrinks to a speck many sets); a given position is kept as is.
+        if "position" not in raw["camera"] and "fit" not in raw["camera"]:
+            raw["camera"]["fit"] = True
         return cls._build(raw)
 
     @classmethod

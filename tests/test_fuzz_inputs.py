@@ -180,6 +180,8 @@ def _toml_wrong_types(key: str) -> list[str]:
     if kind == "_Planes":   # [] is valid (no planes)
         vals = [v for v in vals if v != "[]"] + ["[[0, 0, 0, 1]]", "[1, 2, 3, 4]", "[[1, 0, 0, nan]]",
                                                 "[[1, 0, 0, true]]"]
+    if kind == "_Bool":     # true is a boolean key's own type
+        vals = [v for v in vals if v != "true"] + ["1", '"yes"']
     return vals
 
 

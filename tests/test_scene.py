@@ -20,7 +20,10 @@ else:  # pragma: no cover
 
 def test_defaults() -> None:
     s = Scene.default()
-    assert s == Scene.from_dict({})
+    # a scene read without a camera position frames the set (camera.fit); the built-in
+    # scene is the same with its own camera placed
+    assert s.camera.fit is False and Scene.from_dict({}).camera.fit is True
+    assert s == Scene.from_dict({"camera": {"fit": False}})
     assert s.fractal.c == (-0.2, 0.8, 0.0, 0.0)
     assert s.fractal.max_iter == 12 and s.fractal.bailout == 4.0
     assert s.camera.position == (1.8, 1.6, -2.2, 0.0) and s.camera.fov == 40.0
@@ -408,4 +411,16 @@ def test_deep_toml_and_big_files(tmp_path) -> None:
     with pytest.raises(SceneError, match=r": larger than 1 MiB, not a scene file$"):
         Scene.from_toml(path)
     path.write_bytes(b"#" * ((1 << 20) - 1) + b"\n")  # exactly 1 MiB is fine
-    assert Scene.from_toml(path) == Scene.default()
+    assert Scene.from_toml(path) == Scene.from_dict({})
+
+
+@pytest.mark.parametrize("camera, fit", [({}, True), ({"position": [0, 0, -4, 0]}, False),
+                                          ({"fit": False}, False), ({"position": [0, 0, -4, 0], "fit": True}, True),
+                                          ({"target": [0, 0.1, 0, 0]}, True)])
+def test_fit_is_the_default_without_a_camera_position(camera, fit) -> None:
+    assert Scene.from_dict({"camera": camera}).camera.fit is fit
+    # an override giving the position counts as given
+    assert Scene.from_dict({}, ["camera.position=0,0,-4,0"]).camera.fit is False
+    # a resolved scene says it, so it reads back the same
+    s = Scene.from_dict({"camera": camera})
+    assert Scene.from_dict(tomllib.loads(s.to_toml())) == s
