@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import hashlib
+import math
 import os
 
 import pyopencl as cl
@@ -35,15 +36,27 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
     built from them), the iteration."""
     f = scene.fractal
     power = ("algebra/power",) if f.algebra in ("cquat", "commutative") else ()
-    return ("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power + ("iterate",)
+    # fractal.theta != 0: the rotated map (kind/rotate.cl); fractal.kind other than "julia":
+    # its set test after iterate.cl (kind/<kind>.cl).  The default compiles neither.
+    rotate = ("kind/rotate",) if f.theta != 0 else ()
+    kind = (f"kind/{f.kind}",) if f.kind != "julia" else ()
+    return (("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power + rotate
+            + ("iterate",) + kind)
 
 
 def fractal_defines(scene: Scene) -> tuple[str, ...]:
-    """pwr's complex exponent, compiled in (function/pwr.cl)."""
+    """pwr's complex exponent, compiled in (function/pwr.cl); the rotation's cos and sin
+    (kind/rotate.cl); the kind's switch (KIND_MANDELBROT: normals/jacobian.cl)."""
     f = scene.fractal
-    if f.function != "pwr":
-        return ()
-    return (f"FUNC_EXPONENT_RE={f.exponent[0]!r}", f"FUNC_EXPONENT_IM={f.exponent[1]!r}")
+    out = ()
+    if f.function == "pwr":
+        out += (f"FUNC_EXPONENT_RE={f.exponent[0]!r}", f"FUNC_EXPONENT_IM={f.exponent[1]!r}")
+    if f.theta != 0:
+        t = math.radians(f.theta)
+        out += (f"ROTATE_COS={math.cos(t)!r}", f"ROTATE_SIN={math.sin(t)!r}")
+    if f.kind != "julia":
+        out += (f"KIND_{f.kind.upper()}",)
+    return out
 
 
 def precision_defines(scene: Scene) -> tuple[str, ...]:

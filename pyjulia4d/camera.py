@@ -134,12 +134,54 @@ def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) ->
     return min(float(bailout), s)
 
 
+def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2) -> float:
+    """Radius of a 4-ball that provably holds every c with |q_n| <= bailout for n = 1..max_iter,
+    q_1 = c, q_{n+1} = q_n^degree + c (kernels/kind/mandelbrot.cl).
+
+    |q_1| = |c| = r <= b is needed.  With s_1 = r, s_{n+1} = s_n^D - r a lower bound of |q_n|
+    (|q^D + c| >= |q|^D - |c|), and r > R = 2^(1/(D-1)) (where R^D - R = R), s_n grows with n
+    and with r (ds_{n+1}/dr = D s_n^(D-1) ds_n/dr - 1 >= 1); so the c that stay within b for N
+    steps have r <= max(R, r*), r* the least r >= R with some s_n > b, found by bisection
+    (widened by 1e-9 relative).  ``degree`` None (no norm bound): the bailout, widened as in
+    bounding_radius."""
+    b = float(bailout)
+    if degree is None:
+        return b * (1.0 + 2.0 ** -20)
+    R = 2.0 ** (1.0 / (degree - 1))
+    if b <= R:
+        return b
+
+    def escapes(r: float) -> bool:
+        s = r
+        for _ in range(int(max_iter) - 1):
+            s = s ** degree - r
+            if s > b:
+                return True
+        return False
+
+    if not escapes(b):
+        return b
+    lo, hi = R, b                    # lo stays within b (or is R), hi escapes
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if escapes(mid):
+            hi = mid
+        else:
+            lo = mid
+    return min(b, hi * (1.0 + 1e-9))
+
+
 def march_radius(scene: Scene) -> float:
     """Bounding radius for the march: the escape-time bound, plus 4 epsilon for the
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
     estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
     f = scene.fractal
-    r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
+    if f.kind == "mandelbrot":
+        r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f))
+    else:
+        r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
     if march_method(scene) == "de":
         r += 4.0 * scene.march.epsilon
     return r

@@ -256,6 +256,27 @@ def _build() -> list[Case]:
              "float32 and float64 orbits part: measured, not asserted",
              0.05, 1e-3, "chaotic: float32 and float64 orbits separate near the poles", cheap,
              methods=("fixed",), both_hit_min=0),
+        # Mandelbrot sets (fractal.kind, kernels/kind/mandelbrot.cl): the point is c.
+        Case("mandelbrot_eye_at_zero", ("fractal.kind=mandelbrot", "camera.position=0,0,0,0",
+                                        "camera.target=0,0,1,0", "camera.up=0,1,0,0"),
+             "the eye at c = 0, inside the Mandelbrot set: every iterate is exactly 0 (q_1 = c = 0), "
+             "the derivative with respect to c is 1 + 0 + ...",
+             "every pixel a hit at depth 0 (eye_hit); the Jacobian stops before q underflows "
+             "(jacobian_tiny) and the zero gradient falls back to the view axis, counted; no NaN",
+             0.0, 1e-6, "", small),
+        Case("mandelbrot_max_iter_1000", ("fractal.kind=mandelbrot", "fractal.max_iter=1000",
+                                          "camera.position=-0.5,1.6,-2.9,0", "camera.target=-0.5,0,0,0"),
+             "1000 iterations of the orbit of 0: |dq/dc| grows like 2^n |q_1 ... q_n| past float32's "
+             "range (carried as mantissa * 2^e) and the boundary is chaotic",
+             "finite estimate and normals; terminates; float32 and float64 orbits part near the "
+             "boundary, so the first crossing differs on some rays",
+             0.1, 1e-3, "chaotic: float32 and float64 orbits of 1000 iterations part near the boundary",
+             small),
+        Case("theta_90_cube", ("fractal.function=cube", "fractal.c=0.3,0.4,0,0", "fractal.theta=90",
+                               "fractal.max_iter=20"),
+             "the rotated map u (u^-1 q)^3 + u c (seed 001 §2.3) with u = i: cos 90 degrees is "
+             "6e-17 in float64 and -4e-8 in float32, not 0",
+             "agrees with float64 as the unrotated cube does", 0.02, 1e-4, "", cheap),
     ]
     return cases
 

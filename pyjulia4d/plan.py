@@ -8,6 +8,7 @@ and a tile of it executed anywhere the same kernels build; render.py executes it
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -90,6 +91,16 @@ class Plan:
     def normals(self) -> bool:
         """Whether the normals kernel runs: for the normal output or for shading."""
         return bool({"normal", "color"} & self.outputs)
+
+    @property
+    def halo(self) -> int:
+        """Pixels around each tile computed for its Z-buffer normals (which difference neighbours)."""
+        return 1 if self.scene.normals.method == "zbuffer" and self.normals else 0
+
+    def retile(self, side: int) -> "Plan":
+        """The same plan in tiles of at most side x side pixels (calibrate.tile_side)."""
+        W, H = self.scene.image.width, self.scene.image.height
+        return dataclasses.replace(self, tiles=make_tiles(W, H, side, self.halo, self.region))
 
     @property
     def shades(self) -> bool:

@@ -22,6 +22,7 @@ from . import build, colormap
 from .devices import has_fp64, select_device
 from .lanes import lanes_for
 from .camera import clip_planes
+from .calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
 from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
 from .scene import Scene, SceneError, march_method
 
@@ -52,6 +53,7 @@ class RenderResult:
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
     lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
     scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
+    prediction: Prediction | None = None   # calibrate.py's, where a probe ran
 
     def __repr__(self) -> str:
         h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
@@ -461,7 +463,7 @@ def _seconds(events) -> float:
 
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False, tile: int = TILE, lanes: int | None = None,
-           outputs=None, region=None) -> RenderResult:
+           outputs=None, region=None, calibrate: bool = True) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
@@ -469,7 +471,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     kept (workload.OUTPUTS; None: all): a depth-only render of any size keeps 8 bytes per
     pixel on the host (depth and its bracket) and two tiles on the device.  ``region`` =
     (x0, y0, w, h) renders those pixels of the image alone, bit for bit as the whole
-    render has them (the distributed renderer's unit of one frame)."""
+    render has them (the distributed renderer's unit of one frame).  ``calibrate``: a probe
+    render of the scene predicts the time first (calibrate.py: refuse, warn, size the tiles
+    so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``."""
     t_start = time.perf_counter()
     dev = device if isinstance(device, cl.Device) else select_device(device)
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
@@ -490,6 +494,23 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
     plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
+    prediction = None
+    if calibrate and plan.estimate.seconds > SKIP_BELOW_SECONDS:
+        def run_probe(tiles) -> float:
+            """The probe's kernel seconds, divided by the compute units a tile of the render
+            keeps busy: each probe block is one work-group, run by one of them."""
+            events: list = []
+            probe = TileRunner(dataclasses.replace(plan, tiles=tiles), dev)
+            _run_tiles(probe, tiles, lambda t, got: None, events, _NoProgress())
+            big = max(plan.tiles, key=lambda t: t.n)
+            groups = -(-march_items(big.n, big.aw, plan.lanes) // local_size(probe.march_k, dev))
+            return _seconds(events) / max(1, min(dev.max_compute_units, groups))
+
+        prediction = predict(plan, run_probe)
+        judge(plan, prediction, force)
+        side = tile_side(prediction, tile)
+        if side < tile:
+            plan = plan.retile(side)
     if double and not has_fp64(dev):
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     runner = TileRunner(plan, dev)
@@ -561,7 +582,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
         samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
         device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
-        guards=guards, scene=scene)
+        guards=guards, scene=scene, prediction=prediction)
     result.seconds = time.perf_counter() - t_start
     return result
 
@@ -588,6 +609,11 @@ class _LineProgress:
 
     def __exit__(self, *exc) -> None:
         return None
+
+
+class _NoProgress:
+    def update(self, k: int) -> None:
+        pass
 
 
 def _progress(total: int, enabled: bool):

@@ -72,7 +72,8 @@ def escape_degree(f: "Fractal") -> int | None:
 
 @dataclass(frozen=True)
 class Fractal:
-    """[fractal]: the Julia set of q -> f(q) + c in a 4D algebra."""
+    """[fractal]: the Julia set of q -> f(q) + c in a 4D algebra, or (``kind``) its Mandelbrot
+    set; ``theta`` rotates the quaternion map (seed 001 §2.3)."""
 
     algebra: str = "quaternion"
     function: str = "sqr"

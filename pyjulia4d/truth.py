@@ -434,8 +434,10 @@ class Truth:
 
 
 def is_quaternion_sqr(scene: Scene) -> bool:
-    """The analytic and 2D oracles hold for q -> q^2 + c over the quaternions only."""
-    return scene.fractal.algebra == "quaternion" and scene.fractal.function == "sqr"
+    """The analytic and 2D oracles hold for the Julia sets of q -> q^2 + c over the
+    quaternions only (not a Mandelbrot set, not a rotated map)."""
+    f = scene.fractal
+    return f.algebra == "quaternion" and f.function == "sqr" and f.kind == "julia" and f.theta == 0
 
 
 def is_real_c(scene: Scene) -> bool:

@@ -11,8 +11,11 @@ arithmetic the chosen precision, or whose image the memory, cannot hold.
 
 and turns it into hours with a measured throughput.  ``check(scene)`` raises a
 :class:`WorkloadError` (a SceneError: one line, starting with the key that dominates)
-above ``REFUSE_ITERATIONS`` and warns above ``WARN_ITERATIONS``; ``render(scene,
-force=True)`` skips the refusal.  render() calls it right after picking the device.
+when even the bound's share of a probe render is too much to run (PROBE_LIMIT_ITERATIONS)
+and the bound is above ``REFUSE_ITERATIONS``: hopeless per ray, refused instantly.
+Everything else is judged by a probe render of the scene itself (calibrate.py), which
+render() runs right after the plan: the bound is 50-100x the truth for the distance
+estimate march.  ``render(scene, force=True)`` skips the refusals.
 """
 from __future__ import annotations
 
@@ -38,8 +41,11 @@ ITERATIONS_PER_SECOND = {
     ("GPU", "single"): 2e10,
     ("GPU", "double"): 2e10 / 32,
 }
-REFUSE_ITERATIONS = 1e13   # ~40 h on the development CPU, minutes to hours on a GPU
-WARN_ITERATIONS = 1e11     # ~25 min on the development CPU
+REFUSE_ITERATIONS = 1e13   # ~2 h at the bound on the development CPU
+# calibrate.py's probe renders PROBE_RAYS pixels; where their share of the bound is above
+# PROBE_LIMIT_ITERATIONS (~4 s here) the probe is not run and the bound decides alone
+PROBE_RAYS = 2048
+PROBE_LIMIT_ITERATIONS = 5e9
 
 NORMAL_COST = {"jacobian": 4, "gradient": 6, "zbuffer": 0}
 
@@ -198,21 +204,27 @@ def check_memory(scene: Scene, outputs=None) -> None:
                                  f"half of this machine's {total / 2**30:.3g} GiB; at most ~{most:.3g} pixels")
 
 
+def probe_iterations(scene: Scene, est: Estimate) -> float:
+    """The bound's share of calibrate.py's probe render (PROBE_RAYS pixels)."""
+    pixels = scene.image.width * scene.image.height
+    return est.iterations * min(1.0, PROBE_RAYS / pixels)
+
+
 def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estimate:
-    """Before any kernel runs: refuse what the precision or the memory cannot hold, refuse work above
-    REFUSE_ITERATIONS (unless ``force``), warn above WARN_ITERATIONS.  Returns the estimate."""
+    """Before any kernel runs: refuse what the precision or the memory cannot hold, and (unless
+    ``force``) work that is hopeless per ray: above REFUSE_ITERATIONS with even the probe
+    render beyond PROBE_LIMIT_ITERATIONS.  The rest is judged by calibrate.py.  Returns the
+    estimate (the bound)."""
     check_numerics(scene)
     check_memory(scene, outputs)
     est = estimate(scene, device)
-    text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
-            f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
-            f"on a {est.kind}")
-    if est.iterations > REFUSE_ITERATIONS and not force:
+    if (est.iterations > REFUSE_ITERATIONS and probe_iterations(scene, est) > PROBE_LIMIT_ITERATIONS
+            and not force):
+        text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
+                f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
+                f"on a {est.kind}")
         raise WorkloadError(est.dominant,
                             f"{_value(scene, est.dominant)} could take {text}, over the limit of "
                             f"{REFUSE_ITERATIONS:.0e}; lower {est.dominant}, or force it "
                             f"(--force; render(..., force=True))")
-    if est.iterations > WARN_ITERATIONS:
-        warnings.warn(f"{est.dominant}: {_value(scene, est.dominant)} may take up to {text}",
-                      RuntimeWarning, stacklevel=4)
     return est

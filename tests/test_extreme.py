@@ -235,8 +235,7 @@ def test_hopeless_refused_instantly():
     est = workload.estimate(s)
     assert est.iterations == pytest.approx(3840 * 2160 * (1e9 + 1 + 4 + 3) * 12 + 3840 * 2160 * 12 * 4)
     assert est.dominant == "march.z_resolution"
-    with pytest.warns(RuntimeWarning, match=r"^march\.z_resolution: "):
-        assert workload.check(s, force=True).hours > 1   # force skips the refusal (nothing rendered)
+    assert workload.check(s, force=True).hours > 1   # force skips the refusal (nothing rendered)
 
 
 def test_workload_warns_and_names_the_key():
@@ -244,11 +243,12 @@ def test_workload_warns_and_names_the_key():
                                         "march.method=de"])
     with pytest.raises(SceneError, match=r"^fractal\.max_iter: "):
         workload.check(s)
+    # the bound alone never warns: the 4K default's is ~5 min, its render a few seconds
+    # (the probe render judges it: tests/test_calibrate.py)
     s = Scene.default().with_overrides(["image.width=3840", "image.height=2160", "fractal.max_iter=12"])
-    with pytest.warns(RuntimeWarning, match=r"image\.width"):
-        workload.check(s)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        assert workload.check(s).hours > 0.05   # the bound: ~5 min
         workload.check(Scene.default())   # the default scene: silent
 
 

@@ -11,13 +11,28 @@
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
     quat q = ALG_IN(p);
+#ifdef KIND_MANDELBROT
+    /* the point is c (kind/mandelbrot.cl): q_1 = c, J_1 = dq_1/dp = ALG_IN, and
+     * J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings below) */
+    quat c = q;
+    quat e0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
+    quat e1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
+    quat e2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));
+    quat e3 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1));
+    lreal unit = (lreal)1;          /* 1 / s: the added identity at the scale J is kept in */
+#else
     real4 c = ALG_C(jp.c);
+#endif
     quat j0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
     quat j1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
     quat j2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));
     quat j3 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1));
     lmask live = L_TRUE;
+#ifdef KIND_MANDELBROT
+    for (int n = 1; n < jp.max_iter && L_ANY(live); ++n) {
+#else
     for (int n = 0; n < jp.max_iter && L_ANY(live); ++n) {
+#endif
         lreal m2 = ALG_NORM2(q);
         live &= m2 <= jp.bailout2;
         /* Inside points of c = 0 go to 0 like p^(2^n): q underflows to exactly 0 within a
@@ -36,7 +51,15 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
         j1 = QSEL(j1, julia_f_jvp(q, j1), live);
         j2 = QSEL(j2, julia_f_jvp(q, j2), live);
         j3 = QSEL(j3, julia_f_jvp(q, j3), live);
+#ifdef KIND_MANDELBROT
+        j0 = QSEL(j0, QADD(j0, QSCALE(unit, e0)), live);
+        j1 = QSEL(j1, QADD(j1, QSCALE(unit, e1)), live);
+        j2 = QSEL(j2, QADD(j2, QSCALE(unit, e2)), live);
+        j3 = QSEL(j3, QADD(j3, QSCALE(unit, e3)), live);
+        q = QSEL(q, mandel_f(q, c), live);
+#else
         q = QSEL(q, julia_f(q, c), live);
+#endif
         lreal s = fmax(fmax(QLEN(j0), QLEN(j1)), fmax(QLEN(j2), QLEN(j3)));
         /* rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
@@ -47,6 +70,9 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
             j1 = QSEL(j1, QSCALE(inv, j1), rescale);
             j2 = QSEL(j2, QSCALE(inv, j2), rescale);
             j3 = QSEL(j3, QSCALE(inv, j3), rescale);
+#ifdef KIND_MANDELBROT
+            unit = L_SEL(unit, unit * inv, rescale);
+#endif
         }
     }
     return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), ALG_DOT(q, j3));

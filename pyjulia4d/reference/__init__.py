@@ -33,6 +33,7 @@ def _dot(a, b):
 from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
 from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
 from .. import colormap  # noqa: E402
+from .kind import mandelbrot as _mandelbrot  # noqa: E402
 
 
 # ------------------------------------------------------------------ iterate.cl
@@ -40,6 +41,8 @@ from .. import colormap  # noqa: E402
 def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """|q_n| <= bailout for n = 0..max_iter (seed 003; seed 000 eq. 5)."""
     F = formula
+    if F.kind == "mandelbrot":   # kernels/kind/mandelbrot.cl takes the name over
+        return _mandelbrot.mandel_inside(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     out = np.ones(q.shape[:-1], bool)
@@ -58,6 +61,8 @@ def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(D^(N-n)) - 1 (D = the growth
     degree), capped at 1e30 (iterate.cl; seed 002).  Returns (F, inside)."""
     F = formula
+    if F.kind == "mandelbrot":
+        return _mandelbrot.mandel_level(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
@@ -91,6 +96,8 @@ def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNIO
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
     (d, escaped)."""
     F = formula
+    if F.kind == "mandelbrot":
+        return _mandelbrot.mandel_distance_formula(p, max_iter, bailout, F)
     if F.split:
         return _split_distance_formula(p, c, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
@@ -445,6 +452,8 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
     iteration stops while q is a normal number, |q|^2 >= sqrt(REAL_MIN): inside points of
     c ~ 0 go to exactly 0 otherwise, and the normal with them (GUARD_JACOBIAN_TINY)."""
     F = formula
+    if F.kind == "mandelbrot":   # normals/jacobian.cl, -D KIND_MANDELBROT
+        return _mandelbrot.mandel_normal_jacobian(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
     q = F.ALG_IN(np.array(p, np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     # J[..., k, :] = column k, in the algebra's coordinates: ALG_IN of the unit vectors

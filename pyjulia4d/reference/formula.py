@@ -19,6 +19,8 @@ class Formula:
     algebra: str = "quaternion"
     function: str = "sqr"
     exponent: tuple[float, float] = (2.0, 0.0)
+    kind: str = "julia"        # the set (reference/kind/): "julia" or "mandelbrot"
+    theta: float = 0.0         # the rotation of seed 001 §2.3, degrees (reference/kind/rotate.py)
     alg: Any = field(init=False, repr=False, compare=False)
     fn: Any = field(init=False, repr=False, compare=False)
 
@@ -47,9 +49,15 @@ class Formula:
         return self.alg.ALG_DOT(a, b)
 
     def julia_f(self, q, c):
+        if self.theta != 0:
+            from .kind.rotate import rot_f
+            return rot_f(q, c, self.theta, lambda x, cc: self.alg.julia_f(x, cc, self.fn))
         return self.alg.julia_f(q, c, self.fn)
 
     def julia_f_jvp(self, q, h):
+        if self.theta != 0:
+            from .kind.rotate import rot_f_jvp
+            return rot_f_jvp(q, h, self.theta, lambda x, hh: self.alg.julia_f_jvp(x, hh, self.fn))
         return self.alg.julia_f_jvp(q, h, self.fn)
 
     @property
@@ -83,7 +91,8 @@ QUATERNION_SQR = Formula()
 
 def formula_of(fractal) -> Formula:
     """The Formula of a scene's [fractal] table."""
-    return Formula(fractal.algebra, fractal.function, tuple(float(x) for x in fractal.exponent))
+    return Formula(fractal.algebra, fractal.function, tuple(float(x) for x in fractal.exponent),
+                   fractal.kind, float(fractal.theta))
 
 
 def complex_value(fn_name: str, z, exponent=(2.0, 0.0)):

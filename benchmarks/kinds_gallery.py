@@ -1,0 +1,183 @@
+"""Gallery pictures and depth error against run time for the sets beside the Julia set:
+quaternion and hypercomplex Mandelbrot sets (fractal.kind = "mandelbrot") and rotated
+quaternion Julia sets (fractal.theta, seed 001 §2.3).
+
+Pictures: each scene of GALLERY rendered from the CLI's code path (pyjulia4d.render) at
+--picture size, written to benchmarks/results/kinds/<name>.png.
+
+Error table: each scene of ERROR against ``truth.ground_truth`` (the double-precision
+kernels' fixed scan with 20 post-steps, its z-resolution doubled until converged, polished
+in float64 by the numpy twin's set test; plus the float64 de search where the pair has an
+estimate) - never the single-precision setting under test - for a small grid of march
+settings, timed (kernels alone, median of --repeats) and measured as in
+benchmarks/error_vs_time.py: silhouette error, depth error p50/p99/max on pixels both hit,
+the certified bracket's p99, the Jacobian normal's median angle to the truth's.
+
+Writes benchmarks/results/kinds/<name>.png, kinds_error.csv (this run's rows) and
+kinds_error.md (a section per run: device, date, commit).
+
+    python benchmarks/kinds_gallery.py [--size 64x48] [--picture 480x360] [--repeats 3]
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+for p in (ROOT, ROOT / "benchmarks"):
+    if str(p) not in sys.path:
+        sys.path.insert(0, str(p))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
+from error_vs_time import measure, timed  # noqa: E402
+
+from pyjulia4d import truth  # noqa: E402
+from pyjulia4d.devices import select_device  # noqa: E402
+from pyjulia4d.render import render  # noqa: E402
+from pyjulia4d.scene import Scene, has_distance_estimate  # noqa: E402
+
+MANDEL = ["fractal.kind=mandelbrot"]
+# camera looking at the Mandelbrot sets' centre (-0.5, 0, 0, 0) from above and in front
+M_CAM = ["camera.position=-0.5,1.6,-2.9,0", "camera.target=-0.5,0,0,0"]
+J_CAM = ["camera.position=2.3,2.05,-2.8,0", "camera.target=0,0,0,0"]
+GALLERY = {
+    "mandelbrot_quaternion_sqr": (MANDEL + ["camera.position=-1.3,1.5,-2.6,0", "camera.target=-0.5,0,0,0",
+                                            "fractal.max_iter=20", "march.epsilon=2e-4",
+                                            "clip.planes=0,0,-1,0", "shading.shadow=none"],
+                                  "quaternion Mandelbrot set q^2 + c, max_iter 20, cut open at z = 0: "
+                                  "the cut face is the complex Mandelbrot set, the solid its revolution "
+                                  "about the real axis"),
+    "mandelbrot_quaternion_cube": (MANDEL + ["fractal.function=cube", "fractal.max_iter=14",
+                                             "camera.position=-1.6,1.2,-2.4,0", "camera.fit=true",
+                                             "march.epsilon=2e-4"],
+                                   "quaternion Mandelbrot set q^3 + c, max_iter 14"),
+    "mandelbrot_hypercomplex_sqr": (MANDEL + ["fractal.algebra=hypercomplex", "fractal.max_iter=14",
+                                              "camera.position=-2.2,1.8,-2.6,0", "camera.target=-0.5,0,0,0",
+                                              "camera.fit=true"],
+                                    "hypercomplex Mandelbrot set h^2 + c (the product M x M in the "
+                                    "split coordinates), max_iter 14"),
+    "julia_theta_0": (J_CAM + ["fractal.c=-0.2,0.8,0,0"], "quaternion Julia set, c = -0.2+0.8i, theta 0"),
+    "julia_theta_45": (J_CAM + ["fractal.c=-0.2,0.8,0,0", "fractal.theta=45"], "the same map rotated by 45 degrees"),
+    "julia_theta_90": (J_CAM + ["fractal.c=-0.2,0.8,0,0", "fractal.theta=90"],
+                       "rotated by 90 degrees: the complex Julia set turned a quarter, its quaternion "
+                       "superset cut by another 3D space (seed 001 Fig. 1)"),
+}
+ERROR = {
+    "mandel_q_sqr": (MANDEL + M_CAM + ["fractal.max_iter=12"], "quaternion Mandelbrot q^2 + c, max_iter 12"),
+    "mandel_q_cube": (MANDEL + ["fractal.function=cube", "fractal.max_iter=10", "camera.position=0.2,1.7,-2.6,0"],
+                      "quaternion Mandelbrot q^3 + c, max_iter 10"),
+    "mandel_hc_sqr": (MANDEL + M_CAM + ["fractal.algebra=hypercomplex", "fractal.max_iter=10",
+                                        "camera.position=-0.5,2.2,-3.4,0"],
+                      "hypercomplex Mandelbrot h^2 + c, max_iter 10"),
+    "julia_theta_90": (["fractal.c=-0.2,0.8,0,0", "fractal.theta=90", "fractal.max_iter=12"],
+                       "quaternion Julia, c = -0.2+0.8i, theta 90, max_iter 12"),
+}
+FIXED = [(250, 4), (1000, 4), (1000, 10)]
+DE = [(1e-3, 4), (1e-4, 4), (1e-4, 10)]
+
+
+def settings(scene: Scene) -> list[tuple[str, list[str]]]:
+    out = [(f"fixed z={z} post={p}", ["march.method=fixed", f"march.z_resolution={z}", f"march.post_steps={p}"])
+           for z, p in FIXED]
+    if has_distance_estimate(scene.fractal):
+        out += [(f"de eps={e:g} post={p}", ["march.method=de", f"march.epsilon={e}", f"march.post_steps={p}"])
+                for e, p in DE]
+    return out
+
+
+def fmt(v) -> str:
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.3g}"
+    return str(v)
+
+
+def sheet(out: Path, names: list[str], cell=(320, 240), cols=3) -> None:
+    """The pictures side by side, in GALLERY's order, on a dark ground: <out>/sheet.png."""
+    from PIL import Image
+    rows = -(-len(names) // cols)
+    img = Image.new("RGB", (cell[0] * cols, cell[1] * rows), (24, 24, 28))
+    for i, name in enumerate(names):
+        im = Image.open(out / f"{name}.png").convert("RGBA").resize(cell, Image.LANCZOS)
+        img.paste(im, (cell[0] * (i % cols), cell[1] * (i // cols)), im)
+    img.save(out / "sheet.png")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="64x48", help="error table image size")
+    ap.add_argument("--picture", default="480x360", help="gallery picture size")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--skip-gallery", action="store_true")
+    ap.add_argument("--skip-error", action="store_true")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "kinds")
+    a = ap.parse_args(argv)
+    warnings.simplefilter("ignore", RuntimeWarning)
+    dev = select_device(None)
+    a.out.mkdir(parents=True, exist_ok=True)
+    t_all = time.perf_counter()
+    if not a.skip_gallery:
+        pw, ph = (int(x) for x in a.picture.split("x"))
+        for name, (over, desc) in GALLERY.items():
+            s = Scene.default().with_overrides(over + [f"image.width={pw}", f"image.height={ph}"])
+            r = render(s, device=dev)
+            r.save(a.out / f"{name}.png")
+            print(f"{name}: {r.seconds:.2f} s, {100 * r.hit_fraction:.1f} % hit, guards {r.guards} - {desc}",
+                  flush=True)
+        sheet(a.out, list(GALLERY))
+    if a.skip_error:
+        return 0
+    w, h = (int(x) for x in a.size.split("x"))
+    rows, truths = [], {}
+    for name, (over, desc) in ERROR.items():
+        base = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",
+                                                      "normals.method=jacobian", "camera.fit=false"])
+        tr = truth.ground_truth(base, z_start=4000, max_z=128000)
+        truths[name] = (tr, desc)
+        print(f"[{time.perf_counter() - t_all:6.0f} s] {name}: truth {tr.kind} in {tr.seconds:.1f} s, "
+              f"hit {tr.hit.mean():.3f}, converged {tr.record.get('converged', '')}", flush=True)
+        for label, march in settings(base):
+            scene = base.with_overrides(march)
+            res, ks, rs, _ = timed(scene, dev, a.repeats, 1.0)
+            row = dict(scene=name, setting=label, kernel_s=ks, render_s=rs)
+            row.update(measure(scene, res, tr, {"jacobian": res.normal.astype(np.float64)}))
+            rows.append(row)
+            print(f"    {label:>22} kernel {ks:8.4f} s  sil {row['silhouette_err']:.4f}  "
+                  f"p50 {row['depth_err_median']:.3g}  p99 {row['depth_err_p99']:.3g}  "
+                  f"bracket p99 {row['bracket_p99']:.3g}  normal {row['normal_err_jacobian_median']:.2g} deg",
+                  flush=True)
+    cols = ["scene", "setting", "kernel_s", "render_s", "hit_fraction", "silhouette_err", "depth_err_median",
+            "depth_err_p99", "depth_err_max", "bracket_p99", "stepped_over", "normal_err_jacobian_median"]
+    with open(a.out / "kinds_error.csv", "w", newline="") as f:
+        wr = csv.writer(f)
+        wr.writerow(cols)
+        for r in rows:
+            wr.writerow([fmt(r[c]) for c in cols])
+    L = [f"\n## {utc_now()}, {dev.name.strip()}, commit {git_commit()}, {w}x{h}, "
+         f"{time.perf_counter() - t_all:.0f} s\n",
+         "| scene | truth | truth hit | truth s |", "|---|---|---|---|"]
+    for name, (tr, desc) in truths.items():
+        L.append(f"| {name}: {desc} | {tr.kind}, converged {tr.record.get('converged', '')} | "
+                 f"{tr.hit.mean():.3f} | {tr.seconds:.1f} |")
+    L += ["", "| scene | setting | kernels s | silhouette err | depth err p50 | p99 | max | bracket p99 | "
+              "stepped over | normal err (deg, median) |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        L.append(f"| {r['scene']} | {r['setting']} | {r['kernel_s']:.4f} | {r['silhouette_err']:.4f} | "
+                 f"{fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | {fmt(r['depth_err_max'])} | "
+                 f"{fmt(r['bracket_p99'])} | {r['stepped_over']} | {fmt(r['normal_err_jacobian_median'])} |")
+    append_run(a.out / "kinds_error.md",
+               "# Depth error against run time: Mandelbrot sets and rotated Julia sets\n\nWritten by "
+               "`python benchmarks/kinds_gallery.py` (see its docstring for the truth and the metrics).\n",
+               "\n".join(L) + "\n")
+    print(f"wrote {a.out} in {time.perf_counter() - t_all:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,134 @@
+/* kind/mandelbrot.cl (-D KIND_MANDELBROT; built only for fractal.kind = "mandelbrot"): the
+ * Mandelbrot set of the algebra's q -> f(q) + c, the 4D set of parameters c whose orbit of
+ * the critical point 0 stays bounded (seed 001_01b4b6353b5280e3.txt §2.1: "only one critical
+ * point ... always 0"; seed 002_6b6c8e6b1cd19649.txt ray traces these with the same
+ * primitive as the Julia sets).  The point p is c (in the algebra's coordinates ALG_IN(p),
+ * per lane), q_0 = 0 and q_1 = f(0) + c = c exactly, so the orbit starts there: p is inside
+ * when |q_n| <= bailout for n = 1 .. max_iter (q_0 = 0 always is).  fractal.c is unused.
+ *
+ * Compiled after iterate.cl (its de_value, DE_GROW, JULIA_DF2): the set test, level function
+ * and distance estimate below take over the names julia_inside, julia_level,
+ * julia_distance_formula and julia_distance for every later piece (march, refine, gradient
+ * normals, shadows); normals/jacobian.cl has its own -D KIND_MANDELBROT branch. */
+#ifndef FUNC_POWER
+#error "a Mandelbrot set takes sqr and cube only (critical point 0; scene._check_fractal)"
+#endif
+
+/* f(q) + c with c a lane value (the point), f the algebra's own (julia_f at c = 0) */
+inline quat mandel_f(quat q, quat c) { return QADD(julia_f(q, (real4)(0)), c); }
+
+inline lmask mandel_inside(quat p, julia_params jp)
+{
+    quat c = ALG_IN(p);
+    quat q = c;
+    lmask live = ALG_NORM2(q) <= jp.bailout2;
+    int n = 1;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        q = QSEL(q, mandel_f(q, c), live);
+        live = ALG_NORM2(q) <= jp.bailout2;
+    }
+    COUNT_ITER(jp, n - 1);
+    return live;
+}
+
+/* F = |q_N|^2 / bailout^2 - 1, extrapolated past an escape as in iterate.cl julia_level */
+inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
+{
+    quat c = ALG_IN(p);
+    quat q = c;
+    lreal m2 = ALG_NORM2(q);
+    lmask live = m2 <= jp.bailout2;
+    lmask steps = 1;                /* q_1 = c: one iteration done */
+    int n = 1;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        q = QSEL(q, mandel_f(q, c), live);
+        m2 = ALG_NORM2(q);
+        steps = L_SEL(steps, steps + 1, live);
+        live = m2 <= jp.bailout2;
+    }
+    COUNT_ITER(jp, n - 1);
+    *inside = m2 <= jp.bailout2;
+    lmask k = jp.max_iter - steps;
+#if JULIA_GROWTH == 2
+    lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
+#else
+    lreal e = log(m2 / jp.bailout2) * pow((lreal)JULIA_GROWTH, convert_lreal(min(k, 60)));
+#endif
+    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
+    return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
+}
+
+#ifdef ALG_HAS_DE
+/* The distance estimate of seed 001 §3.1 eq. 8, d = |q_n| ln|q_n| / (2 |q_n'|), with the
+ * derivative taken with respect to c:  q'_1 = 1,  q'_{n+1} = f'(q_n) q'_n + 1.  Its norm is
+ * carried as the bound |q'_{n+1}| <= |f'(q_n)| |q'_n| + 1 (|f'(q)| = sqrt(JULIA_DF2(|q|^2)),
+ * the operator norm of q h + h q is at most 2 |q|): a larger |q'|, a smaller - safer - d.
+ * dr = |q'| is kept as mantissa * 2^e (DE_GROW), so the + 1 is added as 2^-e. */
+#define MANDEL_GROW(dr, e, factor, live) do { \
+        DE_GROW(dr, e, factor, live); \
+        dr = L_SEL(dr, dr + ldexp((lreal)1, -(e)), live); \
+    } while (0)
+
+#ifndef ALG_SPLIT
+inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
+{
+    quat c = ALG_IN(p);
+    quat q = c;
+    lreal m2 = ALG_NORM2(q);
+    lreal dr = (lreal)1;
+    lmask e = 0;                    /* dr is really dr * 2^e */
+    lmask live = m2 <= jp.bailout2;
+    int n = 1;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        MANDEL_GROW(dr, e, sqrt(JULIA_DF2(m2)), live);
+        q = QSEL(q, mandel_f(q, c), live);
+        m2 = ALG_NORM2(q);
+        live = m2 <= jp.bailout2;
+    }
+    COUNT_ITER(jp, n - 1);
+    *escaped = m2 > jp.bailout2;
+    return de_value(m2, dr * dr, e + e);
+}
+#else
+/* The split algebra (algebra/hypercomplex.cl): c = c_a e1 + c_b e2 and the set is the product
+ * M_a x M_b of two complex Mandelbrot sets, so, as for its Julia sets (iterate.cl),
+ * d = sqrt(d_a^2 + d_b^2) / sqrt(2), each d_a the complex estimate above where the component
+ * has provably escaped (|a_n| > 1 + |c_a|), else 0. */
+inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
+{
+    quat c = ALG_IN(p);
+    quat q = c;
+    lreal m2 = ALG_NORM2(q);
+    lreal da = (lreal)1, db = (lreal)1;
+    lmask ea = 0, eb = 0;
+    lmask live = m2 <= jp.bailout2;
+    int n = 1;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        MANDEL_GROW(da, ea, sqrt(JULIA_DF2(q.x * q.x + q.y * q.y)), live);
+        MANDEL_GROW(db, eb, sqrt(JULIA_DF2(q.z * q.z + q.w * q.w)), live);
+        q = QSEL(q, mandel_f(q, c), live);
+        m2 = ALG_NORM2(q);
+        live = m2 <= jp.bailout2;
+    }
+    COUNT_ITER(jp, n - 1);
+    *escaped = m2 > jp.bailout2;
+    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
+    lreal ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
+    lreal d_a = L_SEL((lreal)0, de_value(ma, da * da, ea + ea), ma > ra * ra);
+    lreal d_b = L_SEL((lreal)0, de_value(mb, db * db, eb + eb), mb > rb * rb);
+    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+}
+#endif
+
+inline lreal mandel_distance(quat p, julia_params jp)
+{
+    lmask escaped;
+    lreal d = mandel_distance_formula(p, jp, &escaped);
+    return L_SEL((lreal)0, d, escaped);
+}
+#define julia_distance_formula mandel_distance_formula
+#define julia_distance mandel_distance
+#endif  /* ALG_HAS_DE */
+
+#define julia_inside mandel_inside
+#define julia_level mandel_level

@@ -1,0 +1,155 @@
+"""Rendering on a Dask cluster (pyjulia4d/distributed.py): a worker killed mid-animation,
+tiles equal to the whole render, programs built once per worker, the render command's
+--workers."""
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from pyjulia4d import cli, render
+from pyjulia4d.animation import animate, frame_path, read_header
+from pyjulia4d.distributed import render_many, render_tiled
+from pyjulia4d.keyframes import from_table
+from pyjulia4d.scene import Scene
+
+distributed = pytest.importorskip("distributed")
+
+from harness import device  # noqa: E402
+
+OUTPUTS = ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A local cluster of 2 worker processes, one thread each (as --workers 2 starts)."""
+    lc = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, silence_logs=logging.ERROR)
+    client = distributed.Client(lc, set_as_default=False)
+    try:
+        yield lc, client
+    finally:
+        client.close()
+        lc.close()
+
+
+def _morph(frames: int, w: int = 64, h: int = 48):
+    return from_table({"fractal": {"max_iter": 8}, "camera": {"position": [1.8, 1.6, -2.2, 0.0]},
+                       "image": {"width": w, "height": h},
+                       "animation": {"frames": frames, "interpolation": "linear"},
+                       "keyframe": [{"frame": 0, "fractal": {"c": [0.0, 0.0, 0.0, 0.0]}},
+                                    {"frame": frames - 1, "fractal": {"c": [-0.803762, -0.40615, 0.0, 0.0]}}]})
+
+
+def _pixels(path: Path) -> np.ndarray:
+    with Image.open(path) as im:
+        return np.asarray(im)
+
+
+def test_a_worker_killed_mid_animation_loses_no_frame(cluster, tmp_path):
+    """SIGKILL the worker process that is rendering while frames are coming back: the
+    scheduler hands its frames to the other worker (and the nanny restarts it); every frame
+    is written once, each equal bit for bit to a single-process render."""
+    lc, client = cluster
+    n = 24
+    anim = _morph(n, 96, 72)
+    pids = client.run(os.getpid)  # worker address -> pid
+    written: list[int] = []
+    killed: dict = {}
+
+    def on_written(frame: int, path: Path) -> None:
+        written.append(frame)
+        if len(written) == 2 and not killed:
+            busy = {a: len(ts) for a, ts in client.processing().items() if ts}
+            assert busy, "no worker was rendering at the kill"
+            addr = max(busy, key=busy.get)
+            killed.update(addr=addr, pid=pids[addr], busy=busy[addr])
+            os.kill(pids[addr], signal.SIGKILL)
+
+    s = animate(anim, str(tmp_path / "c" / "m_##.png"), scheduler=lc.scheduler_address,
+                on_written=on_written)
+    assert killed and killed["busy"] >= 1
+    assert sorted(written) == list(range(n)) and len(written) == n  # each exactly once
+    assert sorted(s.rendered) == list(range(n))
+    # the scheduler saw the worker go: its address is gone from the cluster
+    client.wait_for_workers(2, timeout=60)
+    assert killed["addr"] not in client.scheduler_info()["workers"]
+    single = animate(anim, str(tmp_path / "one" / "m_##.png"), workers=0)
+    assert sorted(single.rendered) == list(range(n))
+    for k in range(n):
+        a, b = frame_path(str(tmp_path / "c" / "m_##.png"), k), frame_path(str(tmp_path / "one" / "m_##.png"), k)
+        assert np.array_equal(_pixels(a), _pixels(b)), k
+        assert read_header(a)["pyjulia4d.scene"] == read_header(b)["pyjulia4d.scene"]
+
+
+def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
+
+
+@pytest.mark.parametrize("over", [
+    [],
+    ["normals.method=zbuffer"],                           # a one-pixel halo across tiles
+    ["image.samples=2", "camera.fit=true"],               # antialiasing; the fit resolved once
+])
+def test_tiles_on_two_workers_equal_the_whole_render(cluster, over):
+    _, client = cluster
+    scene = Scene.from_dict({"camera": {"position": [1.8, 1.6, -2.2, 0.0]}},
+                            ["image.width=90", "image.height=70"] + over)
+    whole = render(scene, device=device())
+    tiled, fitted = render_tiled(client, scene, tile=32)
+    assert "9 tiles on 2 workers" in tiled.device_name
+    for name in OUTPUTS:
+        assert _same(getattr(whole, name), getattr(tiled, name)), name
+    assert whole.counts == tiled.counts and whole.guards == tiled.guards
+    assert fitted.camera.fit is False
+    if "camera.fit=true" in over:
+        assert fitted.camera.position != scene.camera.position
+
+
+def test_each_worker_builds_its_programs_once(cluster):
+    """Units after a worker's first build nothing: the OpenCL programs stay built in the
+    long-lived worker process (build.program's cache), frame after frame."""
+    _, client = cluster
+    client.restart()  # fresh worker processes: nothing built yet
+    scene = Scene.from_dict({"camera": {"position": [1.8, 1.6, -2.2, 0.0]}},
+                            ["image.width=48", "image.height=36", "shading.ao=0.3"])
+    infos = []
+    units = [(k, scene.replace(**{"fractal.c": [-0.2, 0.8 - 0.01 * k, 0.0, 0.0]}), {}) for k in range(8)]
+    render_many(client, units, lambda tag, result, info: infos.append((tag, info)))
+    by_pid: dict[int, list] = {}
+    for tag, info in sorted(infos):
+        by_pid.setdefault(info.pid, []).append(info.programs_built)
+    assert len(by_pid) == 2, by_pid  # both workers had frames
+    for built in by_pid.values():
+        assert built[0] > 0 and built[1:] == [0] * (len(built) - 1), by_pid
+
+
+def test_render_command_with_workers_writes_the_same_image(tmp_path, capsys):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    common = ["render", "--width", "80", "--height", "60", "--set", "camera.position=1.8,1.6,-2.2,0"]
+    assert cli.main(common + ["-o", str(a)]) == 0
+    assert cli.main(common + ["-o", str(b), "--workers", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "(1 tile on 1 worker)" in out  # 80x60: one tile of the plan
+    assert np.array_equal(_pixels(a), _pixels(b))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]
+
+
+@pytest.mark.parametrize("args,expected", [
+    (["--workers", "x"], "--workers: expected a whole number of workers, got 'x'"),
+    (["--workers", "1", "--scheduler", "tcp://127.0.0.1:1"], "--workers: give --workers"),
+    (["--scheduler", "nowhere"], "--scheduler: expected an address such as tcp://HOST:8786"),
+])
+def test_render_cluster_options_bad_input(tmp_path, capsys, args, expected):
+    rc = cli.main(["render", "-o", str(tmp_path / "x.png"), "--width", "8", "--height", "6"] + args)
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and expected in err, err
+    assert list(tmp_path.iterdir()) == []
