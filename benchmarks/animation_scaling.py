@@ -3,7 +3,8 @@ workers, one large frame whole against in tiles, and the cost of a work unit.
 
 The animation is examples/c_morph.toml at --size; each configuration first renders one
 warm-up frame per worker (the OpenCL build), then --frames frames, timed from the client:
-submitted, rendered, sent back, written as PNG (what ``animate`` does).  The overhead per
+submitted, rendered and encoded as PNG by the worker, sent back, written (what ``animate``
+does).  The overhead per
 unit is the client's wall time per frame less the worker's own time per frame (render and
 all), with one worker, so nothing overlaps.  Writes benchmarks/results/animation_scaling.md
 (a section per run: device, date, commit).
@@ -31,15 +32,18 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 def _frames_run(client, anim, frames, out: Path):
     """(wall seconds, worker seconds summed) of rendering and writing ``frames``."""
     from pyjulia4d.distributed import render_many
-    from pyjulia4d.output import write_image
+    from pyjulia4d.output import _atomic
 
     worker = []
 
-    def write(n, result, info):
-        write_image(out / f"f_{n:04d}.png", result, {"pyjulia4d.scene": anim.scene(n).to_toml()})
+    def write(n, encoded, info):
+        with _atomic(out / f"f_{n:04d}.png") as tmp:
+            tmp.write_bytes(encoded.data)
         worker.append(info.seconds)
 
-    units = [(n, anim.scene(n), {"outputs": ("color", "alpha")}) for n in frames]
+    units = [(n, anim.scene(n), {"outputs": ("color", "alpha"),
+                                 "encode": (".png", {"pyjulia4d.scene": anim.scene(n).to_toml()})})
+             for n in frames]
     t = time.perf_counter()
     render_many(client, units, write)
     return time.perf_counter() - t, sum(worker)
@@ -84,7 +88,7 @@ def main(argv=None) -> int:
         _frames_run(None, anim, frames[:1], tmp)
         wall, work = min(_frames_run(None, anim, frames, tmp) for _ in range(2))
         rows.append(("in this process", 0.0, len(frames) / wall, wall / len(frames), work / len(frames)))
-        # PNG write alone (the client's share of every frame)
+        # PNG encoding and writing alone (a worker's share of every frame besides the render)
         r = render(anim.scene(frames[-1]), device=dev, outputs=("color", "alpha"))
         t = time.perf_counter()
         for k in range(5):
@@ -131,7 +135,7 @@ def main(argv=None) -> int:
                f"at {args.size}, {len(frames)} frames timed (the faster of 2 runs) after one warm-up frame per worker\n\n"
                + "\n".join(table) + "\n\n"
                f"overhead per frame unit (1 worker: client wall less worker time): {overhead * 1e3:.1f} ms; "
-               f"PNG write on the client: {write_s * 1e3:.1f} ms per frame\n\n"
+               f"PNG encoding and write (output.write_image): {write_s * 1e3:.1f} ms per frame\n\n"
                + "\n".join(big_table) + "\n")
     out = Path(args.out)
     append_run(out / "animation_scaling.md", "# Animation and distributed rendering: frames per second\n\n"

@@ -1,6 +1,8 @@
 """Gallery pictures and depth error against run time for the sets beside the Julia set:
-quaternion and hypercomplex Mandelbrot sets (fractal.kind = "mandelbrot") and rotated
-quaternion Julia sets (fractal.theta, seed 001 §2.3).
+quaternion and hypercomplex Mandelbrot sets (fractal.kind = "mandelbrot"), rotated
+quaternion Julia sets (fractal.theta, seed 001 §2.3), Julia set stacks (fractal.kind =
+"julia_stack", seed 001 §5.1; its "de" rows are the empirical estimate) and the cubic
+connectedness locus (fractal.kind = "cubic_locus", seed 001 §5.2; fixed scan only).
 
 Pictures: each scene of GALLERY rendered from the CLI's code path (pyjulia4d.render) at
 --picture size, written to benchmarks/results/kinds/<name>.png.
@@ -47,6 +49,8 @@ MANDEL = ["fractal.kind=mandelbrot"]
 # camera looking at the Mandelbrot sets' centre (-0.5, 0, 0, 0) from above and in front
 M_CAM = ["camera.position=-0.5,1.6,-2.9,0", "camera.target=-0.5,0,0,0"]
 J_CAM = ["camera.position=2.3,2.05,-2.8,0", "camera.target=0,0,0,0"]
+STACK = ["fractal.kind=julia_stack"]
+LOCUS = ["fractal.kind=cubic_locus"]
 GALLERY = {
     "mandelbrot_quaternion_sqr": (MANDEL + ["camera.position=-1.3,1.5,-2.6,0", "camera.target=-0.5,0,0,0",
                                             "fractal.max_iter=20", "march.epsilon=2e-4",
@@ -68,6 +72,22 @@ GALLERY = {
     "julia_theta_90": (J_CAM + ["fractal.c=-0.2,0.8,0,0", "fractal.theta=90"],
                        "rotated by 90 degrees: the complex Julia set turned a quarter, its quaternion "
                        "superset cut by another 3D space (seed 001 Fig. 1)"),
+    "julia_stack": (STACK + ["fractal.max_iter=20", "camera.position=2.0,2.4,-3.2,0", "image.samples=4"],
+                    "Julia set stack (the default c-line): z^2 + c(u), c from -1 (the basilica, the cap "
+                    "in front) to -0.1+0.75i (near the rabbit, at the back), max_iter 20"),
+    "julia_stack_real": (STACK + ["fractal.c_from=0.25,0", "fractal.c_to=-1.3,0", "fractal.max_iter=20",
+                                  "camera.position=2.2,2.6,-3.0,0", "image.samples=4"],
+                         "Julia set stack along the real axis (seed 001 Fig. 4, Im c = 0): c from 1/4 "
+                         "(the cauliflower, in front) to -1.3, max_iter 20"),
+    "cubic_locus_plus": (LOCUS + ["fractal.max_iter=8", "camera.fit=true", "image.samples=4"],
+                         "cubic connectedness locus C+ (the orbit of +a bounded under z^3 - 3a^2 z + b), "
+                         "the 3D slice Im b = 0 (Re a, Im a, Re b), within |(a, b)| <= 2, max_iter 8"),
+    "cubic_locus_minus": (LOCUS + ["fractal.component=minus", "fractal.max_iter=8", "camera.fit=true",
+                                   "image.samples=4"],
+                          "C- (the orbit of -a), the same slice: C+ mirrored in a"),
+    "cubic_locus_im_a": (LOCUS + ["fractal.max_iter=8", "slice.normal=0,1,0,0", "camera.position=-2.7,3.2,-4.0,0",
+                                  "image.samples=4"],
+                         "C+, the 3D slice Im a = 0 (Re a, Re b, Im b), max_iter 8"),
 }
 ERROR = {
     "mandel_q_sqr": (MANDEL + M_CAM + ["fractal.max_iter=12"], "quaternion Mandelbrot q^2 + c, max_iter 12"),
@@ -78,15 +98,22 @@ ERROR = {
                       "hypercomplex Mandelbrot h^2 + c, max_iter 10"),
     "julia_theta_90": (["fractal.c=-0.2,0.8,0,0", "fractal.theta=90", "fractal.max_iter=12"],
                        "quaternion Julia, c = -0.2+0.8i, theta 90, max_iter 12"),
+    "stack": (STACK + ["fractal.max_iter=12", "camera.position=2.0,2.4,-3.2,0"],
+              "Julia set stack, c from -1 to -0.1+0.75i (the defaults), max_iter 12; de: the empirical estimate"),
+    "locus_plus": (LOCUS + ["fractal.max_iter=8", "camera.position=2.4,2.2,-3.0,0"],
+                   "cubic locus C+, slice Im b = 0, max_iter 8 (fixed scan only: no estimate is known)"),
 }
 FIXED = [(250, 4), (1000, 4), (1000, 10)]
 DE = [(1e-3, 4), (1e-4, 4), (1e-4, 10)]
 
 
 def settings(scene: Scene) -> list[tuple[str, list[str]]]:
+    # the locus has no estimate: a finer scan shows what the fixed scan needs for its thin tubes
+    fixed = FIXED + [(4000, 10)] if scene.fractal.kind == "cubic_locus" else FIXED
     out = [(f"fixed z={z} post={p}", ["march.method=fixed", f"march.z_resolution={z}", f"march.post_steps={p}"])
-           for z, p in FIXED]
-    if has_distance_estimate(scene.fractal):
+           for z, p in fixed]
+    # the stack's "de" is its empirical estimate (kernels/kind/julia_stack.cl), measured here
+    if has_distance_estimate(scene.fractal) or scene.fractal.kind == "julia_stack":
         out += [(f"de eps={e:g} post={p}", ["march.method=de", f"march.epsilon={e}", f"march.post_steps={p}"])
                 for e, p in DE]
     return out

@@ -3,8 +3,10 @@
 Seed 000_1dc675fe64448cc1.txt §6: morphing c, flying the camera, moving it along w.
 Frames are whole work units on a Dask cluster or in this process (distributed.py); the
 results come back here, and only this process writes files, each frame once, atomically
-(output.write_image), with the frame number, the frame's resolved scene and its render
-report in the header.  A run killed at any moment and started again renders only the
+(output.py's temp file and rename); each frame's file - with the frame number, the
+frame's resolved scene and its render report in its header - is encoded by the worker that
+rendered it (output.write_image), so that the client's encoding does not bound a farm.
+A run killed at any moment and started again renders only the
 frames that are missing or whose recorded scene or channels differ; temporary files a
 killed run left beside the frames are removed first.
 """
@@ -22,7 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from .keyframes import Animation, parse_frames
-from .output import _NAME_MAX, OutputError, _limit, _shown, _temp_affixes, check_output_path, write_image
+from .output import _NAME_MAX, OutputError, _atomic, _limit, _shown, _temp_affixes, check_output_path
 from .scene import SceneError
 
 HEADER_SCENE = "pyjulia4d.scene"
@@ -236,10 +238,12 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
     bar = None
 
     def write(n: int, result: Any, info: Any) -> None:
-        s = anim.scene(n)
-        report, _ = result.report()
-        header = {HEADER_SCENE: s.to_toml(), HEADER_FRAME: str(n), HEADER_OUTPUTS: tag, **report}
-        write_image(paths[n], result, header)
+        """File a frame that came back: its bytes, encoded by the worker (distributed.EncodedImage)."""
+        try:
+            with _atomic(paths[n]) as tmp:
+                tmp.write_bytes(result.data)
+        except OSError as e:
+            raise OutputError(f"{paths[n]}: cannot write: {e.strerror or e}") from e
         summary.rendered.append(n)
         summary.workers.add((info.worker, info.pid))
         summary.devices.add(info.device)
@@ -257,7 +261,9 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
             if is_current(paths[n], a.scene(n).to_toml(), tag):
                 summary.current.append(n)
             else:
-                out.append((n, a.scene(n), {"outputs": outputs}))
+                s = a.scene(n)
+                header = {HEADER_SCENE: s.to_toml(), HEADER_FRAME: str(n), HEADER_OUTPUTS: tag}
+                out.append((n, s, {"outputs": outputs, "encode": (paths[n].suffix.lower(), header)}))
         return out
 
     # without camera.fit the frames on disk are known before any cluster starts
@@ -331,22 +337,13 @@ def closing_line(summary: Summary, pattern: str, video: str | None, fps: float) 
 def run_cli(args: Any) -> int:
     """``python -m pyjulia4d animate`` (cli.py parses; errors are raised as ValueError)."""
     from . import keyframes
-    from .scene import override_key
+    from .cli import _outputs, _size_overrides
 
-    overrides = list(args.overrides)
-    for flag, dotted in (("--width", "image.width"), ("--height", "image.height")):
-        value = getattr(args, flag[2:])
-        if value is None:
-            continue
-        if any(override_key(o) == dotted for o in overrides):
-            raise SceneError(dotted, f"given twice, by {flag} and by --set {dotted}; use one")
-        overrides.append(f"{dotted}={value}")
+    overrides = _size_overrides(args)
     anim = keyframes.load(args.scene, overrides)
     frames = parse_frames(args.frames, anim.frames)
     pattern = args.output if args.output is not None else Path(args.scene).stem + "_####.png"
     check_pattern(pattern)
-    from .cli import _outputs
-
     outputs = _outputs(args.channels, Path(pattern.replace("#", "0")))
     from .distributed import check_workers
 

@@ -46,7 +46,8 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
 
 def fractal_defines(scene: Scene) -> tuple[str, ...]:
     """pwr's complex exponent, compiled in (function/pwr.cl); the rotation's cos and sin
-    (kind/rotate.cl); the kind's switch (KIND_MANDELBROT: normals/jacobian.cl)."""
+    (kind/rotate.cl); the kind's switch (KIND_MANDELBROT: normals/jacobian.cl); a stack's
+    c-line and its empirical estimate's switch (kind/julia_stack.cl)."""
     f = scene.fractal
     out = ()
     if f.function == "pwr":
@@ -56,6 +57,14 @@ def fractal_defines(scene: Scene) -> tuple[str, ...]:
         out += (f"ROTATE_COS={math.cos(t)!r}", f"ROTATE_SIN={math.sin(t)!r}")
     if f.kind != "julia":
         out += (f"KIND_{f.kind.upper()}",)
+    if f.kind == "julia_stack":   # c(u) = c_mid + u c_half (kind/julia_stack.cl), in float64 here
+        (r0, i0), (r1, i1) = f.c_from, f.c_to
+        out += (f"STACK_CM_RE={(r0 + r1) / 2!r}", f"STACK_CM_IM={(i0 + i1) / 2!r}",
+                f"STACK_CH_RE={(r1 - r0) / 2!r}", f"STACK_CH_IM={(i1 - i0) / 2!r}")
+        if scene.march.method == "de":   # the empirical estimate, on request only
+            out += ("STACK_DE",)
+    if f.kind == "cubic_locus":   # the critical point +a or -a, the ball (kind/cubic_locus.cl)
+        out += (f"LOCUS_SIGN={1 if f.component == 'plus' else -1}", f"LOCUS_R2={f.locus_radius ** 2!r}")
     return out
 
 
@@ -92,6 +101,8 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
         defines.append("FOG")
     if not isinstance(scene.shading.light, str):
         defines.append("LIGHT_POINT")
+    if scene.shading.lights:   # shading.lights: compiled to their count
+        defines.append(f"EXTRA_LIGHTS={len(scene.shading.lights)}")
     return KernelConfig(tuple(pieces), tuple(defines))
 
 
@@ -101,8 +112,10 @@ def light_defines(scene: Scene) -> tuple[str, ...]:
     out = []
     # the light at the eye lights every point the eye sees: its shadows are invisible, so
     # none are traced; soft shadows need the estimate (shade/light.cl: hard without one)
-    if sh.shadow != "none" and not isinstance(sh.light, str):
+    if sh.shadow != "none" and (not isinstance(sh.light, str) or sh.lights):
         out.append(f"SHADOW_{sh.shadow.upper()}")
+    if sh.shadow != "none" and sh.lights:
+        out.append("EXTRA_SHADOWS")
     if sh.ao > 0:
         out.append("AO")
     if sh.coloring != "flat":

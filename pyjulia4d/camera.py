@@ -107,6 +107,25 @@ def light_position(scene: Scene) -> np.ndarray | None:
     return to_world(scene, scene.shading.light)
 
 
+def extra_lights(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """shading.lights for the kernels (shade/shade.cl, shade/light.cl): (geo, rgb), geo[j]
+    the world position, or the unit world direction towards a distant light; rgb[j] its
+    colour times intensity, and w = 1 for a distant light.  One inert row when there are none
+    (a buffer is never empty)."""
+    lights = scene.shading.lights
+    geo = np.zeros((max(1, len(lights)), 4))
+    rgb = np.zeros((max(1, len(lights)), 4))
+    for j, light in enumerate(lights):
+        if light.position is not None:
+            geo[j] = to_world(scene, light.position)
+        else:
+            d = to_world(scene, light.direction, direction=True)
+            geo[j] = d / np.linalg.norm(d)
+            rgb[j, 3] = 1.0
+        rgb[j, :3] = np.asarray(light.color) * light.intensity
+    return geo, rgb
+
+
 def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) -> float:
     """Radius of a 4-ball that provably holds every point with |q_n| <= bailout for
     n = 0..max_iter (the set the fixed scan finds), for q -> q^degree + c.
@@ -173,6 +192,19 @@ def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2) -> 
     return min(b, hi * (1.0 + 1e-9))
 
 
+def stack_radius(scene: Scene) -> float:
+    """Radius of a 4-ball about the origin that holds a Julia set stack (kernels/kind/
+    julia_stack.cl) in the hyperplane w = w0 the view keeps to (scene._check_stack): there
+    |z| <= bounding_radius(max |c(u)|) (|c(u)| <= the larger end point's: the segment is
+    convex), |u| <= 1 and w = w0, widened by 2^-20 so that a scan starts outside."""
+    f, cam, sl = scene.fractal, scene.camera, scene.slice
+    cmax = max(math.hypot(*f.c_from), math.hypot(*f.c_to))
+    rz = bounding_radius((cmax, 0.0, 0.0, 0.0), f.bailout, f.max_iter, 2)
+    w0 = float(to_world(scene, tuple(cam.position[:3]) + ((cam.position[3],) if len(cam.position) == 4
+                                                              else (0.0,)))[3])
+    return math.sqrt(rz * rz + 1.0 + w0 * w0) * (1.0 + 2.0 ** -20)
+
+
 def march_radius(scene: Scene) -> float:
     """Bounding radius for the march: the escape-time bound, plus 4 epsilon for the
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
@@ -180,6 +212,10 @@ def march_radius(scene: Scene) -> float:
     f = scene.fractal
     if f.kind == "mandelbrot":
         r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f))
+    elif f.kind == "julia_stack":
+        r = stack_radius(scene)
+    elif f.kind == "cubic_locus":   # kernels/kind/cubic_locus.cl: drawn within |p| <= locus_radius,
+        r = f.locus_radius * (1.0 + 2.0 ** -20)   # widened so that a scan starts outside
     else:
         r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
     if march_method(scene) == "de":

@@ -277,6 +277,38 @@ def _build() -> list[Case]:
              "the rotated map u (u^-1 q)^3 + u c (seed 001 §2.3) with u = i: cos 90 degrees is "
              "6e-17 in float64 and -4e-8 in float32, not 0",
              "agrees with float64 as the unrotated cube does", 0.02, 1e-4, "", cheap),
+        # Julia set stacks (fractal.kind = "julia_stack", kernels/kind/julia_stack.cl); "de" is the
+        # empirical estimate (seed 001 §5.1: none is proven)
+        Case("stack_through_boundary", ("fractal.kind=julia_stack", "fractal.c_from=0,0", "fractal.c_to=0.5,0",
+                                        "fractal.max_iter=40", "camera.position=1.6,1.9,-3.0,0"),
+             "a c-line through the Mandelbrot set's cusp c = 1/4: the sections implode from the "
+             "cauliflower (parabolic at 1/4, orbits creeping past the fixed point) to Cantor dust "
+             "(c > 1/4), thinner than any scan step beyond; 40 iterations near a parabolic point",
+             "no NaN in any output; terminates; the dust past 1/4 is what max_iter 40 leaves of it",
+             0.03, 1e-4, "", cheap),
+        Case("stack_zero_length", ("fractal.kind=julia_stack", "fractal.c_from=-0.12,0.75",
+                                   "fractal.c_to=-0.12,0.75", "fractal.max_iter=20",
+                                   "camera.position=2.0,2.4,-3.2,0"),
+             "c_from = c_to: c_half = 0, the stack a prism over one Julia set (the rabbit); the "
+             "derivative in u is exactly 0 on the sides",
+             "the sides' normals perpendicular to u, the caps' along it; no NaN; agrees with float64",
+             0.02, 1e-4, "", cheap),
+        # the cubic connectedness locus (fractal.kind = "cubic_locus", kernels/kind/cubic_locus.cl):
+        # the fixed scan only (no estimate is known)
+        Case("locus_a_zero_plus", ("fractal.kind=cubic_locus", "camera.position=0,0,-3,0", "camera.target=0,0,0,0",
+                                   "camera.up=0,1,0,0", "fractal.max_iter=30"),
+             "a = 0 along the view axis (odd image: the centre ray has a = 0 exactly): the critical "
+             "points +a and -a collide, z_0 = 0 exactly, f = z^3 + b (the degree-3 Mandelbrot set); "
+             "the derivative in a starts at 1 with z_0 = 0",
+             "no NaN, no normal fallback; terminates; agrees with float64", 0.03, 1e-4, "", (25, 19),
+             methods=("fixed",)),
+        Case("locus_a_zero_minus", ("fractal.kind=cubic_locus", "fractal.component=minus",
+                                    "camera.position=0,0,-3,0", "camera.target=0,0,0,0", "camera.up=0,1,0,0",
+                                    "fractal.max_iter=30"),
+             "C- seen along a = 0: the same set as C+ there (both critical points are 0), mirrored "
+             "(a -> -a) elsewhere",
+             "as locus_a_zero_plus; tests/test_stack_locus.py checks the mirror and the a = 0 section",
+             0.03, 1e-4, "", (25, 19), methods=("fixed",)),
     ]
     return cases
 

@@ -106,7 +106,8 @@ def select_device(spec: str | None) -> Any:
     return select(spec)
 
 
-def _render(args: argparse.Namespace) -> int:
+def _size_overrides(args: argparse.Namespace) -> list[str]:
+    """--set overrides with --width and --height added (render and animate)."""
     overrides = list(args.overrides)
     for flag, dotted in (("--width", "image.width"), ("--height", "image.height")):
         value = getattr(args, flag[2:])
@@ -115,6 +116,11 @@ def _render(args: argparse.Namespace) -> int:
         if any(override_key(o) == dotted for o in overrides):
             raise SceneError(dotted, f"given twice, by {flag} and by --set {dotted}; use one")
         overrides.append(f"{dotted}={value}")
+    return overrides
+
+
+def _render(args: argparse.Namespace) -> int:
+    overrides = _size_overrides(args)
     if args.scene is None:   # the built-in scene; framed (camera.fit) unless a position is set
         scene = Scene.from_dict({}, overrides)
         default_out = "julia.png"

@@ -18,10 +18,10 @@ import pyopencl as cl
 import pyopencl.array as cla
 from tqdm import tqdm
 
-from . import build, colormap
+from . import antialias, build, colormap
 from .devices import has_fp64, select_device
 from .lanes import lanes_for
-from .camera import clip_planes
+from .camera import clip_planes, extra_lights
 from .calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
 from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
 from .scene import Scene, SceneError, march_method
@@ -336,6 +336,8 @@ class TileRunner:
                 bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
             if plan.light_terms:
                 bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+                bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.program.defines
+                                              else 1, cl.cltypes.float4)
             stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
             self.slots.append((bufs, stage))
         fr = plan.frame
@@ -347,7 +349,7 @@ class TileRunner:
                             np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
         self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(plan.light),
                             _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
-                            np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
+                            _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
                             np.float32(sh.shininess))
         self.fog = (np.float32(sh.fog), np.float32(fog_start(plan.frame.position, plan.radius)))
         self.march_k = cl.Kernel(self.march_prg, "march")
@@ -367,6 +369,12 @@ class TileRunner:
         self.lut = cla.to_device(self.queue, lut.view(cl.cltypes.float4).ravel())
         self.n_lut = np.int32(len(lut))
         self.no_terms = cla.empty(self.queue, 1, cl.cltypes.float4)
+        # shading.lights (camera.extra_lights): positions or directions, colours; their
+        # visibility per pixel where shadows are traced (-D EXTRA_SHADOWS)
+        geo, rgb = extra_lights(sc)
+        self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in geo]))
+        self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in rgb]))
+        self.extra_shadows = "EXTRA_SHADOWS" in plan.program.defines
 
     def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
                 ) -> tuple[list[cl.Event], list[cl.Event]]:
@@ -393,13 +401,16 @@ class TileRunner:
         if plan.light_terms:
             kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
-                                  bufs["terms"].data,
+                                  self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
+                                  bufs["vis_extra"].data,
                                   lanes=plan.lanes))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
+            vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
             kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
                                   bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
-                                  self.n_lut, *self.fog, bufs["rgba"].data))
+                                  self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
+                                  vis_extra.data, bufs["rgba"].data))
         copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
         return kernels, copies
 
@@ -553,14 +564,50 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
 
     S = scene.image.samples
     aa = S > 1 and bool({"color", "alpha"} & keep)
+    adaptive = aa and scene.image.adaptive
+    IW, IH = scene.image.width, scene.image.height
+    centre_file = file
+    if adaptive:
+        # antialias.py: the centre's colour and alpha over the region and the one-pixel ring
+        # around it (flags of border pixels look outside the region), as the flags take them
+        ex0, ey0 = max(0, rx - 1), max(0, ry - 1)
+        ex1, ey1 = min(IW, rx + W + 1), min(IH, ry + H + 1)
+        centre_c = np.zeros((ey1 - ey0, ex1 - ex0, 3), np.float32) if plan.shades else None
+        centre_a = np.zeros((ey1 - ey0, ex1 - ex0), np.float32)
+
+        def note(t: Tile, got: dict[str, np.ndarray]) -> None:
+            rows, cols = t.dst()
+            dst = slice(rows.start - ey0, rows.stop - ey0), slice(cols.start - ex0, cols.stop - ex0)
+            c, a = _centre_values(got, t.own(), plan.shades)
+            if centre_c is not None:
+                centre_c[dst] = c
+            centre_a[dst] = a
+
+        def centre_file(t: Tile, got: dict[str, np.ndarray]) -> None:
+            file(t, got)
+            note(t, got)
+
     with _progress(W * H * (1 + S if aa else 1), progress) as bar:
         # the centre of each pixel: every output (depth, normal, position come from it)
-        _run_tiles(runner, plan.tiles, file, kernel_events, bar)
+        _run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
         if aa:
             # image.samples more passes of colour and alpha alone, each through its own
             # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
             cplan = dataclasses.replace(plan, outputs=frozenset({"color", "alpha", "bracket"}))
-            crunner = TileRunner(cplan, dev)
+            tiles, flags = cplan.tiles, None
+            if adaptive:
+                # image.adaptive: the samples run over the blocks holding a flagged pixel,
+                # and the flagged pixels alone take their mean (antialias.py)
+                ring = tuple(t for box in antialias.ring(plan.region, IW, IH)
+                             for t in make_tiles(IW, IH, max(box[2], box[3]), plan.halo, box))
+                if ring:
+                    _run_tiles(TileRunner(dataclasses.replace(cplan, tiles=ring), dev), ring, note,
+                               kernel_events, bar)
+                flags = antialias.flag_edges(centre_c, centre_a)[ry - ey0:ry - ey0 + H, rx - ex0:rx - ex0 + W]
+                tiles = antialias.block_tiles(flags, plan.region, IW, IH, plan.halo,
+                                              max(t.n for t in plan.tiles))
+                _set_total(bar, W * H + sum(t.w * t.h for t in ring) + S * sum(t.w * t.h for t in tiles))
+            crunner = TileRunner(dataclasses.replace(cplan, tiles=tiles), dev) if tiles else None
             acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
             acc_a = np.zeros((H, W), np.float32)
 
@@ -570,12 +617,18 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
                     acc_c[dst] += got["rgba"][own][..., :3]
                 acc_a[dst] += got["rgba"][own][..., 3]
 
-            for k in range(S):
-                _run_tiles(crunner, cplan.tiles, add, kernel_events, bar, sample=k, samples=S)
-            if acc_c is not None:
-                img["color"] = acc_c / S
-            if "alpha" in keep:
-                img["alpha"] = acc_a / S
+            for k in range(S if tiles else 0):
+                _run_tiles(crunner, tiles, add, kernel_events, bar, sample=k, samples=S)
+            if flags is None:
+                if acc_c is not None:
+                    img["color"] = acc_c / S
+                if "alpha" in keep:
+                    img["alpha"] = acc_a / S
+            else:
+                if acc_c is not None:
+                    img["color"] = np.where(flags[..., None], acc_c / S, img["color"])
+                if "alpha" in keep:
+                    img["alpha"] = np.where(flags, acc_a / S, img["alpha"])
 
     result = RenderResult(
         color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
@@ -585,6 +638,22 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         guards=guards, scene=scene, prediction=prediction)
     result.seconds = time.perf_counter() - t_start
     return result
+
+
+def _centre_values(got: dict[str, np.ndarray], own, shaded: bool):
+    """A tile's centre colour (None where the plan does not shade) and alpha over its own
+    pixels, as the render keeps them (``file``): what antialias.flag_edges compares."""
+    if shaded:
+        rgba = got["rgba"][own]
+        return rgba[..., :3], rgba[..., 3]
+    return None, (got["status"][own] == STATUS_HIT).astype(np.float32)
+
+
+def _set_total(bar, total: int) -> None:
+    """The progress bar's total, once the adaptive passes' work is known."""
+    bar.total = total
+    if hasattr(bar, "refresh"):
+        bar.refresh()
 
 
 class _LineProgress:

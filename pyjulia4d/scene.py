@@ -73,7 +73,8 @@ def escape_degree(f: "Fractal") -> int | None:
 @dataclass(frozen=True)
 class Fractal:
     """[fractal]: the Julia set of q -> f(q) + c in a 4D algebra, or (``kind``) its Mandelbrot
-    set; ``theta`` rotates the quaternion map (seed 001 §2.3)."""
+    set, a stack of complex Julia sets or the cubic connectedness locus (seed 001 §5); ``theta``
+    rotates the quaternion map (seed 001 §2.3)."""
 
     algebra: str = "quaternion"
     function: str = "sqr"
@@ -87,10 +88,20 @@ class Fractal:
     # the complex rotation g(q) = e^(i theta) q conjugating the map, in degrees (seed 001
     # §2.3; kernels/kind/rotate.cl); 0 compiles the rotation out
     theta: float = 0.0
+    # "julia_stack" (seed 001 §5.1; kernels/kind/julia_stack.cl): the complex Julia sets of
+    # z^2 + c(s), c(s) = c_from + s (c_to - c_from), stacked along the third coordinate u =
+    # 2 s - 1 in [-1, 1] (c_from at u = -1); complex numbers as (re, im)
+    c_from: tuple[float, float] = (-1.0, 0.0)
+    c_to: tuple[float, float] = (-0.1, 0.75)
+    # "cubic_locus" (seed 001 §5.2; kernels/kind/cubic_locus.cl): the (a, b) = (x + i y, z + i w)
+    # whose critical point +a ("plus": C+) or -a ("minus": C-) has a bounded orbit under
+    # z^3 - 3 a^2 z + b, drawn within the 4-ball |(a, b)| <= locus_radius (C+ is unbounded)
+    component: str = "plus"
+    locus_radius: float = 2.0
 
 
 # The kinds of set a [fractal] table describes (Fractal.kind).
-KINDS = ("julia", "mandelbrot")
+KINDS = ("julia", "mandelbrot", "julia_stack", "cubic_locus")
 
 
 def has_distance_estimate(f: Fractal) -> bool:
@@ -99,6 +110,8 @@ def has_distance_estimate(f: Fractal) -> bool:
     hypercomplex sqr and cube, whose set is the product of two complex Julia sets with
     complex estimates (iterate.cl).  The other pairs are marched by the fixed scan
     (march.method = "auto")."""
+    if f.kind in ("julia_stack", "cubic_locus"):   # none proven (seed 001 §5.1, §5.2); the stack's
+        return False                                # "de" is an empirical one
     return f.algebra in ("quaternion", "hypercomplex") and f.function in POLYNOMIAL_DEGREE
 
 
@@ -178,6 +191,34 @@ class Shading:
     colormap: str = "viridis"      # a matplotlib colour map (COLORMAPS)
     trap: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the orbit trap's point (coloring = "trap")
     fog: float = 0.0               # depth cueing: fade to the background by exp(-fog distance)
+    sky: Vec3 = (1.0, 1.0, 1.0)    # colour of the ambient light (times ambient and occlusion)
+    lights: tuple["Light", ...] = ()   # more lights beside ``light`` (at most MAX_LIGHTS)
+
+
+@dataclass(frozen=True)
+class Light:
+    """One of shading.lights: a point light at ``position`` or a distant light from
+    ``direction`` (towards the light; scene coordinates, like shading.light), of ``color``
+    times ``intensity``.  It lights diffuse and specular terms and casts shadows as
+    shading.light does (shading.shadow)."""
+
+    position: Vec4 | None = None
+    direction: Vec4 | None = None
+    color: Vec3 = (1.0, 1.0, 1.0)
+    intensity: float = 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if self.position is not None:
+            out["position"] = list(self.position)
+        else:
+            out["direction"] = list(self.direction or ())
+        out["color"] = list(self.color)
+        out["intensity"] = self.intensity
+        return out
+
+
+MAX_LIGHTS = 3   # shading.lights beside shading.light (kernels/shade/: EXTRA_LIGHTS)
 
 
 @dataclass(frozen=True)
@@ -187,6 +228,7 @@ class Image:
     width: int = 640
     height: int = 480
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
+    adaptive: bool = False   # samples only where neighbours differ (antialias.py)
 
 
 @dataclass(frozen=True)
@@ -410,6 +452,68 @@ class _Planes:
         return tuple(out)
 
 
+class _Lights:
+    """Up to ``most`` lights, each a table with exactly one of position / direction (3 or 4
+    numbers; a direction not all 0) and optional color (3 numbers in [0, 1e3]) and intensity
+    (in [0, 1e3]).  On the command line: "position x,y,z[,w] color r,g,b intensity k; direction
+    x,y,z[,w] ..." ("" or "[]": none)."""
+
+    verbatim = True
+    FIELDS = ("position", "direction", "color", "intensity")
+
+    def __init__(self, most: int) -> None:
+        self.most = most
+        self.valid = (f"up to {most} tables {{position = [x, y, z, w] or direction = [x, y, z, w], "
+                      f"color = [r, g, b], intensity = k}} (--set: position x,y,z,w color r,g,b "
+                      f"intensity k; ...)")
+        self.point = _Vector((3, 4), -COORD, COORD)
+        self.direction = _Vector((3, 4), -COORD, COORD, nonzero=True)
+        self.color = _Vector((3,), 0.0, 1e3)
+        self.intensity = _Real(0.0, 1e3)
+
+    def _parse(self, key: str, text: str) -> list:
+        lights = []
+        for i, part in enumerate(text.strip("[]").split(";")):
+            words = part.split()
+            if len(words) % 2:
+                raise SceneError(key, f"light {i}: expected pairs 'name value', got {_show(part.strip())}")
+            table: dict[str, Any] = {}
+            for name, value in zip(words[0::2], words[1::2]):
+                table[name] = _scalar(value) if name == "intensity" else [_scalar(x) for x in value.split(",")]
+            lights.append(table)
+        return lights
+
+    def __call__(self, key: str, v: Any) -> tuple:
+        if isinstance(v, str):
+            text = v.strip()
+            v = [] if text in ("", "[]") else self._parse(key, text)
+        if not isinstance(v, (list, tuple)):
+            raise SceneError(key, f"expected a list of light tables, got {_show(v)}")
+        if len(v) > self.most:
+            raise SceneError(key, f"at most {self.most} lights (besides shading.light), got {len(v)}")
+        out = []
+        for i, table in enumerate(v):
+            where = f"{key}[{i}]"
+            if isinstance(table, Light):
+                table = table.to_dict()
+            if not isinstance(table, Mapping):
+                raise SceneError(where, f"expected a table {{position = [...], color = [...], intensity = k}}, "
+                                        f"got {_show(table)}")
+            for name in table:
+                if name not in self.FIELDS:
+                    raise SceneError(f"{where}.{_show_key(str(name))}", "unknown key; use position or direction, "
+                                                                        "color, intensity")
+            if ("position" in table) == ("direction" in table):
+                raise SceneError(where, "give exactly one of position and direction")
+            kw: dict[str, Any] = {}
+            for name, check in (("position", self.point), ("direction", self.direction), ("color", self.color),
+                                ("intensity", self.intensity)):
+                if name in table:
+                    kw[name] = check(f"{where}.{name}", table[name])
+            out.append(Light(**kw))
+        return tuple(out)
+
+
 class _OrWord:
     """The literal string ``word``, else what ``inner`` accepts."""
 
@@ -456,6 +560,13 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "kind": _Choice(*KINDS),
         # degrees; one turn each way (the map is periodic in theta with period 360)
         "theta": _Real(-360.0, 360.0),
+        # the stack's end points: a Julia set is empty (dust) for |c| > 2, so +-4 covers all
+        "c_from": _Vector((2,), -4.0, 4.0),
+        "c_to": _Vector((2,), -4.0, 4.0),
+        "component": _Choice("plus", "minus"),
+        # the ball the unbounded C+ is drawn in; fractal.bailout must reach its maps' escape
+        # radius (scene._check_locus: 4 does up to 2.19)
+        "locus_radius": _Real(0.05, 16.0),
     },
     "camera": {
         "position": _Vector((3, 4), -COORD, COORD),
@@ -502,11 +613,14 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "colormap": _Choice(*COLORMAPS),
         "trap": _Vector((3, 4), -COORD, COORD),
         "fog": _Real(0.0, 100.0),
+        "sky": _Vector((3,), 0.0, 1e3),
+        "lights": _Lights(MAX_LIGHTS),
     },
     "image": {
         "width": _Integer(1, _INT_MAX),
         "height": _Integer(1, _INT_MAX),
         "samples": _Integer(1, 256),
+        "adaptive": _Bool(),
     },
     "clip": {
         "planes": _Planes(4),
@@ -597,6 +711,10 @@ def _toml_value(v: Any) -> str:
         return json.dumps(v)  # JSON string escapes are a subset of TOML's
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, Light):
+        v = v.to_dict()
+    if isinstance(v, Mapping):   # an inline table (shading.lights)
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     raise TypeError(f"cannot write {v!r} as TOML")
 
 
@@ -658,6 +776,76 @@ def _check_camera(cam: Camera) -> None:
         raise SceneError("camera.up", "parallel to the view direction or to camera.limbo")
 
 
+def locus_escape_radius(radius: float) -> float:
+    """The escape radius of every f_{a,b}(z) = z^3 - 3 a^2 z + b with |a|, |b| <= radius: the
+    root R of R^3 - (3 radius^2 + 1) R - radius = 0, beyond which |f(z)| >= |z|^3 - 3 |a|^2 |z|
+    - |b| > |z| and the orbit grows without bound (kernels/kind/cubic_locus.cl)."""
+    k = 3.0 * radius * radius + 1.0
+    lo, hi = math.sqrt(k), math.sqrt(k) + radius + 1.0   # g(lo) = -radius < 0 < g(hi)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid * mid * mid - k * mid - radius > 0:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def _check_locus(scene: "Scene") -> None:
+    """fractal.kind = "cubic_locus": the complex cubic only, no rotation, no orbit colouring,
+    no estimate (fixed scan, Jacobian or zbuffer normals), and a bailout that is an escape
+    radius for every map in the ball, so that the truncated set tends to the locus."""
+    f, m = scene.fractal, scene.march
+    if f.algebra != "quaternion" or f.function != "sqr":
+        raise SceneError("fractal.kind", "cubic_locus iterates the complex cubic z^3 - 3 a^2 z + b: leave "
+                         "fractal.algebra=quaternion and fractal.function=sqr")
+    if f.theta != 0:
+        raise SceneError("fractal.theta", "the rotation is of the quaternion map, not of the cubic locus: set 0")
+    if scene.shading.coloring in ("iteration", "trap"):
+        raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the quaternion orbit of "
+                         "fractal.c, not the cubic locus's; use flat or w")
+    if m.method == "de" and m.quality == "custom":   # a preset's de: refused by name below
+        raise SceneError("march.method", "no distance estimate is known for the cubic connectedness locus "
+                         "(seed 001 section 5.2); use fixed or auto")
+    if scene.normals.method == "gradient":
+        raise SceneError("normals.method", "gradient differences a distance estimate, which the cubic locus "
+                         "has none of; use jacobian or zbuffer")
+    need = locus_escape_radius(f.locus_radius)
+    if f.bailout < need:
+        raise SceneError("fractal.bailout", f"{f.bailout!r} is below the escape radius {need:.4g} of the cubic "
+                         f"maps within fractal.locus_radius={f.locus_radius!r}: set at least that")
+
+
+def _check_stack(scene: "Scene") -> None:
+    """fractal.kind = "julia_stack" (kernels/kind/julia_stack.cl): the complex square only, no
+    rotation, colouring by the quaternion orbit or estimate-based normals; its set does not
+    depend on the fourth coordinate w, so the view must stay in one hyperplane w = const (the
+    bounding ball, camera.march_radius, holds the stack there only)."""
+    f, cam, sl = scene.fractal, scene.camera, scene.slice
+    if f.algebra != "quaternion" or f.function != "sqr":
+        raise SceneError("fractal.kind", "julia_stack iterates the complex square z^2 + c: leave "
+                         "fractal.algebra=quaternion and fractal.function=sqr")
+    if f.theta != 0:
+        raise SceneError("fractal.theta", "the rotation is of the quaternion map, not of a Julia set stack: set 0")
+    if scene.shading.coloring in ("iteration", "trap"):
+        raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the quaternion orbit of "
+                         "fractal.c, not a stack's; use flat or w")
+    if scene.normals.method == "gradient":
+        raise SceneError("normals.method", "gradient differences a distance estimate, which a Julia set stack "
+                         "has no proven one of; use jacobian or zbuffer")
+    if any(sl.normal[:3]):
+        raise SceneError("slice.normal", "a Julia set stack is the same at every w: slice it by w = const "
+                         "only, normal (0, 0, 0, 1)")
+    if len(cam.limbo) == 4 and any(cam.limbo[:3]):
+        raise SceneError("camera.limbo", "a Julia set stack is the same at every w: keep the rays in w = const, "
+                         "limbo (0, 0, 0, 1)")
+    pw = cam.position[3] if len(cam.position) == 4 else 0.0
+    tw = cam.target[3] if len(cam.target) == 4 else 0.0
+    if pw != tw:
+        raise SceneError("camera.target", "a Julia set stack is the same at every w: give camera.position and "
+                         "camera.target the same w")
+
+
 def _check_fractal(scene: "Scene") -> None:
     """The algebra x function pairs that exist, and the methods each can use."""
     f, m = scene.fractal, scene.march
@@ -677,6 +865,10 @@ def _check_fractal(scene: "Scene") -> None:
         if scene.shading.coloring in ("iteration", "trap"):
             raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the Julia orbit of "
                              f"fractal.c, not a Mandelbrot set's; use flat or w")
+    if f.kind == "julia_stack":
+        _check_stack(scene)
+    if f.kind == "cubic_locus":
+        _check_locus(scene)
     if f.theta != 0 and f.algebra != "quaternion":
         raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
                          f"section 2.3), not {f.algebra}: set 0")
@@ -688,7 +880,7 @@ def _check_fractal(scene: "Scene") -> None:
                          f"march keys (march.quality=custom), measured in README's algebras section")
     if has_distance_estimate(f):
         return
-    if m.method == "de":
+    if m.method == "de" and f.kind != "julia_stack":   # the stack's "de": its empirical estimate
         raise SceneError("march.method", f"de needs a distance estimate, which {pair} has none of; "
                          f"use fixed or auto")
     if scene.normals.method == "gradient":
@@ -812,6 +1004,7 @@ class Scene:
                 f.name: list(v) if isinstance(v := getattr(part, f.name), tuple) else v
                 for f in fields(part)
             }
+        out["shading"]["lights"] = [light.to_dict() for light in self.shading.lights]
         return out
 
     def to_toml(self) -> str:

@@ -19,7 +19,7 @@ import pyjulia4d
 from pyjulia4d import cli
 from pyjulia4d.animation import animate, frame_path, read_header, remove_stale_temps
 from pyjulia4d.keyframes import from_table, interpolate, load
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.scene import Scene
 
 ROOT = Path(pyjulia4d.__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

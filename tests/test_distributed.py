@@ -6,7 +6,6 @@ from __future__ import annotations
 import logging
 import os
 import signal
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +18,7 @@ from pyjulia4d.distributed import render_many, render_tiled
 from pyjulia4d.keyframes import from_table
 from pyjulia4d.scene import Scene
 
-distributed = pytest.importorskip("distributed")
+import distributed  # noqa: E402  (a dependency: the tests fail without it)
 
 from harness import device  # noqa: E402
 

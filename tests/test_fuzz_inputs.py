@@ -100,6 +100,12 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
         opts = check.options
         vals += [rng.choice(opts).upper(), rng.choice(opts)[:-1], rng.choice(opts) + "x", "1", "0"]
         return [v for v in vals if v.strip() not in opts]
+    if kind == "_Lights":   # "" and "[]" are valid (no lights)
+        vals = [v for v in vals if v.strip() not in ("", "[]")]
+        return vals + ["position", "position 1,2", "direction 0,0,0", "position 1,2,3 direction 1,0,0",
+                       "color 1,1,1", "position 1,2,3 intensity -1", "position 1,2,3 intensity nan",
+                       "position 1,2,3 color 1,1", "pos 1,2,3", ";".join(["position 1,2,3"] * 4),
+                       "position 1,2,3;x"]
     if kind == "_Planes":   # "" and "[]" are valid (no planes)
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["1,0,0", "0,0,0,1", "1,0,0,nan", "1,0,0,2e6", ";".join(["1,0,0,0"] * 5), "1,0,0,0;x"]
@@ -177,6 +183,11 @@ def _toml_wrong_types(key: str) -> list[str]:
         vals += ["1.0", "[nan, 0, 0, 0]", "[0, inf, 0]", "[true, 1, 1]", '["0", 0, 0, 0]']
     if kind == "_Choice":
         vals = [v for v in vals if v != "[]"] + ['"FIXED"', '""', '" de "']
+    if kind == "_Lights":   # [] is valid (no lights)
+        vals = [v for v in vals if v != "[]"] + ["[{ color = [1, 1, 1] }]", "[[1, 2, 3]]",
+                                                "[{ position = [1, 2, 3], direction = [1, 0, 0] }]",
+                                                "[{ position = [1, 2, 3], x = 1 }]",
+                                                "[{ direction = [0, 0, 0] }]", "[{ position = [nan, 0, 0] }]"]
     if kind == "_Planes":   # [] is valid (no planes)
         vals = [v for v in vals if v != "[]"] + ["[[0, 0, 0, 1]]", "[1, 2, 3, 4]", "[[1, 0, 0, nan]]",
                                                 "[[1, 0, 0, true]]"]
@@ -417,7 +428,7 @@ def test_case_count() -> None:
     """The generator makes a few hundred cases, every group represented."""
     groups = {c.id.split("-")[0] for c in CASES}
     assert groups == {"set", "toml", "path", "flag", "out"}
-    assert 300 <= len(CASES) <= 1000, len(CASES)
+    assert 300 <= len(CASES) <= 1600, len(CASES)
 
 
 @pytest.mark.parametrize("spec", ["99:99", "0:99", "-1:0", "x:y", "", ":", "no-such-device-4f2a",

@@ -7,14 +7,18 @@ import pytest
 
 from harness import Runner
 from pyjulia4d import build, reference as ref
-from pyjulia4d.camera import camera_frame, light_position
+from pyjulia4d.camera import camera_frame, extra_lights, light_position
 from pyjulia4d.scene import Scene
 
 
 @pytest.mark.parametrize("over", [["shading.light=eye"], ["shading.light=2,3,-4"], ["shading.specular=0"],
                                   ["shading.light=-1,2,-3,0.5", "shading.shininess=5",
                                    "shading.light_color=1,0.5,0.2", "shading.background=0.1,0.2,0.3"],
-                                  ["shading.fog=0.7", "shading.background=0.3,0.4,0.5"]])
+                                  ["shading.fog=0.7", "shading.background=0.3,0.4,0.5"],
+                                  ["shading.sky=0.3,0.5,0.9", "shading.ambient=0.4",
+                                   "shading.lights=position 3,1,-2 color 0.2,0.4,1 intensity 2; direction -1,0.5,0.2,0.3"],
+                                  ["shading.light=eye", "shading.shadow=hard",
+                                   "shading.lights=direction 0,1,0 color 1,0.8,0.6; position 0,0,-3,1 intensity 0.5; position 2,2,2"]])
 @pytest.mark.parametrize("fl", ["single", "double"])
 def test_shade_matches_reference(over, fl):
     # shade.cl alone: no light terms (those are test_light_terms_in_render_match_reference's)
@@ -32,17 +36,26 @@ def test_shade_matches_reference(over, fl):
     point, nrm = point.astype(R.real).astype(float), nrm.astype(R.real).astype(float)
     lp = light_position(s)
     sh = s.shading
+    geo, rgb = extra_lights(s)
+    geo = geo.astype(R.real).astype(float)
+    # the extra lights' visibility (light.cl's, given here): 1 with no shadows compiled
+    vis = rng.uniform(0, 1, (n, 4)) if "EXTRA_SHADOWS" in build.scene_config(s).defines else np.ones((n, 4))
+    # light.cl's terms (the key light's visibility, occlusion, colour value): none here
+    terms = np.tile([1.0, 1.0, 0.0, 0.0], (n, 1))
     out = R.out(n, cl.cltypes.float4)
     c4 = lambda v: cl.cltypes.make_float4(*[float(x) for x in v], 0.0)
     R("shade", (n,), R.buf(status, np.int32), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf4(point),
       R.vec(fr.position), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward),
       R.vec(lp if lp is not None else fr.position), c4(sh.color), c4(sh.background),
-      c4(sh.light_color), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-      np.float32(sh.shininess), R.out(1, cl.cltypes.float4), R.buf(np.zeros((2, 4)), np.float32),
-      np.int32(2), np.float32(sh.fog), np.float32(1.5), out)
+      c4(sh.light_color), c4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
+      np.float32(sh.shininess), R.buf(terms, np.float32), R.buf(np.zeros((2, 4)), np.float32),
+      np.int32(2), np.float32(sh.fog), np.float32(1.5), R.buf4(geo), R.buf(rgb, np.float32),
+      R.buf(vis, np.float32), out)
     got = out.get().view(np.float32).reshape(n, 4)
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
-                     sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5)
+                     sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5,
+                     terms=terms, sky=sh.sky, lights_geo=geo if sh.lights else None, lights_rgb=rgb,
+                     vis_extra=vis)
     # the shading itself is float32 in both variants (colour needs no more; shade.cl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
@@ -78,6 +91,11 @@ LIGHT_SCENES = {
                   "shading.shadow=none", "shading.ao=0"],
     "w": ["shading.coloring=w", "camera.position=1.8,1.6,-2.2,0.6", "shading.ao=0.5"],
     "fixed-hard-ao": ["march.method=fixed", "shading.light=-3,4,-2", "shading.shadow=hard", "shading.ao=0.8"],
+    "three-lights-soft": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.sky=0.5,0.6,1",
+                          "shading.lights=position 3,2,-1 color 0.3,0.5,1 intensity 0.8; direction 0,-1,0.2 "
+                          "color 1,0.5,0.2 intensity 0.4"],
+    "eye-and-lights-hard-fixed": ["march.method=fixed", "shading.light=eye", "shading.shadow=hard",
+                                  "shading.lights=position -2,3,-3 intensity 0.7; direction 1,1,-1,0.2"],
     "hypercomplex": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=0.5,0.8,0.2,0.1",
                      "fractal.max_iter=6", "camera.position=3.6,3.2,-4.4,0", "shading.light=-5,6,-3",
                      "shading.shadow=hard", "shading.ao=0.6", "shading.coloring=iteration"],

@@ -8,6 +8,11 @@
  * any max_iter.  The 4D gradient is projected onto the 3D space the rays span
  * and returned in camera coordinates (x right, y up, z towards the eye). */
 
+#ifdef KIND_NORMAL
+/* a kind with a normal of its own (kind/julia_stack.cl, kind/cubic_locus.cl: KIND_NORMAL names
+ * its function) */
+#define normal_jacobian KIND_NORMAL
+#else
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
     quat q = ALG_IN(p);
@@ -77,6 +82,7 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
     }
     return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), ALG_DOT(q, j3));
 }
+#endif  /* KIND_NORMAL */
 
 /* 4D vector -> camera coordinates (right, up, -forward), normalised: (*nx, *ny, *nz).
  * Degenerate (zero: the orbit hit the critical point 0 exactly, e.g. an eye at 0 inside

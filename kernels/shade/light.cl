@@ -123,7 +123,9 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
                           const real epsilon, const real4 right, const real4 up, const real4 forward,
                           const real4 light_pos, const real radius, const real step, const real bias,
                           const real softness, const int max_steps, const real ao_distance,
-                          const real ao_strength, const real4 trap, __global float4 *terms)
+                          const real ao_strength, const real4 trap, __global const real4 *lights_geo,
+                          __global const float4 *lights_rgb, __global float4 *terms,
+                          __global float4 *vis_extra)
 {
     size_t i0 = get_global_id(0) * LANES;
     if (i0 >= (size_t)n_items)
@@ -156,7 +158,7 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
     }
 #endif
     lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;
-#if defined(SHADOW_HARD) || defined(SHADOW_SOFT)
+#if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
     {
         quat o = QRAY(p, nw, (lreal)bias);     /* off the surface, outside */
         quat lv = QADD(QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w),
@@ -164,6 +166,28 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
         lreal dist = QLEN(lv);
         quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
         vis = shadow_ray(o, l, dist, hit, jp, radius, step, softness, max_steps);
+    }
+#endif
+#ifdef EXTRA_SHADOWS
+    /* shading.lights: the same shadow ray towards each (a distant one: along its direction,
+     * out of the bounding ball) */
+    lreal ve[3] = {(lreal)1, (lreal)1, (lreal)1};
+    {
+        quat o = QRAY(p, nw, (lreal)bias);
+        for (int j = 0; j < EXTRA_LIGHTS; ++j) {
+            real4 g = lights_geo[j];
+            quat lv;
+            lreal dist;
+            if (lights_rgb[j].w != 0.0f) {
+                lv = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
+                dist = (lreal)INFINITY;
+            } else {
+                lv = QADD(QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w), QSCALE((lreal)-1, o));
+                dist = QLEN(lv);
+            }
+            quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
+            ve[j] = shadow_ray(o, l, dist, hit, jp, radius, step, softness, max_steps);
+        }
     }
 #endif
 #ifdef AO
@@ -178,12 +202,20 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
 #endif
 #if LANES == 1
     terms[i0] = (float4)((float)vis, (float)amb, (float)val, 0.0f);
+#ifdef EXTRA_SHADOWS
+    vis_extra[i0] = (float4)((float)ve[0], (float)ve[1], (float)ve[2], 0.0f);
+#endif
 #else
     for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
         size_t i = i0 + k;
         terms[i] = status[i] == STATUS_HIT
                        ? (float4)((float)((real *)&vis)[k], (float)((real *)&amb)[k], (float)((real *)&val)[k], 0.0f)
                        : (float4)(1, 1, 0, 0);
+#ifdef EXTRA_SHADOWS
+        vis_extra[i] = status[i] == STATUS_HIT
+                       ? (float4)((float)((real *)&ve[0])[k], (float)((real *)&ve[1])[k], (float)((real *)&ve[2])[k], 0.0f)
+                       : (float4)(1, 1, 1, 0);
+#endif
     }
 #endif
 }

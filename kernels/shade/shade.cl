@@ -1,7 +1,12 @@
 /* shade/shade.cl: Lambert diffuse with the light at the eye by default, so every visible
  * point is lit (seed 001 §4), or at a positioned light (-D LIGHT_POINT); Blinn-Phong
- * specular (-D SPECULAR; seed 000 §5.2); ambient; background colour on a miss.
- *     rgb = light_color (base (ambient ao + diffuse vis max(n.l, 0)) + vis specular max(n.h, 0)^shininess)
+ * specular (-D SPECULAR; seed 000 §5.2); ambient from the sky; background colour on a miss.
+ *     rgb = base ambient ao sky
+ *         + sum over lights k of  color_k (base diffuse vis_k max(n.l_k, 0) + vis_k specular max(n.h_k, 0)^shininess)
+ * the first light being shading.light (color light_color), the others shading.lights
+ * (-D EXTRA_LIGHTS=k: lights_geo[j] a 4D position, or with lights_rgb[j].w = 1 the direction
+ * towards a distant light; lights_rgb[j].xyz its colour times intensity; their visibility
+ * vis_extra[i] with -D EXTRA_SHADOWS),
  * with vis (the light's visibility: shadows) and ao (ambient occlusion) from
  * shade/light.cl's terms (-D LIGHT_TERMS; else 1), and base the scene's colour or, with
  * -D COLORMAP, the colour map's entry for the hit's colour value (terms.z, linear
@@ -13,9 +18,11 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
                     __global const real4 *point, const real4 eye, const real4 right,
                     const real4 up, const real4 forward, const real4 light_pos,
                     const float4 color, const float4 background, const float4 light_color,
-                    const float ambient, const float diffuse, const float specular,
+                    const float4 sky, const float ambient, const float diffuse, const float specular,
                     const float shininess, __global const float4 *terms, __global const float4 *lut,
-                    const int n_lut, const float fog, const float fog_start, __global float4 *rgba)
+                    const int n_lut, const float fog, const float fog_start,
+                    __global const real4 *lights_geo, __global const float4 *lights_rgb,
+                    __global const float4 *vis_extra, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -51,14 +58,35 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
 #else
     float3 base = color.xyz;
 #endif
-    float3 rgb = base * (ambient * ao + diffuse * vis * lambert);
+    float3 lit = base * (diffuse * vis * lambert);
 #ifdef SPECULAR
     if (lambert > 0.0f) {
         float3 hv = normalize(l + v);
-        rgb += vis * specular * pow(fmax(dot(n, hv), 0.0f), shininess);
+        lit += vis * specular * pow(fmax(dot(n, hv), 0.0f), shininess);
     }
 #endif
-    rgb *= light_color.xyz;
+    float3 rgb = base * (ambient * ao) * sky.xyz + lit * light_color.xyz;
+#ifdef EXTRA_LIGHTS
+#ifdef EXTRA_SHADOWS
+    float4 ve = vis_extra[i];
+#else
+    float4 ve = (float4)(1.0f);
+#endif
+    for (int j = 0; j < EXTRA_LIGHTS; ++j) {
+        float4 lc = lights_rgb[j];
+        real4 g = lc.w != 0.0f ? lights_geo[j] : lights_geo[j] - point[i];
+        float3 lj = (float3)(dot(g, right), dot(g, up), -dot(g, forward));
+        lj = dot(lj, lj) > 0.0f ? normalize(lj) : v;
+        float vj = j == 0 ? ve.x : (j == 1 ? ve.y : ve.z);
+        float lam = fmax(dot(n, lj), 0.0f);
+        float3 add = base * (diffuse * vj * lam);
+#ifdef SPECULAR
+        if (lam > 0.0f)
+            add += vj * specular * pow(fmax(dot(n, normalize(lj + v)), 0.0f), shininess);
+#endif
+        rgb += add * lc.xyz;
+    }
+#endif
 #ifdef FOG
     /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the
      * distance from the eye, fog_start where the bounding ball begins */

@@ -34,6 +34,8 @@ from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
 from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
 from .. import colormap  # noqa: E402
 from .kind import mandelbrot as _mandelbrot  # noqa: E402
+from .kind import julia_stack as _stack  # noqa: E402
+from .kind import cubic_locus as _locus  # noqa: E402
 
 
 # ------------------------------------------------------------------ iterate.cl
@@ -43,6 +45,10 @@ def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     F = formula
     if F.kind == "mandelbrot":   # kernels/kind/mandelbrot.cl takes the name over
         return _mandelbrot.mandel_inside(p, max_iter, bailout, F)
+    if F.kind == "julia_stack":  # kernels/kind/julia_stack.cl likewise
+        return _stack.stack_inside(p, max_iter, bailout, F)
+    if F.kind == "cubic_locus":  # kernels/kind/cubic_locus.cl likewise
+        return _locus.locus_inside(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     out = np.ones(q.shape[:-1], bool)
@@ -63,6 +69,10 @@ def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     F = formula
     if F.kind == "mandelbrot":
         return _mandelbrot.mandel_level(p, max_iter, bailout, F)
+    if F.kind == "julia_stack":
+        return _stack.stack_level(p, max_iter, bailout, F)
+    if F.kind == "cubic_locus":
+        return _locus.locus_level(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
@@ -98,6 +108,8 @@ def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNIO
     F = formula
     if F.kind == "mandelbrot":
         return _mandelbrot.mandel_distance_formula(p, max_iter, bailout, F)
+    if F.kind == "julia_stack":   # the empirical estimate (-D STACK_DE)
+        return _stack.stack_distance_formula(p, max_iter, bailout, F)
     if F.split:
         return _split_distance_formula(p, c, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
@@ -454,6 +466,10 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
     F = formula
     if F.kind == "mandelbrot":   # normals/jacobian.cl, -D KIND_MANDELBROT
         return _mandelbrot.mandel_normal_jacobian(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
+    if F.kind == "julia_stack":  # KIND_NORMAL: kind/julia_stack.cl stack_normal
+        return _stack.stack_normal(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
+    if F.kind == "cubic_locus":  # KIND_NORMAL: kind/cubic_locus.cl locus_normal
+        return _locus.locus_normal(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
     q = F.ALG_IN(np.array(p, np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     # J[..., k, :] = column k, in the algebra's coordinates: ALG_IN of the unit vectors
@@ -589,10 +605,26 @@ def clip_normals(flags, status, frame: Frame, planes, normal):
 
 # -------------------------------------------------------------------- pipeline
 
+def flag_edges(color, alpha, threshold: float):
+    """Twin of antialias.flag_edges, written apart: (H, W) bool, True where some pixel of the
+    3 x 3 neighbourhood (clipped to the image) differs from the centre by more than
+    ``threshold`` in alpha or in a channel of the sRGB-encoded colour."""
+    v = np.concatenate([colormap.linear_to_srgb(np.nan_to_num(np.asarray(color, np.float64))),
+                        np.nan_to_num(np.asarray(alpha, np.float64))[..., None]], axis=-1)
+    h, w = v.shape[:2]
+    p = np.pad(v, ((1, 1), (1, 1), (0, 0)), mode="edge")   # an edge copy never differs
+    out = np.zeros((h, w), bool)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            out |= np.abs(p[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] - v).max(axis=-1) > threshold
+    return out
+
+
 def render(scene: Scene) -> RenderResult:
     """The whole pipeline in float64 numpy (slow: for small images).  With image.samples = S
     > 1 the colour and alpha are the mean of S more passes through stratified samples of
-    each pixel (rays.cl sample_offset); everything else comes from the pixel centres."""
+    each pixel (rays.cl sample_offset); everything else comes from the pixel centres.  With
+    image.adaptive, only the pixels flag_edges flags in the centre pass take that mean."""
     t0 = time.perf_counter()
     frame = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
@@ -618,20 +650,28 @@ def render(scene: Scene) -> RenderResult:
         else:
             normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
         normal = clip_normals(guard, status, frame, planes, normal)
-        from .shade import light_terms_of_scene, shade
+        from .shade import extra_visibility_of_scene, light_terms_of_scene, shade
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
+        from ..camera import extra_lights
         from ..render import fog_start
+        geo, rgb = extra_lights(scene) if sh.lights else (None, None)
         rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
                      sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut,
-                     sh.fog, fog_start(frame.position, march_radius(scene)))
+                     sh.fog, fog_start(frame.position, march_radius(scene)), sh.sky, geo, rgb,
+                     extra_visibility_of_scene(scene, point, normal, status, F))
         return rgba, depth, point, status, smp, normal, guard, bracket
 
     planes = clip_planes(scene)
     rgba, depth, point, status, smp, normal, guard, bracket = one_pass(0, 1)
     S = scene.image.samples
     if S > 1:
-        rgba = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
+        mean = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
+        if scene.image.adaptive:   # antialias.py: the flagged pixels alone take the mean
+            from ..antialias import THRESHOLD
+            flags = flag_edges(rgba[:, :3].reshape(h, w, 3), rgba[:, 3].reshape(h, w), THRESHOLD).ravel()
+            mean = np.where(flags[:, None], mean, rgba)
+        rgba = mean
     res = RenderResult(color=rgba[:, :3].reshape(h, w, 3), alpha=rgba[:, 3].reshape(h, w),
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),

@@ -19,8 +19,12 @@ class Formula:
     algebra: str = "quaternion"
     function: str = "sqr"
     exponent: tuple[float, float] = (2.0, 0.0)
-    kind: str = "julia"        # the set (reference/kind/): "julia" or "mandelbrot"
+    kind: str = "julia"        # the set (reference/kind/): "julia", "mandelbrot", "julia_stack"
     theta: float = 0.0         # the rotation of seed 001 §2.3, degrees (reference/kind/rotate.py)
+    c_from: tuple[float, float] = (-1.0, 0.0)   # a Julia set stack's c-line (reference/kind/julia_stack.py)
+    c_to: tuple[float, float] = (-0.1, 0.75)
+    component: str = "plus"    # the cubic locus's critical point (reference/kind/cubic_locus.py)
+    locus_radius: float = 2.0
     alg: Any = field(init=False, repr=False, compare=False)
     fn: Any = field(init=False, repr=False, compare=False)
 
@@ -92,7 +96,9 @@ QUATERNION_SQR = Formula()
 def formula_of(fractal) -> Formula:
     """The Formula of a scene's [fractal] table."""
     return Formula(fractal.algebra, fractal.function, tuple(float(x) for x in fractal.exponent),
-                   fractal.kind, float(fractal.theta))
+                   fractal.kind, float(fractal.theta),
+                   c_from=tuple(float(x) for x in fractal.c_from), c_to=tuple(float(x) for x in fractal.c_to),
+                   component=fractal.component, locus_radius=float(fractal.locus_radius))
 
 
 def complex_value(fn_name: str, z, exponent=(2.0, 0.0)):

@@ -136,6 +136,47 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
     return out
 
 
+def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter, bailout, radius, step,
+                     bias, softness, max_steps, soft, F: Formula = QUATERNION_SQR):
+    """The visibility of each of shading.lights (shade/light.cl, EXTRA_SHADOWS): (n, 4), column
+    j for light j (geo, rgb as camera.extra_lights: rgb[j, 3] = 1 a distant light along
+    geo[j]), 1 off hits and in unused columns."""
+    n = len(status)
+    out = np.ones((n, 4))
+    out[:, 3] = 0.0
+    k = np.nonzero(status == STATUS_HIT)[0]
+    if k.size == 0:
+        return out
+    nc = normal[k]
+    nw = nc[:, :1] * frame.right + nc[:, 1:2] * frame.up - nc[:, 2:3] * frame.forward
+    o = point[k] + bias * nw
+    for j in range(len(geo)):
+        if rgb[j, 3] != 0:
+            lv = np.broadcast_to(np.asarray(geo[j], np.float64), o.shape)
+            dist = np.full(len(k), np.inf)
+        else:
+            lv = np.asarray(geo[j], np.float64) - o
+            dist = np.linalg.norm(lv, axis=-1)
+        l = lv / np.maximum(np.linalg.norm(lv, axis=-1), 1e-300)[:, None]
+        out[k, j] = shadow_ray(o, l, dist, c, max_iter, bailout, radius, step, softness, max_steps, soft, F)
+    return out
+
+
+def extra_visibility_of_scene(scene, point, normal, status, F: Formula):
+    """extra_visibility with the scene's settings, or None without shadows or shading.lights."""
+    from ..camera import camera_frame, extra_lights, march_radius
+    from ..render import light_parameters
+    sh = scene.shading
+    if sh.shadow == "none" or not sh.lights:
+        return None
+    radius = march_radius(scene)
+    lp = light_parameters(scene, radius)
+    geo, rgb = extra_lights(scene)
+    f = scene.fractal
+    return extra_visibility(point, normal, status, camera_frame(scene), geo, rgb, f.c, f.max_iter, f.bailout,
+                            radius, lp["step"], lp["bias"], lp["softness"], lp["max_steps"], sh.shadow == "soft", F)
+
+
 def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     """light_terms with the scene's settings (render.light_parameters), or None when the
     scene uses none of them."""
@@ -143,7 +184,7 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     from ..render import light_parameters
     sh = scene.shading
     shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # build.light_defines
-    if shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
+    if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
         return None
     fr = camera_frame(scene)
     radius = march_radius(scene)
@@ -157,10 +198,13 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
 
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
-          ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0):
-    """Lambert (light at the eye by default, seed 001 §4) + ambient + Blinn-Phong, with the
-    light's visibility and ambient occlusion from ``terms`` and the base colour from the
-    colour table ``lut`` at terms' colour value (shade/shade.cl); RGBA, linear light."""
+          ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0,
+          sky=(1.0, 1.0, 1.0), lights_geo=None, lights_rgb=None, vis_extra=None):
+    """Lambert (light at the eye by default, seed 001 §4) + ambient (times ``sky``) +
+    Blinn-Phong, with the light's visibility and ambient occlusion from ``terms`` and the
+    base colour from the colour table ``lut`` at terms' colour value; the lights of
+    ``lights_geo``/``lights_rgb`` (camera.extra_lights) likewise, their visibility from
+    ``vis_extra`` (shade/shade.cl); RGBA, linear light."""
     hit = status == STATUS_HIT
     rgba = np.zeros((len(status), 4))
     rgba[:, :3] = background
@@ -187,13 +231,26 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
         base = lut[k, :3] * (1 - fr) + lut[k + 1, :3] * fr
     else:
         base = np.asarray(color)[None, :]
-    rgb = base * (ambient * ao + diffuse * vis * lam)[:, None]
-    if specular > 0:
-        hv = l + v
-        hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
-        spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
-        rgb = rgb + (vis * specular * spec)[:, None]
-    rgb = rgb * np.asarray(light_color)[None, :]
+    def lit(l, vis):
+        lam = np.maximum(_dot(n, l), 0.0)
+        out = base * (diffuse * vis * lam)[:, None]
+        if specular > 0:
+            hv = l + v
+            hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
+            spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
+            out = out + (vis * specular * spec)[:, None]
+        return out
+
+    rgb = base * (ambient * ao)[:, None] * np.asarray(sky)[None, :] + lit(l, vis) * np.asarray(light_color)[None, :]
+    for j in range(0 if lights_geo is None else len(lights_geo)):
+        if lights_rgb[j, 3] != 0:
+            lj = np.broadcast_to(_to_camera(np.asarray(lights_geo[j])[None, :], frame), p.shape)
+        else:
+            lj = _to_camera(np.asarray(lights_geo[j]) - point[hit], frame)
+        ln = np.linalg.norm(lj, axis=-1, keepdims=True)
+        lj = np.where(ln > 0, lj / np.where(ln > 0, ln, 1), v)
+        vj = vis_extra[hit, j] if vis_extra is not None else np.ones(len(lam))
+        rgb = rgb + lit(lj, vj) * np.asarray(lights_rgb[j, :3])[None, :]
     if fog > 0:   # depth cueing toward the background (shade.cl, -D FOG)
         t = np.linalg.norm(point[hit] - frame.position, axis=-1)   # the 4D distance, as shade.cl
         k = np.exp(-fog * np.maximum(t - fog_start, 0.0))[:, None]

@@ -1,0 +1,321 @@
+// tests/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)
+typedef float real;
+typedef float4 real4;
+typedef float3 real3;
+typedef struct {
+real4 c;
+real bailout2;
+real epsilon;
+int max_iter;
+} julia_params;
+typedef real lreal;
+typedef int lmask;
+typedef real4 quat;
+typedef struct { lreal re, im; } cplx;
+inline cplx C(lreal re, lreal im) { cplx z = {re, im}; return z; }
+inline cplx c_add(cplx a, cplx b) { return C(a.re + b.re, a.im + b.im); }
+inline cplx c_sub(cplx a, cplx b) { return C(a.re - b.re, a.im - b.im); }
+inline cplx c_neg(cplx a) { return C(-a.re, -a.im); }
+inline cplx c_mul(cplx a, cplx b) { return C(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re); }
+inline cplx c_sqr(cplx a) { return C(a.re * a.re - a.im * a.im, (real)2 * a.re * a.im); }
+inline cplx c_scale(lreal s, cplx a) { return C(s * a.re, s * a.im); }
+inline cplx c_times_i(cplx a) { return C(-a.im, a.re); }
+inline cplx c_times_minus_i(cplx a) { return C(a.im, -a.re); }
+inline cplx c_recip(cplx b)
+{
+lreal s = fmax(fabs(b.re), fabs(b.im));
+lreal x = b.re / s, y = b.im / s;
+lreal d = s * (x * x + y * y);
+return C(x / d, -y / d);
+}
+inline cplx c_div(cplx a, cplx b) { return c_mul(a, c_recip(b)); }
+inline cplx c_exp(cplx z)
+{
+lreal r = exp(z.re);
+return C(r * cos(z.im), ((z.im == (real)0) ? (z.im) : (r * sin(z.im))));
+}
+inline cplx c_log(cplx z) { return C(log(hypot(z.re, z.im)), atan2(z.im, z.re)); }
+inline cplx c_sqrt(cplx z)
+{
+lreal t = sqrt((hypot(z.re, z.im) + fabs(z.re)) * (real)0.5);
+lreal u = ((z.re >= (real)0) ? (t) : (fabs(z.im) / ((real)2 * t)));
+lreal v = ((z.re >= (real)0) ? (z.im / ((real)2 * t)) : (copysign(t, z.im)));
+lmask zero = t == (real)0;
+return C(((zero) ? ((lreal)0) : (u)), ((zero) ? (z.im) : (v)));
+}
+inline cplx c_sin(cplx z) { return C(sin(z.re) * cosh(z.im), cos(z.re) * sinh(z.im)); }
+inline cplx c_cos(cplx z) { return C(cos(z.re) * cosh(z.im), -sin(z.re) * sinh(z.im)); }
+inline cplx c_sinh(cplx z) { return C(sinh(z.re) * cos(z.im), cosh(z.re) * sin(z.im)); }
+inline cplx c_cosh(cplx z) { return C(cosh(z.re) * cos(z.im), sinh(z.re) * sin(z.im)); }
+inline cplx c_tanh(cplx z)
+{
+lreal d = cosh((real)2 * z.re) + cos((real)2 * z.im);
+lmask far = fabs(z.re) > (real)20;
+return C(((far) ? (copysign((lreal)1, z.re)) : (sinh((real)2 * z.re) / d)),
+((far) ? ((lreal)0 * z.im) : (sin((real)2 * z.im) / d)));
+}
+inline cplx c_tan(cplx z) { return c_times_minus_i(c_tanh(c_times_i(z))); }
+inline cplx c_asinh(cplx z)
+{
+lmask neg = z.re < (real)0;
+cplx w = C(((neg) ? (-z.re) : (z.re)), ((neg) ? (-z.im) : (z.im)));
+cplx r = c_log(c_add(w, c_sqrt(c_add(c_sqr(w), C((lreal)1, (lreal)0)))));
+return C(((neg) ? (-r.re) : (r.re)), ((neg) ? (-r.im) : (r.im)));
+}
+inline cplx c_asin(cplx z) { return c_times_minus_i(c_asinh(c_times_i(z))); }
+inline cplx c_acos(cplx z)
+{
+cplx a = c_asin(z);
+return C((real)1.57079632679489661923 - a.re, -a.im);
+}
+inline cplx c_acosh(cplx z)
+{
+cplx p = c_mul(c_sqrt(C(z.re + (real)1, z.im)), c_sqrt(C(z.re - (real)1, z.im)));
+return c_log(c_add(z, p));
+}
+inline cplx c_atanh(cplx z)
+{
+cplx d = c_sub(c_log(C((real)1 + z.re, z.im)), c_log(C((real)1 - z.re, -z.im)));
+return c_scale((lreal)0.5, d);
+}
+inline cplx c_atan(cplx z) { return c_times_minus_i(c_atanh(c_times_i(z))); }
+inline cplx c_pow(cplx z, cplx p)
+{
+cplx r = c_exp(c_mul(p, c_log(z)));
+lmask zero = (z.re == (real)0) & (z.im == (real)0);
+return C(((zero) ? ((lreal)0) : (r.re)), ((zero) ? ((lreal)0) : (r.im)));
+}
+inline cplx cfun(cplx z) { return c_sqr(z); }
+inline cplx cfun_d(cplx z) { return c_scale((lreal)2, z); }
+inline real4 alg_mul(real4 a, real4 b)
+{
+return (real4)(a.x * b.x - a.y * b.y - a.z * b.z - a.w * b.w,
+a.x * b.y + a.y * b.x + a.z * b.w - a.w * b.z,
+a.x * b.z - a.y * b.w + a.z * b.x + a.w * b.y,
+a.x * b.w + a.y * b.z - a.z * b.y + a.w * b.x);
+}
+inline quat alg_sqr(quat q)
+{
+return ((real4)((q.x * q.x - q.y * q.y - q.z * q.z - q.w * q.w), ((real)2 * q.x * q.y), ((real)2 * q.x * q.z), ((real)2 * q.x * q.w)));
+}
+inline quat alg_sqr_jvp(quat q, quat h)
+{
+return ((real4)(((real)2 * (q.x * h.x - q.y * h.y - q.z * h.z - q.w * h.w)), ((real)2 * (q.x * h.y + h.x * q.y)), ((real)2 * (q.x * h.z + h.x * q.z)), ((real)2 * (q.x * h.w + h.x * q.w))));
+}
+inline quat alg_cube(quat q)
+{
+lreal v2 = q.y * q.y + q.z * q.z + q.w * q.w;
+lreal s = (real)3 * q.x * q.x - v2;
+return ((real4)((q.x * (q.x * q.x - (real)3 * v2)), (s * q.y), (s * q.z), (s * q.w)));
+}
+inline quat alg_cube_jvp(quat q, quat h)
+{
+lreal v2 = q.y * q.y + q.z * q.z + q.w * q.w;
+lreal vu = q.y * h.y + q.z * h.z + q.w * h.w;
+lreal s = (real)3 * q.x * q.x - v2;
+lreal t = (real)6 * q.x * h.x - (real)2 * vu;
+return ((real4)(((real)3 * (q.x * q.x * h.x - h.x * v2) - (real)6 * q.x * vu), (t * q.y + s * h.y), (t * q.z + s * h.z), (t * q.w + s * h.w)));
+}
+inline quat julia_f(quat q, real4 c) { return ((alg_sqr(q)) + (c)); }
+inline quat julia_f_jvp(quat q, quat h) { return alg_sqr_jvp(q, h); }
+inline lmask julia_inside(quat p, julia_params jp)
+{
+quat q = (p);
+real4 c = (jp.c);
+lmask live = dot((q), (q)) <= jp.bailout2;
+int n = 0;
+for (; n < jp.max_iter && (live); ++n) {
+q = ((live) ? (julia_f(q, c)) : (q));
+live = dot((q), (q)) <= jp.bailout2;
+}
+;
+return live;
+}
+inline lreal julia_level(quat p, julia_params jp, lmask *inside)
+{
+quat q = (p);
+real4 c = (jp.c);
+lreal m2 = dot((q), (q));
+lmask live = m2 <= jp.bailout2;
+lmask steps = 0;
+int n = 0;
+for (; n < jp.max_iter && (live); ++n) {
+q = ((live) ? (julia_f(q, c)) : (q));
+m2 = dot((q), (q));
+steps = ((live) ? (steps + 1) : (steps));
+live = m2 <= jp.bailout2;
+}
+;
+*inside = m2 <= jp.bailout2;
+lmask k = jp.max_iter - steps;
+lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
+lreal out = (((k > 60) | (e > (real)69)) ? ((lreal)1e30) : (expm1(fmin(e, (real)69))));
+return ((*inside) ? (m2 / jp.bailout2 - (real)1) : (out));
+}
+inline lreal de_value(lreal m2, lreal dm2, lmask e)
+{
+lreal mq = fmax(m2, FLT_MIN);
+lreal ratio = ldexp(sqrt(mq / fmax(dm2, FLT_MIN)), -e / 2);
+ratio = (((e & 1) != 0) ? (ratio * (real)0.70710678118654752) : (ratio));
+return ratio * log(mq) / (real)4;
+}
+inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
+{
+quat q = (p);
+real4 c = (jp.c);
+lreal m2 = dot((q), (q));
+lreal dm2 = (lreal)1;
+lmask e = 0;
+lmask live = m2 <= jp.bailout2;
+int n = 0;
+for (; n < jp.max_iter && (live); ++n) {
+do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) { lmask k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + k_) : (e)); } } while (0);
+q = ((live) ? (julia_f(q, c)) : (q));
+m2 = dot((q), (q));
+live = m2 <= jp.bailout2;
+}
+;
+*escaped = m2 > jp.bailout2;
+return de_value(m2, dm2, e);
+}
+inline lreal julia_distance(quat p, julia_params jp)
+{
+lmask escaped;
+lreal d = julia_distance_formula(p, jp, &escaped);
+return ((escaped) ? (d) : ((lreal)0));
+}
+inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int steps,
+julia_params jp, lreal *width)
+{
+if (!(todo)) {
+*width = b - a;
+return a;
+}
+lmask inside;
+lreal fa = julia_level(((o) + (a) * (d)), jp, &inside);
+lreal fb = julia_level(((o) + (b) * (d)), jp, &inside);
+lreal ya = -fmax(fa, FLT_MIN), yb = -fmin(fb, (real)0);
+lreal w0 = b - a;
+lreal eps = ldexp(w0, -(steps + 1));
+lreal k1 = (real)0.2 / w0;
+lmask live = todo & (b - a > (real)2 * eps);
+for (int j = 0; j <= steps && (live); ++j) {
+lreal xh = (real)0.5 * (a + b);
+live &= (xh > a) & (xh < b);
+if (!(live))
+break;
+lreal r = ldexp(eps, steps + 1 - j) - (real)0.5 * (b - a);
+lreal delta = k1 * (b - a) * (b - a);
+lreal xf = ((yb != ya) ? ((yb * a - ya * b) / (yb - ya)) : (xh));
+lreal sigma = ((xh >= xf) ? ((lreal)1) : ((lreal)-1));
+lreal xt = ((delta <= fabs(xh - xf)) ? (xf + sigma * delta) : (xh));
+lreal x = ((fabs(xt - xh) <= r) ? (xt) : (xh - sigma * r));
+x = (((x > a) & (x < b)) ? (x) : (xh));
+lreal y = -julia_level(((o) + (x) * (d)), jp, &inside);
+lmask got_in = live & inside, got_out = live & !inside;
+b = ((got_in) ? (x) : (b));
+yb = ((got_in) ? (fmax(y, (real)0)) : (yb));
+a = ((got_out) ? (x) : (a));
+ya = ((got_out) ? (fmin(y, -FLT_MIN)) : (ya));
+live &= b - a > (real)2 * eps;
+}
+*width = b - a;
+return a;
+}
+inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
+int z_resolution, int post_steps, int max_steps, lmask *status,
+lmask *samples, lmask *flags, lreal *width)
+{
+lreal t = near, t_prev = near;
+lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
+for (int i = 0; i < max_steps && (active); ++i) {
+lmask out = active & (t > far);
+*samples = ((out) ? ((lmask)i) : (*samples));
+miss |= out;
+active &= !out;
+lmask escaped;
+lreal dist = julia_distance_formula(((o) + (t) * (d)), jp, &escaped);
+lmask got = active & !escaped;
+*samples = ((got) ? ((lmask)(i + 1)) : (*samples));
+hit |= got;
+if (i == 0)
+first = got;
+active &= !got;
+shell |= active & (dist < jp.epsilon);
+lreal next = t + fmax(dist, jp.epsilon);
+lmask stall = active & (next == t);
+next = ((stall) ? (nextafter(t, (lreal)INFINITY)) : (next));
+*flags |= ((stall) ? ((lmask)4) : ((lmask)0));
+t_prev = ((active) ? (t) : (t_prev));
+t = ((active) ? (next) : (t));
+}
+*samples = ((active) ? ((lmask)max_steps) : (*samples));
+*flags |= ((miss & shell) ? ((lmask)8) : ((lmask)0));
+*status = ((live) ? (((hit) ? ((lmask)1) : (((miss) ? ((lmask)0) : ((lmask)2))))) : (*status));
+lreal w;
+lreal a = refine_bracket(o, d, t_prev, t, hit & !first, post_steps, jp, &w);
+*width = ((hit) ? (((hit & !first) ? (w) : ((lreal)0))) : (*width));
+return ((hit) ? (((hit & !first) ? (a) : (t))) : ((lreal)INFINITY));
+}
+inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
+{
+quat q = (p);
+real4 c = (jp.c);
+quat j0 = (((real4)(((lreal)1), ((lreal)0), ((lreal)0), ((lreal)0))));
+quat j1 = (((real4)(((lreal)0), ((lreal)1), ((lreal)0), ((lreal)0))));
+quat j2 = (((real4)(((lreal)0), ((lreal)0), ((lreal)1), ((lreal)0))));
+quat j3 = (((real4)(((lreal)0), ((lreal)0), ((lreal)0), ((lreal)1))));
+lmask live = 1;
+for (int n = 0; n < jp.max_iter && (live); ++n) {
+lreal m2 = dot((q), (q));
+live &= m2 <= jp.bailout2;
+lmask tiny = live & (m2 < sqrt(FLT_MIN));
+*guard |= ((tiny) ? ((lmask)2) : ((lmask)0));
+live &= !tiny;
+if (!(live))
+break;
+j0 = ((live) ? (julia_f_jvp(q, j0)) : (j0));
+j1 = ((live) ? (julia_f_jvp(q, j1)) : (j1));
+j2 = ((live) ? (julia_f_jvp(q, j2)) : (j2));
+j3 = ((live) ? (julia_f_jvp(q, j3)) : (j3));
+q = ((live) ? (julia_f(q, c)) : (q));
+lreal s = fmax(fmax(length(j0), length(j1)), fmax(length(j2), length(j3)));
+lmask rescale = live & ((s > (real)1e12) | ((s < (real)1e-12) & (s > (real)0)));
+if ((rescale)) {
+lreal inv = (real)1 / s;
+j0 = ((rescale) ? (((inv) * (j0))) : (j0));
+j1 = ((rescale) ? (((inv) * (j1))) : (j1));
+j2 = ((rescale) ? (((inv) * (j2))) : (j2));
+j3 = ((rescale) ? (((inv) * (j3))) : (j3));
+}
+}
+return ((real4)((dot((q), (j0))), (dot((q), (j1))), (dot((q), (j2))), (dot((q), (j3)))));
+}
+inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *guard,
+lreal *nx, lreal *ny, lreal *nz)
+{
+real4 n = (real4)(dot(g, right), dot(g, up), -dot(g, forward), 0);
+real l = length(n);
+int ok = l > (real)0 && isfinite(l);
+n = ok ? n / l : (real4)(0, 0, 1, 0);
+*nx = n.x, *ny = n.y, *nz = n.z;
+*guard |= ((ok) ? ((lmask)0) : ((lmask)1));
+}
+__kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
+const real4 c, const int max_iter, const real bailout,
+const real4 right, const real4 up, const real4 forward,
+__global real4 *normal)
+{
+size_t i0 = get_global_id(0) * 1;
+if (i0 >= (size_t)n_items)
+return;
+julia_params jp = { c, bailout * bailout, 0, max_iter };
+if (status[i0] != 1) {
+normal[i0] = (real4)(0);
+return;
+}
+int guard = 0;
+real nx, ny, nz;
+to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+normal[i0] = (real4)(nx, ny, nz, (real)guard);
+}
