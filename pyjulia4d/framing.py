@@ -35,7 +35,11 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     tan_h = tan_v * scene.image.width / scene.image.height
     half = math.atan(min(tan_v, tan_h))
     d0 = 1.2 * radius / math.sin(half)
-    centre = np.zeros(4)          # the bounding ball is about the world origin (camera.march_radius)
+    # the bounding ball is about the world origin (camera.march_radius); the camera sees the
+    # 3D hyperplane through its eye spanned by right, up and forward (the slice, seed 000
+    # §4), so the pass looks at the point of that hyperplane nearest the ball's centre
+    rel = -np.asarray(fr.position, float)
+    centre = np.asarray(fr.position, float) + sum((rel @ v) * v for v in (fr.right, fr.up, fr.forward))
     eye = centre - d0 * fr.forward
     w, h = PROBE
     probe = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, eye)],
@@ -48,6 +52,8 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     if len(pts) == 0:
         return scene.replace(**{"camera.fit": False}), record
     c = pts.mean(axis=0)
+    # back onto the viewed hyperplane exactly (the hits are float32)
+    c = centre + sum(((c - centre) @ v) * v for v in (fr.right, fr.up, fr.forward))
     rel = pts - c
     x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
     dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),

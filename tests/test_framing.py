@@ -37,3 +37,14 @@ def test_fit_through_render():
     r = render(s)
     border = np.concatenate([r.alpha[0], r.alpha[-1], r.alpha[:, 0], r.alpha[:, -1]])
     assert r.hit_fraction > 0.1 and np.mean(border > 0) < 0.05
+
+
+def test_fit_keeps_the_slice():
+    """The pass looks in the camera's own hyperplane (the slice): slice.distance still moves
+    the section the picture shows, and the fitted camera stays in it."""
+    for d in (-0.6, 0.3):
+        s = Scene.from_dict({"camera": {"fit": True}}, [f"slice.distance={d}", "image.width=64", "image.height=48"])
+        r = render(s)
+        w = r.position[..., 3][r.status == 1]
+        assert w.size > 100 and np.allclose(w, d, atol=1e-6)
+        assert abs(r.scene.camera.position[3]) < 1e-9 and abs(r.scene.camera.target[3]) < 1e-9
