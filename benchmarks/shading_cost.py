@@ -41,6 +41,12 @@ VARIANTS = {
     "soft shadows + AO + trap": LIGHT + ["shading.shadow=soft", "shading.ao=0.8", "shading.coloring=trap"],
     "the default look (soft shadows, AO 0.6)": ["shading.light=-2,5,-4", "shading.shadow=soft", "shading.ao=0.6"],
     "fixed scan, hard shadows + AO": LIGHT + ["march.method=fixed", "shading.shadow=hard", "shading.ao=0.8"],
+    "three lights (2 in shading.lights), soft shadows": LIGHT + [
+        "shading.shadow=soft", "shading.lights=position 3,1,-2 color 0.3,0.5,1 intensity 0.8; "
+        "direction 0,-1,0.3 color 1,0.45,0.2 intensity 0.35"],
+    "reflection 0.35": ["shading.reflection=0.35"],
+    "the default look + reflection 0.35": ["shading.light=-2,5,-4", "shading.shadow=soft", "shading.ao=0.6",
+                                           "shading.reflection=0.35"],
 }
 
 

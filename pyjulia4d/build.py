@@ -93,6 +93,9 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     light = light_defines(scene)
     if light:
         pieces.append("shade/light")
+    if scene.shading.reflection > 0:   # one mirror bounce (shade/reflect.cl)
+        pieces.append("shade/reflect")
+        defines.append("REFLECTION")
     pieces.append("shade/shade")
     defines += light
     if scene.shading.specular > 0:

@@ -112,6 +112,18 @@ class Plan:
         return self.shades and "shade/light" in self.program.pieces
 
     @property
+    def reflects(self) -> bool:
+        """Whether the mirror bounce runs (shading.reflection > 0; shade/reflect.cl): only for shading."""
+        return self.shades and "shade/reflect" in self.program.pieces
+
+    @property
+    def reflect_program(self) -> build.KernelConfig:
+        """The march of the reflected rays: this plan's march reading given rays."""
+        if self.lanes > 1:
+            return build.march_config(self.scene, self.lanes, ray_buffers=True)
+        return build.scene_config(self.scene, ray_buffers=True)
+
+    @property
     def normals_in_march_program(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (build.march_config)."""
         return self.scene.normals.method == "jacobian"

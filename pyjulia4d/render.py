@@ -334,6 +334,14 @@ class TileRunner:
                 bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
             if plan.shades:
                 bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            if plan.reflects:   # the reflected rays, their march, normals and colour
+                for k in ("origins", "dirs", "point2", "normal2"):
+                    bufs[k] = cla.empty(self.queue, nmax, pr.vec_dtype)
+                for k in ("depth2", "bracket2"):
+                    bufs[k] = cla.empty(self.queue, nmax, pr.scalar)
+                for k in ("status2", "samples2", "flags2"):
+                    bufs[k] = cla.empty(self.queue, nmax, np.int32)
+                bufs["refl"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
             if plan.light_terms:
                 bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
                 bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.program.defines
@@ -375,6 +383,12 @@ class TileRunner:
         self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in geo]))
         self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in rgb]))
         self.extra_shadows = "EXTRA_SHADOWS" in plan.program.defines
+        if plan.reflects:
+            self.refl_prg = build.program(self.ctx, plan.reflect_program)
+            self.refl_march_k = cl.Kernel(self.refl_prg, "march")
+            self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
+            self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
+            self.refl_bias = pr.scalar(light_parameters(sc, plan.radius)["bias"])
 
     def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
                 ) -> tuple[list[cl.Event], list[cl.Event]]:
@@ -398,6 +412,8 @@ class TileRunner:
             if self.clip_k is not None:
                 kernels.append(launch(q, self.clip_k, n, bufs["flags"].data, bufs["status"].data, self.right,
                                       self.up, self.fwd, *self.clip_n, bufs["normal"].data))
+        if plan.reflects:
+            kernels += self.enqueue_reflection(tile, bufs)
         if plan.light_terms:
             kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
@@ -407,12 +423,39 @@ class TileRunner:
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
+            refl = bufs["refl"] if plan.reflects else self.no_terms
             kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
                                   bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
                                   self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
-                                  vis_extra.data, bufs["rgba"].data))
+                                  vis_extra.data, refl.data, np.float32(plan.scene.shading.reflection),
+                                  bufs["rgba"].data))
         copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
         return kernels, copies
+
+    def enqueue_reflection(self, tile: Tile, bufs: dict) -> list:
+        """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
+        march reading given rays, in the same packets), its normals and its colour."""
+        plan, pr, q, n = self.plan, self.pr, self.queue, tile.n
+        sh = plan.scene.shading
+        ev = [launch(q, self.reflect_rays_k, n, bufs["point"].data, bufs["normal"].data, bufs["status"].data,
+                     self.eye, self.right, self.up, self.fwd, self.refl_bias, pr.scalar(plan.radius),
+                     bufs["origins"].data, bufs["dirs"].data)]
+        ev.append(launch(q, self.refl_march_k, n, np.int32(tile.aw), bufs["origins"].data, bufs["dirs"].data,
+                         *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
+                         bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data, *self.clip_args,
+                         items=march_items(n, tile.aw, plan.lanes)))
+        packet = plan.normals_in_march_program
+        ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
+                                 plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],
+                                 size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))
+        if self.clip_k is not None:
+            ev.append(launch(q, self.clip_k, n, bufs["flags2"].data, bufs["status2"].data, self.right, self.up,
+                             self.fwd, *self.clip_n, bufs["normal2"].data))
+        ev.append(launch(q, self.reflect_color_k, n, bufs["status2"].data, bufs["normal2"].data,
+                         bufs["point2"].data, bufs["dirs"].data, self.right, self.up, self.fwd,
+                         pr.v4(plan.light), _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
+                         _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), bufs["refl"].data))
+        return ev
 
     def collect(self, tile: Tile, slot: int) -> dict[str, np.ndarray]:
         """The slot's staged arrays of ``tile``, shaped (ah, aw[, 4]) over its box (valid once

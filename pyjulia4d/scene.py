@@ -193,6 +193,7 @@ class Shading:
     fog: float = 0.0               # depth cueing: fade to the background by exp(-fog distance)
     sky: Vec3 = (1.0, 1.0, 1.0)    # colour of the ambient light (times ambient and occlusion)
     lights: tuple["Light", ...] = ()   # more lights beside ``light`` (at most MAX_LIGHTS)
+    reflection: float = 0.0        # share of one mirror bounce in the colour (shade/reflect.cl); 0 = off
 
 
 @dataclass(frozen=True)
@@ -615,6 +616,7 @@ _CHECKS: dict[str, dict[str, Checker]] = {
         "fog": _Real(0.0, 100.0),
         "sky": _Vector((3,), 0.0, 1e3),
         "lights": _Lights(MAX_LIGHTS),
+        "reflection": _Real(0.0, 1.0),
     },
     "image": {
         "width": _Integer(1, _INT_MAX),
@@ -972,6 +974,9 @@ class Scene:
         scene = cls(**parts)
         _check_camera(scene.camera)
         _check_fractal(scene)
+        if scene.shading.reflection > 0 and scene.normals.method == "zbuffer":
+            raise SceneError("shading.reflection", "needs normals.method \"jacobian\" or \"gradient\": the "
+                                                   "Z-buffer has no neighbours for reflected rays")
         m = scene.march
         if m.quality != "custom" and any(getattr(m, k) != v for k, v in preset_values(m.quality).items()):
             # a march key set after the preset: the resolved scene says what really runs

@@ -17,6 +17,7 @@ from pyjulia4d.scene import Scene
                                   ["shading.fog=0.7", "shading.background=0.3,0.4,0.5"],
                                   ["shading.sky=0.3,0.5,0.9", "shading.ambient=0.4",
                                    "shading.lights=position 3,1,-2 color 0.2,0.4,1 intensity 2; direction -1,0.5,0.2,0.3"],
+                                  ["shading.reflection=0.4", "shading.fog=0.3"],
                                   ["shading.light=eye", "shading.shadow=hard",
                                    "shading.lights=direction 0,1,0 color 1,0.8,0.6; position 0,0,-3,1 intensity 0.5; position 2,2,2"]])
 @pytest.mark.parametrize("fl", ["single", "double"])
@@ -42,6 +43,7 @@ def test_shade_matches_reference(over, fl):
     vis = rng.uniform(0, 1, (n, 4)) if "EXTRA_SHADOWS" in build.scene_config(s).defines else np.ones((n, 4))
     # light.cl's terms (the key light's visibility, occlusion, colour value): none here
     terms = np.tile([1.0, 1.0, 0.0, 0.0], (n, 1))
+    refl = rng.uniform(0, 1, (n, 4))   # reflect.cl's colour of the bounce (given here)
     out = R.out(n, cl.cltypes.float4)
     c4 = lambda v: cl.cltypes.make_float4(*[float(x) for x in v], 0.0)
     R("shade", (n,), R.buf(status, np.int32), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf4(point),
@@ -50,12 +52,12 @@ def test_shade_matches_reference(over, fl):
       c4(sh.light_color), c4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
       np.float32(sh.shininess), R.buf(terms, np.float32), R.buf(np.zeros((2, 4)), np.float32),
       np.int32(2), np.float32(sh.fog), np.float32(1.5), R.buf4(geo), R.buf(rgb, np.float32),
-      R.buf(vis, np.float32), out)
+      R.buf(vis, np.float32), R.buf(refl, np.float32), np.float32(sh.reflection), out)
     got = out.get().view(np.float32).reshape(n, 4)
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
                      sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5,
                      terms=terms, sky=sh.sky, lights_geo=geo if sh.lights else None, lights_rgb=rgb,
-                     vis_extra=vis)
+                     vis_extra=vis, refl=refl if sh.reflection > 0 else None, reflection=sh.reflection)
     # the shading itself is float32 in both variants (colour needs no more; shade.cl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
@@ -96,6 +98,9 @@ LIGHT_SCENES = {
                           "color 1,0.5,0.2 intensity 0.4"],
     "eye-and-lights-hard-fixed": ["march.method=fixed", "shading.light=eye", "shading.shadow=hard",
                                   "shading.lights=position -2,3,-3 intensity 0.7; direction 1,1,-1,0.2"],
+    "reflection": ["shading.reflection=0.5", "shading.background=0.2,0.3,0.5"],
+    "reflection-fixed-cut-eye": ["march.method=fixed", "shading.light=eye", "shading.reflection=0.3",
+                                 "clip.planes=0,0,-1,0.1", "normals.method=gradient"],
     "hypercomplex": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=0.5,0.8,0.2,0.1",
                      "fractal.max_iter=6", "camera.position=3.6,3.2,-4.4,0", "shading.light=-5,6,-3",
                      "shading.shadow=hard", "shading.ao=0.6", "shading.coloring=iteration"],
@@ -164,3 +169,60 @@ def test_every_switch_together_builds_and_stays_finite(extra):
     r = render(Scene.default().with_overrides(EVERYTHING + extra))
     assert np.all(np.isfinite(r.color)) and np.all(np.isfinite(r.alpha))
     assert r.hit_fraction > 0
+
+
+@pytest.mark.parametrize("light", ["eye", "2,3,-4"])
+@pytest.mark.parametrize("fl", ["single", "double"])
+def test_reflect_kernels_match_reference(light, fl):
+    """shade/reflect.cl's two kernels against their twins on the same random hits: the
+    reflected rays to float rounding of their precision, the bounce's colour to float32."""
+    s = Scene.default().with_overrides([f"shading.light={light}", "shading.reflection=0.5",
+                                        "shading.sky=0.3,0.5,0.9", f"render.float={fl}"])
+    R = Runner(build.scene_config(s))
+    fr = camera_frame(s)
+    rng = np.random.default_rng(7)
+    n = 3000
+    status = rng.integers(0, 3, n).astype(np.int32)
+    point = (rng.normal(size=(n, 4)) * 0.5).astype(R.real).astype(float)
+    nrm = rng.normal(size=(n, 3))
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm = nrm.astype(R.real).astype(float)
+    o, d = R.out4(n), R.out4(n)
+    R("reflect_rays", (n,), R.buf4(point), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf(status, np.int32),
+      R.vec(fr.position), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), R.scalar(0.01), R.scalar(2.0), o, d)
+    got_o, got_d = R.get4(o), R.get4(d)
+    want_o, want_d = ref.reflect_rays(point, nrm, status, fr, 0.01, 2.0)
+    tol = 1e-5 if fl == "single" else 1e-12
+    np.testing.assert_allclose(got_d, want_d, atol=tol)
+    np.testing.assert_allclose(got_o, want_o, atol=tol)
+    hit = status == 1
+    # a mirror keeps the angle: d'.n = -d.n, and |d'| = 1
+    nw = nrm[:, :1] * fr.right + nrm[:, 1:2] * fr.up - nrm[:, 2:3] * fr.forward
+    dv = point - fr.position
+    dv /= np.linalg.norm(dv, axis=1, keepdims=True)
+    np.testing.assert_allclose(np.sum(got_d * nw, 1)[hit], -np.sum(dv * nw, 1)[hit], atol=10 * tol)
+    sh = s.shading
+    lp = light_position(s)
+    c4 = lambda v: cl.cltypes.make_float4(*[float(x) for x in v], 0.0)
+    out = R.out(n, cl.cltypes.float4)
+    R("reflect_color", (n,), R.buf(status, np.int32), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf4(point),
+      R.buf4(want_d), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), R.vec(lp if lp is not None else fr.position),
+      c4(sh.color), c4(sh.background), c4(sh.light_color), c4(sh.sky), np.float32(sh.ambient),
+      np.float32(sh.diffuse), out)
+    got = out.get().view(np.float32).reshape(n, 4)
+    want = ref.reflect_color(status, nrm, point, want_d.astype(R.real).astype(float), fr, lp, sh.color,
+                             sh.background, sh.light_color, sh.sky, sh.ambient, sh.diffuse)
+    np.testing.assert_allclose(got, want, atol=2e-5)
+
+
+def test_reflection_shows_in_the_picture_and_zbuffer_is_refused():
+    from pyjulia4d.render import render
+    from pyjulia4d.scene import SceneError
+    base = Scene.default().with_overrides(["image.width=48", "image.height=36", "shading.background=0,0,1"])
+    plain, mirror = render(base), render(base.with_overrides(["shading.reflection=0.5"]))
+    np.testing.assert_array_equal(plain.depth, mirror.depth)
+    hit = plain.status == 1
+    # half the colour is now the bounce's: the blue background shows in the set's surface
+    assert mirror.color[hit][:, 2].mean() > plain.color[hit][:, 2].mean() + 0.05
+    with pytest.raises(SceneError, match=r"^shading\.reflection: needs normals\.method"):
+        base.with_overrides(["shading.reflection=0.5", "normals.method=zbuffer"])

@@ -11,7 +11,8 @@
  * shade/light.cl's terms (-D LIGHT_TERMS; else 1), and base the scene's colour or, with
  * -D COLORMAP, the colour map's entry for the hit's colour value (terms.z, linear
  * interpolation in a table of n_lut colours); -D FOG fades it toward the background with
- * distance.  All vectors in camera coordinates; linear light; output is float RGBA
+ * distance; -D REFLECTION mixes in the mirror bounce (shade/reflect.cl) before it.  All
+ * vectors in camera coordinates; linear light; output is float RGBA
  * whatever the precision. */
 
 __kernel void shade(const int n_items, __global const int *status, __global const real4 *normal,
@@ -22,7 +23,8 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
                     const float shininess, __global const float4 *terms, __global const float4 *lut,
                     const int n_lut, const float fog, const float fog_start,
                     __global const real4 *lights_geo, __global const float4 *lights_rgb,
-                    __global const float4 *vis_extra, __global float4 *rgba)
+                    __global const float4 *vis_extra, __global const float4 *refl,
+                    const float reflection, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -86,6 +88,9 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
 #endif
         rgb += add * lc.xyz;
     }
+#endif
+#ifdef REFLECTION
+    rgb = mix(rgb, refl[i].xyz, reflection);   /* shade/reflect.cl's one bounce */
 #endif
 #ifdef FOG
     /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the

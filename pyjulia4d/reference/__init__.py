@@ -650,6 +650,23 @@ def render(scene: Scene) -> RenderResult:
         else:
             normal = normals_zbuffer(point, depth, status, w, h, frame, guard)
         normal = clip_normals(guard, status, frame, planes, normal)
+        refl = None
+        if sh.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray
+            from ..render import light_parameters
+            from .shade import reflect_color, reflect_rays
+            radius = march_radius(scene)
+            o2, d2 = reflect_rays(point, normal, status, frame, light_parameters(scene, radius)["bias"], radius)
+            g2 = np.zeros(len(o2), np.int64)
+            _, p2, s2, _ = march(o2, d2, f.c, f.max_iter, f.bailout, m.epsilon, radius, near, far,
+                                 m.z_resolution, m.post_steps, m.max_steps, march_method(scene), g2, m.refine,
+                                 None, F, planes)
+            if scene.normals.method == "jacobian":
+                n2 = normals_jacobian(p2, s2, f.c, f.max_iter, f.bailout, frame, g2, F)
+            else:
+                n2 = normals_gradient(p2, s2, f.c, f.max_iter, f.bailout, gradient_step(scene), frame, g2, F)
+            n2 = clip_normals(g2, s2, frame, planes, n2)
+            refl = reflect_color(s2, n2, p2, d2, frame, light_position(scene), sh.color, sh.background,
+                                 sh.light_color, sh.sky, sh.ambient, sh.diffuse)
         from .shade import extra_visibility_of_scene, light_terms_of_scene, shade
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
@@ -659,7 +676,7 @@ def render(scene: Scene) -> RenderResult:
         rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
                      sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut,
                      sh.fog, fog_start(frame.position, march_radius(scene)), sh.sky, geo, rgb,
-                     extra_visibility_of_scene(scene, point, normal, status, F))
+                     extra_visibility_of_scene(scene, point, normal, status, F), refl, sh.reflection)
         return rgba, depth, point, status, smp, normal, guard, bracket
 
     planes = clip_planes(scene)
@@ -682,4 +699,4 @@ def render(scene: Scene) -> RenderResult:
     return res
 
 
-from .shade import light_terms, shade  # noqa: E402,F401  (kernels/shade/: ref.shade, ref.light_terms)
+from .shade import light_terms, reflect_color, reflect_rays, shade  # noqa: E402,F401  (kernels/shade/)

@@ -199,7 +199,8 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
           ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0,
-          sky=(1.0, 1.0, 1.0), lights_geo=None, lights_rgb=None, vis_extra=None):
+          sky=(1.0, 1.0, 1.0), lights_geo=None, lights_rgb=None, vis_extra=None, refl=None,
+          reflection=0.0):
     """Lambert (light at the eye by default, seed 001 §4) + ambient (times ``sky``) +
     Blinn-Phong, with the light's visibility and ambient occlusion from ``terms`` and the
     base colour from the colour table ``lut`` at terms' colour value; the lights of
@@ -251,6 +252,8 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
         lj = np.where(ln > 0, lj / np.where(ln > 0, ln, 1), v)
         vj = vis_extra[hit, j] if vis_extra is not None else np.ones(len(lam))
         rgb = rgb + lit(lj, vj) * np.asarray(lights_rgb[j, :3])[None, :]
+    if refl is not None:   # the mirror bounce (shade/reflect.cl), before depth cueing
+        rgb = rgb * (1 - reflection) + refl[hit, :3] * reflection
     if fog > 0:   # depth cueing toward the background (shade.cl, -D FOG)
         t = np.linalg.norm(point[hit] - frame.position, axis=-1)   # the 4D distance, as shade.cl
         k = np.exp(-fog * np.maximum(t - fog_start, 0.0))[:, None]
@@ -258,3 +261,48 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     rgba[hit, :3] = rgb
     rgba[hit, 3] = 1.0
     return rgba
+
+
+def reflect_rays(point, normal, status, frame: Frame, bias, radius):
+    """shade/reflect.cl reflect_rays: (origins, dirs) of the mirror bounce d' = d - 2 (d . n) n
+    from p + bias n for hits; a ray leaving the bounding ball elsewhere."""
+    n_items = len(status)
+    origins = np.tile([4.0 * radius, 0.0, 0.0, 0.0], (n_items, 1))
+    dirs = np.tile([1.0, 0.0, 0.0, 0.0], (n_items, 1))
+    k = np.nonzero(status == STATUS_HIT)[0]
+    if k.size == 0:
+        return origins, dirs
+    nc = normal[k]
+    nw = nc[:, :1] * frame.right + nc[:, 1:2] * frame.up - nc[:, 2:3] * frame.forward
+    d = point[k] - frame.position
+    dl = np.linalg.norm(d, axis=-1, keepdims=True)
+    d = np.where(dl > 0, d / np.where(dl > 0, dl, 1), frame.forward)
+    r = d - 2 * _dot(d, nw)[:, None] * nw
+    rl = np.linalg.norm(r, axis=-1, keepdims=True)
+    dirs[k] = np.where(rl > 0, r / np.where(rl > 0, rl, 1), -d)
+    origins[k] = point[k] + bias * nw
+    return origins, dirs
+
+
+def reflect_color(status, normal, point, dirs, frame: Frame, light_pos, color, background, light_color,
+                  sky, ambient, diffuse):
+    """shade/reflect.cl reflect_color: color (ambient sky + diffuse max(n . l, 0) light_color) on
+    the reflected hits, l towards the light (back along the ray for the light at the eye);
+    the background elsewhere.  RGBA (alpha 1 on hits)."""
+    out = np.zeros((len(status), 4))
+    out[:, :3] = background
+    k = np.nonzero(status == STATUS_HIT)[0]
+    if k.size == 0:
+        return out
+    nc = normal[k]
+    nw = nc[:, :1] * frame.right + nc[:, 1:2] * frame.up - nc[:, 2:3] * frame.forward
+    if light_pos is None:
+        l = -dirs[k]
+    else:
+        l = np.asarray(light_pos, np.float64) - point[k]
+        ll = np.linalg.norm(l, axis=-1, keepdims=True)
+        l = np.where(ll > 0, l / np.where(ll > 0, ll, 1), -dirs[k])
+    lam = np.maximum(_dot(nw, l), 0.0)
+    out[k, :3] = np.asarray(color) * (ambient * np.asarray(sky) + diffuse * lam[:, None] * np.asarray(light_color))
+    out[k, 3] = 1.0
+    return out
