@@ -29,20 +29,15 @@ order (camera.py): limbo' = unit(limbo - (limbo.f) f), up' = unit(up - (up.f) f 
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-from .scene import (MAX_SCENE_BYTES, Scene, SceneError, _CHECKS, _Integer, _OrWord, _Real, _Vector,
-                    _show, _show_key, override_key)
+from .scene import (Scene, SceneError, _CHECKS, _Integer, _OrWord, _Real, _Vector, _show, _show_key,
+                    override_key, read_scene_table)
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 INTERPOLATIONS = ("linear", "smooth", "catmull-rom")
 MAX_FRAMES = 1_000_000
@@ -188,28 +183,6 @@ class Animation:
         return Animation(base, self.tracks, self.frames, self.fps, self.interpolation)
 
 
-def _read_table(path: str | Path) -> dict[str, Any]:
-    """The TOML table of a scene file, read as Scene.from_toml reads it (bounded, UTF-8)."""
-    where = _show_key(str(path))
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_SCENE_BYTES + 1)
-    except (OSError, ValueError) as e:
-        raise SceneError(where, f"cannot read: {getattr(e, 'strerror', None) or e}") from None
-    if len(data) > MAX_SCENE_BYTES:
-        raise SceneError(where, f"larger than {MAX_SCENE_BYTES // 2**20} MiB, not a scene file")
-    try:
-        return tomllib.loads(data.decode("utf-8"))
-    except UnicodeDecodeError as e:
-        raise SceneError(where, f"invalid TOML: not UTF-8 ({e.reason})") from None
-    except RecursionError:
-        raise SceneError(where, "invalid TOML: nested too deeply") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(where, f"invalid TOML: {' '.join(str(e).split())}") from None
-    except ValueError:
-        raise SceneError(where, "invalid TOML: a number too long to read") from None
-
-
 def _animation_settings(table: Any, overrides: list[tuple[str, str]]) -> dict[str, Any]:
     """[animation]: frames (integer >= 1), fps (> 0), interpolation; overrides (key, text) last."""
     if table is None:
@@ -306,7 +279,7 @@ def load(path: str | Path, overrides: Iterable[str] = ()) -> Animation:
     per frame, the camera would jump as the set changes.  Keyframes that set
     camera.position or camera.target turn that default off; with camera.fit = true they
     are an error."""
-    table = _read_table(path)
+    table = read_scene_table(path)
     return from_table(table, overrides)
 
 

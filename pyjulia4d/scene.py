@@ -723,6 +723,30 @@ def _toml_value(v: Any) -> str:
 # ---------------------------------------------------------------- scene
 
 
+def read_scene_table(path: str | Path) -> dict[str, Any]:
+    """The TOML table of a scene file: a bounded read (/dev/zero or a stray multi-gigabyte
+    file is refused, not loaded), UTF-8, every failure one SceneError naming the path
+    (Scene.from_toml, keyframes.load)."""
+    where = _show_key(str(path))
+    try:
+        with open(path, "rb") as f:
+            data = f.read(MAX_SCENE_BYTES + 1)
+    except (OSError, ValueError) as e:  # ValueError: a NUL in the path
+        raise SceneError(where, f"cannot read: {getattr(e, 'strerror', None) or e}") from None
+    if len(data) > MAX_SCENE_BYTES:
+        raise SceneError(where, f"larger than {MAX_SCENE_BYTES // 2**20} MiB, not a scene file")
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise SceneError(where, f"invalid TOML: not UTF-8 ({e.reason})") from None
+    except RecursionError:
+        raise SceneError(where, "invalid TOML: nested too deeply") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(where, f"invalid TOML: {' '.join(str(e).split())}") from None
+    except ValueError:  # int() of an integer of over 4300 digits
+        raise SceneError(where, "invalid TOML: a number too long to read") from None
+
+
 def _sub(a: tuple[float, ...], b: tuple[float, ...]) -> list[float]:
     return [x - y for x, y in zip(a, b)]
 
@@ -943,25 +967,7 @@ class Scene:
     @classmethod
     def from_toml(cls, path: str | Path, overrides: Iterable[str] = ()) -> Scene:
         """Read a TOML scene file (at most MAX_SCENE_BYTES), then apply overrides."""
-        where = _show_key(str(path))
-        try:
-            # a bounded read: /dev/zero or a stray multi-gigabyte file is refused, not loaded
-            with open(path, "rb") as f:
-                data = f.read(MAX_SCENE_BYTES + 1)
-        except (OSError, ValueError) as e:  # ValueError: a NUL in the path
-            raise SceneError(where, f"cannot read: {getattr(e, 'strerror', None) or e}") from None
-        if len(data) > MAX_SCENE_BYTES:
-            raise SceneError(where, f"larger than {MAX_SCENE_BYTES // 2**20} MiB, not a scene file")
-        try:
-            table = tomllib.loads(data.decode("utf-8"))
-        except UnicodeDecodeError as e:
-            raise SceneError(where, f"invalid TOML: not UTF-8 ({e.reason})") from None
-        except RecursionError:
-            raise SceneError(where, "invalid TOML: nested too deeply") from None
-        except tomllib.TOMLDecodeError as e:
-            raise SceneError(where, f"invalid TOML: {' '.join(str(e).split())}") from None
-        except ValueError:  # int() of an integer of over 4300 digits
-            raise SceneError(where, "invalid TOML: a number too long to read") from None
+        table = read_scene_table(path)
         return cls.from_dict(table, overrides)
 
     @classmethod
