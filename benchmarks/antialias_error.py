@@ -11,10 +11,13 @@ alpha to one of the 8 neighbours.  The cost is the median over --repeats renders
 kernels' own time (RenderResult.kernel_seconds) and of the wall time, as ratios to
 samples = 1 measured in the same run (the machine is shared and noisy).  For the adaptive
 modes, the share of pixels flagged and of pixels the sample passes ran over (whole 8x8
-blocks) are listed too.  Writes benchmarks/results/antialias.md (a section per run:
-device, date, commit); --pictures DIR also writes each mode's PNG, to look at.
+blocks) are listed too; --thresholds 16 4 adds 4-sample adaptive rows with the flag
+threshold (antialias.THRESHOLD, 1/64) set to 1/16 and 1/4.  Writes
+benchmarks/results/antialias.md (a section per run: device, date, commit); --pictures DIR
+also writes each mode's PNG, to look at.
 
-    python benchmarks/antialias_error.py [--size 320x240] [--repeats 3] [--pictures DIR]
+    python benchmarks/antialias_error.py [--size 320x240] [--repeats 3] [--thresholds 256 16 4]
+                                         [--pictures DIR]
 """
 from __future__ import annotations
 
@@ -46,6 +49,7 @@ SCENES = {
 MODES = [("1", 1, False), ("4", 4, False), ("4 adaptive", 4, True), ("9", 9, False),
          ("9 adaptive", 9, True)]
 REFERENCE = 16
+DEFAULT_THRESHOLD = antialias.THRESHOLD
 EDGE_STEP = 0.1   # sRGB step to a neighbour that makes a reference pixel an edge pixel
 
 
@@ -88,6 +92,8 @@ def main(argv=None) -> int:
     ap.add_argument("--scenes", nargs="*", default=list(SCENES), choices=list(SCENES))
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     ap.add_argument("--pictures", type=Path, default=None)
+    ap.add_argument("--thresholds", type=int, nargs="*", default=[],
+                    help="denominators d: also 4-sample adaptive with threshold 1/d")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
     w, h = (int(x) for x in a.size.split("x"))
@@ -101,7 +107,9 @@ def main(argv=None) -> int:
         rows = []
         wall1 = kern1 = None
         centre = None
-        for label, n, adaptive in MODES:
+        modes = MODES + [(f"4 adaptive, threshold 1/{d}", 4, True, 1.0 / d) for d in a.thresholds]
+        for label, n, adaptive, *threshold in modes:
+            antialias.THRESHOLD = threshold[0] if threshold else DEFAULT_THRESHOLD
             s = base.with_overrides([f"image.samples={n}", f"image.adaptive={'true' if adaptive else 'false'}"])
             r, wall, kern = timed(s, a.repeats)
             if n == 1:
@@ -121,7 +129,9 @@ def main(argv=None) -> int:
                 from pyjulia4d.output import write_png
                 a.pictures.mkdir(parents=True, exist_ok=True)
                 slug = name.split(" ")[0] + ("_sin" if "sin" in name else "")
-                write_png(a.pictures / f"{slug}_{label.replace(' ', '_')}.png", r.color, r.alpha)
+                tag = "".join(ch if ch.isalnum() else "_" for ch in label)
+                write_png(a.pictures / f"{slug}_{tag}.png", r.color, r.alpha)
+        antialias.THRESHOLD = DEFAULT_THRESHOLD
         sections.append(
             f"\n### {name} ({march_method(base)} march; {100 * edges.mean():.1f} % edge pixels)\n\n"
             "| samples | edge mean | edge p99 | all mean | all p99 | kernels s | kernels / 1 | "

@@ -6,8 +6,8 @@ The rule (reference.flag_edges is its float64 twin, tests/test_antialias.py chec
 - a pixel is *flagged* when one of its 8 neighbours differs from it in alpha (hit/miss or
   partial cover) or in any colour channel by more than THRESHOLD, colour compared
   sRGB-encoded - the values a PNG stores (output.write_png) and a viewer shows, so that a
-  step is judged alike in the darks and the lights (in linear light 1/64 is 11 of 255 sRGB
-  codes near black and under 1 code near white).  8 neighbours, not 4: a fractal's
+  step is judged alike in the darks and the lights (a linear step of 1/64 is 33 of 255
+  sRGB codes up from black and under 2 near white).  8 neighbours, not 4: a fractal's
   silhouette has corners and filaments that run diagonally between pixel centres, which a
   diagonal neighbour sees first; the extra cost is a one-pixel ring (benchmarks/antialias_error.py
   measures the flagged share);
@@ -22,11 +22,27 @@ from __future__ import annotations
 
 import numpy as np
 
-from .colormap import linear_to_srgb
 from .plan import Tile, make_tiles
 
 THRESHOLD = 1.0 / 64.0   # largest sRGB-encoded (or alpha) step between neighbours left alone
-BLOCK = 8                # side of the blocks the sample passes run over (whole ray packets, as calibrate.PROBE_BOX)
+# Side of the blocks the sample passes run over.  Larger blocks run more unflagged pixels
+# but in fewer launches, and the launches cost more: on PoCL (2 cores) the default scene
+# with image.samples = 4 took 1.82 / 1.61 / 1.44 kernel seconds at 1280x960 and 0.18 /
+# 0.15 / 0.14 at 320x240 with blocks of 8 / 16 / 32 (render().kernel_seconds, medians of
+# 2 and 5 renders, 2026-11-25); uniform passes took 1.53 and 0.12 s.
+BLOCK = 32
+
+
+def _srgb32(x: np.ndarray) -> np.ndarray:
+    """colormap.linear_to_srgb (IEC 61966-2-1) in float32: a megapixel in a fraction of
+    its time (flags a step of the threshold alike to ~1e-7)."""
+    x = np.clip(np.asarray(x, np.float32), np.float32(0), np.float32(1))
+    lo = x <= np.float32(0.0031308)
+    out = np.power(x, np.float32(1 / 2.4), dtype=np.float32)
+    out *= np.float32(1.055)
+    out -= np.float32(0.055)
+    out[lo] = x[lo] * np.float32(12.92)
+    return out
 
 
 def flag_edges(color: np.ndarray | None, alpha: np.ndarray, threshold: float | None = None) -> np.ndarray:
@@ -34,10 +50,11 @@ def flag_edges(color: np.ndarray | None, alpha: np.ndarray, threshold: float | N
     ``threshold`` (default THRESHOLD) in alpha or in a channel of the sRGB-encoded ``color``
     (linear light, (H, W, 3); None: alpha alone)."""
     t = THRESHOLD if threshold is None else threshold
-    chans = [np.nan_to_num(np.asarray(alpha, np.float64), nan=0.0)[..., None]]
+    h, w = np.shape(alpha)
+    v = np.empty((h, w, 4 if color is not None else 1), np.float32)
+    v[..., -1] = np.nan_to_num(alpha, nan=0.0)
     if color is not None:
-        chans.insert(0, linear_to_srgb(np.nan_to_num(np.asarray(color, np.float64), nan=0.0)))
-    v = np.concatenate(chans, axis=-1)
+        v[..., :3] = _srgb32(np.nan_to_num(color, nan=0.0))
     out = np.zeros(v.shape[:2], bool)
     # each unordered pair of neighbours once (right, down, down-right, down-left); a pair
     # that differs flags both its pixels

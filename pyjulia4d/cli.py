@@ -58,7 +58,7 @@ def _parser() -> argparse.ArgumentParser:
                         "its bracket), N (normal), P (4D position); default all.  Z alone skips normals "
                         "and shading and keeps 8 bytes per pixel: the way to render huge depth maps")
     r.add_argument("--force", action="store_true",
-                   help="render settings whose estimated work is refused as hopeless (hours)")
+                   help="render settings refused for their work: predicted over 6 hours by a probe render, or hopeless per ray")
     _cluster_options(r, "tiles of the image")
 
     a = sub.add_parser("animate", help="render a keyframed scene to numbered frames and a video")

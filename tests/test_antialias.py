@@ -86,7 +86,8 @@ def test_flag_rule_steps_in_srgb_and_alpha_over_8_neighbours():
     np.testing.assert_array_equal(f, ref.flag_edges(c, a, t))
 
 
-def test_block_tiles_cover_the_flagged_blocks_alone():
+def test_block_tiles_cover_the_flagged_blocks_alone(monkeypatch):
+    monkeypatch.setattr(antialias, "BLOCK", 8)   # several blocks in a small region
     rng = np.random.default_rng(2)
     region, W, H = (5, 3, 37, 29), 50, 40
     flags = rng.random((29, 37)) > 0.97
@@ -165,3 +166,52 @@ def test_adaptive_colour_matches_reference(over):
     dc = np.abs(k.color - r.color).max(axis=-1)
     assert np.median(dc) < 1e-3 and np.mean(dc < 0.3) > 0.99
     np.testing.assert_allclose(k.alpha.mean(), r.alpha.mean(), atol=0.01)
+
+
+def test_progress_total_is_the_adaptive_work(monkeypatch):
+    import sys
+
+    rmod = sys.modules["pyjulia4d.render"]   # the package's render is the function
+
+    bars = []
+
+    class Bar:   # the progress bar render() drives: its total and what it was told was done
+        def __init__(self, total, enabled):
+            self.total, self.n = total, 0
+            bars.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return None
+
+    monkeypatch.setattr(rmod, "_progress", Bar)
+    monkeypatch.setattr(antialias, "BLOCK", 8)   # blocks of background in a small image
+    s = Scene.default().with_overrides(SMALL + ["image.samples=4", "image.adaptive=true"])
+    render(s, calibrate=False)
+    render(s, calibrate=False, region=(5, 4, 20, 20))
+    (whole, part) = bars
+    assert whole.n == whole.total < 40 * 30 * 5   # the blocks alone, not every pixel 4 times
+    assert part.n == part.total   # the ring around the region counted too
+
+
+def test_antialias_benchmark_runs(tmp_path):
+    """benchmarks/antialias_error.py, tiny, so that it cannot rot."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "antialias_error.py"
+    spec = importlib.util.spec_from_file_location("antialias_error", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--size", "40x30", "--repeats", "1", "--scenes", "default", "--thresholds", "16",
+                     "--out", str(tmp_path)]) == 0
+    assert antialias.THRESHOLD == 1.0 / 64.0   # restored
+    md = (tmp_path / "antialias.md").read_text()
+    assert "commit " in md and "| 9 adaptive |" in md and "| 4 adaptive, threshold 1/16 |" in md
+    rows = [line.split("|") for line in md.splitlines() if line.startswith("| 1 |")]
+    assert len(rows) == 1 and float(rows[0][7]) == 1.0   # the ratios are to one sample
