@@ -700,12 +700,14 @@ def _set_total(bar, total: int) -> None:
 
 
 class _LineProgress:
-    """Progress for a stderr that is not a terminal (a log file, a pipe): whole lines, at most
-    one per ``every`` seconds and none for renders shorter than that - no carriage returns."""
+    """Progress for a stderr that is not a terminal (a log file, a pipe): whole lines, the
+    first after ``first`` seconds (none for renders shorter than that), then at most one per
+    ``every`` seconds - no carriage returns."""
 
-    def __init__(self, total: int, every: float = 10.0):
+    def __init__(self, total: int, every: float = 10.0, first: float = 3.0):
         self.total, self.every, self.n = total, every, 0
-        self.t0 = self.last = time.perf_counter()
+        self.t0 = time.perf_counter()
+        self.last = self.t0 - every + first
 
     def update(self, k: int) -> None:
         self.n += k

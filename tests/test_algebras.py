@@ -255,7 +255,18 @@ def test_jacobian_normal_is_the_gradient(algebra, function):
     assert np.median(cos) > 1 - 1e-8 and np.mean(cos > 0.9999) > 0.95
 
 
-@pytest.mark.parametrize("algebra,function", PAIRS)
+# whole renders of every pair take ~2 s each to build from cold: a sample runs by default
+# (each algebra, the polynomial, exponential, trigonometric, logarithmic, reciprocal and
+# power families), the rest is marked slow (setup.cfg); every function's piece, step,
+# inside test and Jacobian are checked above for all pairs
+RENDER_SAMPLE = {("quaternion", "sqr"), ("quaternion", "cube"), ("hypercomplex", "sqr"), ("hypercomplex", "cube"),
+                 ("hypercomplex", "exp"), ("hypercomplex", "sin"), ("hypercomplex", "atanh"),
+                 ("hypercomplex", "ln"), ("hypercomplex", "reciprocal"), ("hypercomplex", "pwr"),
+                 ("cquat", "sqr"), ("commutative", "cube")}
+
+
+@pytest.mark.parametrize("algebra,function", [
+    pytest.param(a, f, marks=[] if (a, f) in RENDER_SAMPLE else [pytest.mark.slow]) for a, f in PAIRS])
 def test_render_matches_reference(algebra, function):
     # the whole pipeline on a 40 x 30 image: hit masks, certified depth and Jacobian normals
     # of the kernels against the float64 reference render

@@ -561,7 +561,7 @@ def test_signal_during_a_real_render(sig: int, tmp_path) -> None:
                                 preexec_fn=_default_signals)
     try:
         # stderr is a file, not a terminal: progress comes as whole lines ("render: N% ..."),
-        # the first once the render has run for 10 s, and never a carriage return
+        # the first once the render has run for 3 s, and never a carriage return
         assert _wait_for(lambda: b"render: " in err_path.read_bytes(), 60), err_path.read_text()
         assert b"\r" not in err_path.read_bytes()
         assert proc.poll() is None, "the render finished before the signal"

@@ -315,6 +315,7 @@ def test_new_keys_refused_with_the_key(over, key):
     assert str(e.value).startswith(f"{key}: ") and "\n" not in str(e.value)
 
 
+@pytest.mark.slow   # builds every kind's configuration (~25 s from cold); the benchmark is the sweep
 def test_kinds_gallery_runs(tmp_path):
     # benchmarks/kinds_gallery.py end to end on tiny images: every picture, the sheet, and an
     # error row per scene and setting, each with a finite time and a silhouette error in [0, 1]
