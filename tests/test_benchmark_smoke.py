@@ -2,6 +2,7 @@
 import csv
 import importlib.util
 from pathlib import Path
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -98,6 +99,7 @@ def test_iteration_counter_counts_exactly():
     assert r["iterations"] == 9 * 7 * 37 and r["hit"] == 1.0
 
 
+@pytest.mark.slow   # builds a program per packet width and precision (~9 s from cold)
 def test_throughput_report_runs(tmp_path):
     tp = load("throughput")
     assert tp.main(["--size", "16x12", "--repeats", "1", "--widths", "1,4", "--out", str(tmp_path)]) == 0
