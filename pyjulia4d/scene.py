@@ -888,9 +888,6 @@ def _check_fractal(scene: "Scene") -> None:
         if f.theta != 0:
             raise SceneError("fractal.theta", "the rotation leaves a Mandelbrot set unchanged (its orbits are "
                              "the unrotated ones times e^(i theta)): set 0")
-        if scene.shading.coloring in ("iteration", "trap"):
-            raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the Julia orbit of "
-                             f"fractal.c, not a Mandelbrot set's; use flat or w")
     if f.kind == "julia_stack":
         _check_stack(scene)
     if f.kind == "cubic_locus":

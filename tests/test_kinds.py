@@ -301,7 +301,6 @@ def test_truth_uses_the_quaternion_oracles_for_plain_julia_sets_only():
 @pytest.mark.parametrize("over,key", [
     (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=sin"], "fractal.kind"),
     (["fractal.kind=mandelbrot", "fractal.theta=10"], "fractal.theta"),
-    (["fractal.kind=mandelbrot", "shading.coloring=iteration"], "shading.coloring"),
     (["fractal.kind=mandelbrot", "march.quality=draft"], "march.quality"),
     (["fractal.kind=mandelbrot", "fractal.algebra=cquat", "march.method=de"], "march.method"),
     (["fractal.theta=10", "fractal.algebra=hypercomplex"], "fractal.theta"),

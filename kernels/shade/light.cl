@@ -76,16 +76,27 @@ inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real 
  * surface lies to the limit set (the outside end is no use: the truncated set's surface is
  * where orbits escape at max_iter, so its escape count is the same everywhere).  Trap:
  * 1 - exp(-3 min_n |q_n - trap|) over the outside end's orbit. */
+/* The orbit a colour follows: q_0 = p under q -> f(q) + c for a Julia set; for a
+ * Mandelbrot set (kind/mandelbrot.cl) the orbit of the critical point 0 with c = p, from
+ * q_1 = c (so its count starts at 1). */
+#ifdef KIND_MANDELBROT
+#define ORBIT_START(p) quat oc_ = ALG_IN(p); quat q = oc_
+#define ORBIT_F(q) mandel_f(q, oc_)
+#define ORBIT_N0 1
+#else
+#define ORBIT_START(p) real4 oc_ = ALG_C(jp.c); quat q = ALG_IN(p)
+#define ORBIT_F(q) julia_f(q, oc_)
+#define ORBIT_N0 0
+#endif
 #ifdef COLOR_ITERATION
 inline lreal orbit_value(quat p, julia_params jp)
 {
-    quat q = ALG_IN(p);
-    real4 c = ALG_C(jp.c);
+    ORBIT_START(p);
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
-    lmask n = 0;
-    for (int k = 0; k < 4 * jp.max_iter && L_ANY(live); ++k) {
-        q = QSEL(q, julia_f(q, c), live);
+    lmask n = ORBIT_N0;
+    for (int k = ORBIT_N0; k < 4 * jp.max_iter && L_ANY(live); ++k) {
+        q = QSEL(q, ORBIT_F(q), live);
         m2 = L_SEL(m2, ALG_NORM2(q), live);
         n = L_SEL(n, n + 1, live);
         live &= m2 <= jp.bailout2;
@@ -99,14 +110,13 @@ inline lreal orbit_value(quat p, julia_params jp)
 #ifdef COLOR_TRAP
 inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 {
-    quat q = ALG_IN(p);
-    real4 c = ALG_C(jp.c);
+    ORBIT_START(p);
     quat tq = QSCALE((lreal)-1, ALG_IN(QUAT((lreal)trap.x, (lreal)trap.y, (lreal)trap.z, (lreal)trap.w)));
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
     lreal best = ALG_NORM2(QADD(q, tq));
-    for (int k = 0; k < jp.max_iter && L_ANY(live); ++k) {
-        q = QSEL(q, julia_f(q, c), live);
+    for (int k = ORBIT_N0; k < jp.max_iter && L_ANY(live); ++k) {
+        q = QSEL(q, ORBIT_F(q), live);
         m2 = ALG_NORM2(q);
         live &= m2 <= jp.bailout2;
         best = L_SEL(best, fmin(best, ALG_NORM2(QADD(q, tq))), live);

@@ -61,20 +61,30 @@ def ambient_occlusion(p, nw, c, max_iter, bailout, dist, strength, F: Formula = 
     return np.clip(1 - strength * occ / wsum, 0.0, 1.0)
 
 
-def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR):
+def _orbit_start(p, c, F: Formula, mandelbrot: bool):
+    """(q_start, step(q, live) -> f(q) + c on the live points, first index): the Julia orbit
+    of p, or for a Mandelbrot set that of 0 with c = p from q_1 = c (shade/light.cl ORBIT_*)."""
+    if mandelbrot:
+        from .kind.mandelbrot import mandel_f
+        cp = F.ALG_IN(np.asarray(p, np.float64))
+        return cp.copy(), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
+    cc = F.ALG_C(np.asarray(c, np.float64))
+    return F.ALG_IN(p).copy(), (lambda q, live: F.julia_f(q[live], cc)), 0
+
+
+def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
     """Smooth escape count of p iterated up to 4 max_iter, as (nu - max_iter) / (3 max_iter);
     1 where it never escapes (shade/light.cl orbit_value, COLOR_ITERATION)."""
-    q = F.ALG_IN(p).copy()
-    cc = F.ALG_C(np.asarray(c, np.float64))
+    q, step, n0 = _orbit_start(p, c, F, mandelbrot)
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
-    n = np.zeros(len(q))
+    n = np.full(len(q), float(n0))
     live = m2 <= b2
     with np.errstate(all="ignore"):
-        for _ in range(4 * max_iter):
+        for _ in range(n0, 4 * max_iter):
             if not live.any():
                 break
-            q[live] = F.julia_f(q[live], cc)
+            q[live] = step(q, live)
             m2[live] = F.ALG_NORM2(q[live])
             n[live] += 1
             live &= m2 <= b2
@@ -84,20 +94,19 @@ def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR):
     return np.where(m2 > b2, v, 1.0)
 
 
-def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR):
+def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
     """1 - exp(-3 min_n |q_n - trap|) over the orbit while inside the bailout (COLOR_TRAP)."""
-    q = F.ALG_IN(p).copy()
-    cc = F.ALG_C(np.asarray(c, np.float64))
+    q, step, n0 = _orbit_start(p, c, F, mandelbrot)
     tq = F.ALG_IN(np.asarray(trap, np.float64))
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
     live = m2 <= b2
     best = F.ALG_NORM2(q - tq)
     with np.errstate(all="ignore"):
-        for _ in range(max_iter):
+        for _ in range(n0, max_iter):
             if not live.any():
                 break
-            q[live] = F.julia_f(q[live], cc)
+            q[live] = step(q, live)
             m2 = F.ALG_NORM2(q)
             live &= m2 <= b2
             best = np.where(live, np.minimum(best, F.ALG_NORM2(q - tq)), best)
@@ -106,7 +115,7 @@ def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR):
 
 def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame: Frame, light_pos,
                 radius, step, bias, softness, max_steps, ao_distance, ao_strength, trap,
-                shadow="none", ao=False, coloring="flat", F: Formula = QUATERNION_SQR):
+                shadow="none", ao=False, coloring="flat", F: Formula = QUATERNION_SQR, mandelbrot=False):
     """(visibility, ambient factor, colour value, 0) per item, (1, 1, 0, 0) off hits."""
     n = len(status)
     out = np.tile(np.array([1.0, 1.0, 0.0, 0.0]), (n, 1))
@@ -128,9 +137,9 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
     if coloring == "iteration":
         dirs = p - np.asarray(eye, np.float64)
         dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
-        out[k, 2] = orbit_iteration(p + bracket[k, None] * dirs, c, max_iter, bailout, F)
+        out[k, 2] = orbit_iteration(p + bracket[k, None] * dirs, c, max_iter, bailout, F, mandelbrot)
     elif coloring == "trap":
-        out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F)
+        out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F, mandelbrot)
     elif coloring == "w":
         out[k, 2] = np.clip(0.5 + p[:, 3] / radius, 0.0, 1.0)
     return out
@@ -194,7 +203,7 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     return light_terms(point, normal, status, bracket, fr.position, f.c, f.max_iter, f.bailout, fr,
                        light if light is not None else fr.position, radius, lp["step"], lp["bias"],
                        lp["softness"], lp["max_steps"], lp["ao_distance"], lp["ao_strength"], lp["trap"],
-                       shadow, sh.ao > 0, sh.coloring, F)
+                       shadow, sh.ao > 0, sh.coloring, F, f.kind == "mandelbrot")
 
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
