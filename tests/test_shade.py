@@ -159,12 +159,18 @@ EVERYTHING = ["shading.light=-3,4,-2", "shading.ao=0.5", "shading.fog=0.3", "cli
 
 
 @pytest.mark.parametrize("extra", [
-    ["shading.shadow=soft", "shading.coloring=iteration"],
-    ["shading.shadow=hard", "shading.coloring=trap", "march.method=fixed", "normals.method=zbuffer"],
-    ["shading.shadow=soft", "shading.coloring=w", "render.float=double", "normals.method=gradient"],
-    ["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin"],
-    ["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0"],
-    ["shading.shadow=soft", "fractal.algebra=hypercomplex", "fractal.function=cube", "render.variant=scalar"],
+    ["shading.shadow=soft", "shading.coloring=iteration", "shading.reflection=0.3",
+     "shading.lights=position 2,1,-2; direction 0,-1,0 intensity 0.3"],
+    ["shading.shadow=hard", "shading.coloring=trap", "march.method=fixed", "normals.method=zbuffer",
+     "image.adaptive=true"],
+    ["shading.shadow=soft", "shading.coloring=w", "render.float=double", "normals.method=gradient",
+     "shading.reflection=0.5", "shading.lights=direction 1,1,-1 color 0.2,0.3,1"],
+    ["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin",
+     "shading.lights=position -2,2,-2; position 2,-2,-2; position 0,3,0"],
+    ["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0", "fractal.kind=mandelbrot",
+     "fractal.max_iter=8", "shading.reflection=0.2"],
+    ["shading.shadow=soft", "fractal.algebra=hypercomplex", "fractal.function=cube", "render.variant=scalar",
+     "shading.reflection=0.4", "image.adaptive=true", "shading.sky=0.5,0.6,1"],
 ])
 def test_every_switch_together_builds_and_stays_finite(extra):
     # the -D switches of one scene meet in one program: none may clash (a shared name, a
