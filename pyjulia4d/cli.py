@@ -160,8 +160,12 @@ def _render(args: argparse.Namespace) -> int:
         tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
     write_image(out, result, header)
     w, h = scene.image.width, scene.image.height
+    why = ""
+    if args.device is None and args.workers is None and args.scheduler is None and hasattr(device, "int_ptr"):
+        from .devices import default_reason
+        why = f" ({default_reason(device)})"
     print(
-        f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}, "
+        f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}{why}, "
         f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
     return 0

@@ -118,6 +118,22 @@ def describe_devices() -> str:
     return "\n".join(out)
 
 
+def default_reason(dev: cl.Device) -> str:
+    """Why select_device(None) picked ``dev``, for the closing line: its index, and the
+    devices passed over before it (a device of the wanted type that cannot compile)."""
+    rows = _indexed()
+    at = next((k for k, (_, _, d) in enumerate(rows) if d.int_ptr == dev.int_ptr), len(rows))
+    idx = rows[at][0] if at < len(rows) else "?"
+    kind = device_type(dev)
+    skipped = [i for i, _, d in rows[:at] if device_type(d) == kind and compile_error(d)]
+    why = f"{idx}, the default: the first {kind} that compiles"
+    if kind != "GPU":
+        why += ", no GPU"
+    if skipped:
+        why += f"; {', '.join(skipped)} cannot compile"
+    return why
+
+
 def select_device(spec: str | None = None) -> cl.Device:
     """Pick a device.
 

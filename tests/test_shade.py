@@ -236,3 +236,17 @@ def test_reflection_shows_in_the_picture_and_zbuffer_is_refused():
     assert mirror.color[hit][:, 2].mean() > plain.color[hit][:, 2].mean() + 0.05
     with pytest.raises(SceneError, match=r"^shading\.reflection: needs normals\.method"):
         base.with_overrides(["shading.reflection=0.5", "normals.method=zbuffer"])
+
+
+def test_lights_and_reflection_compile_only_where_used():
+    """shade/reflect.cl and the extra lights' code are compiled only in scenes that use them
+    (-D REFLECTION, -D EXTRA_LIGHTS=k, -D EXTRA_SHADOWS)."""
+    plain = Scene.default()
+    src = build.source(build.scene_config(plain))
+    assert '"shade/reflect.cl"' not in src and "EXTRA_LIGHTS" not in build.scene_config(plain).defines
+    lit = plain.with_overrides(["shading.lights=position 1,2,3; direction 0,1,0", "shading.reflection=0.2"])
+    cfg = build.scene_config(lit)
+    assert '"shade/reflect.cl"' in build.source(cfg)
+    assert {"REFLECTION", "EXTRA_LIGHTS=2", "EXTRA_SHADOWS"} <= set(cfg.defines)
+    # no shadows: the extra lights shine, but no shadow rays are compiled for them
+    assert "EXTRA_SHADOWS" not in build.scene_config(lit.with_overrides(["shading.shadow=none"])).defines
