@@ -937,6 +937,9 @@ class Scene:
             raise SceneError("scene", f"expected a table, got {_show(data)}")
         raw: dict[str, dict[str, Any]] = {name: {} for name in _CHECKS}
         for section, table in data.items():
+            if section in ("animation", "keyframe"):   # keyframes.py reads these
+                raise SceneError(section, "a keyframed scene: render its frames with "
+                                          "'python -m pyjulia4d animate' (or --frames N:N for one)")
             if section not in _CHECKS:
                 raise SceneError(_show_key(str(section)), "unknown key")
             if not isinstance(table, Mapping):

@@ -424,3 +424,9 @@ def test_fit_is_the_default_without_a_camera_position(camera, fit) -> None:
     # a resolved scene says it, so it reads back the same
     s = Scene.from_dict({"camera": camera})
     assert Scene.from_dict(tomllib.loads(s.to_toml())) == s
+
+
+def test_a_keyframed_scene_points_to_animate() -> None:
+    for table in ({"animation": {"frames": 3}}, {"keyframe": [{"frame": 0}]}):
+        with pytest.raises(SceneError, match=r"^(animation|keyframe): a keyframed scene: render its frames with "):
+            Scene.from_dict(table)
