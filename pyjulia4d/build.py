@@ -20,7 +20,7 @@ import pyopencl as cl
 
 from .devices import cache_dir, cannot_compile, compile_error, device_key
 from .resources import kernel_dir
-from .scene import Scene, march_method
+from .scene import MANDELBROT_START, Scene, march_method
 
 
 @dataclass(frozen=True)
@@ -57,6 +57,8 @@ def fractal_defines(scene: Scene) -> tuple[str, ...]:
         out += (f"ROTATE_COS={math.cos(t)!r}", f"ROTATE_SIN={math.sin(t)!r}")
     if f.kind != "julia":
         out += (f"KIND_{f.kind.upper()}",)
+    if f.kind == "mandelbrot" and any(MANDELBROT_START[f.function]):   # q_1 = v + c (kind/mandelbrot.cl)
+        out += tuple(f"MANDEL_V_{a}={v!r}" for a, v in zip("XYZW", MANDELBROT_START[f.function]))
     if f.kind == "julia_stack":   # c(u) = c_mid + u c_half (kind/julia_stack.cl), in float64 here
         (r0, i0), (r1, i1) = f.c_from, f.c_to
         out += (f"STACK_CM_RE={(r0 + r1) / 2!r}", f"STACK_CM_IM={(i0 + i1) / 2!r}",

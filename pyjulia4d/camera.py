@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import Scene, SceneError, escape_degree, march_method
+from .scene import MANDELBROT_START, Scene, SceneError, escape_degree, march_method
 
 
 def cross4(a, b, c) -> np.ndarray:
@@ -153,7 +153,7 @@ def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) ->
     return min(float(bailout), s)
 
 
-def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2) -> float:
+def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2, start: float = 0.0) -> float:
     """Radius of a 4-ball that provably holds every c with |q_n| <= bailout for n = 1..max_iter,
     q_1 = c, q_{n+1} = q_n^degree + c (kernels/kind/mandelbrot.cl).
 
@@ -161,11 +161,11 @@ def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2) -> 
     (|q^D + c| >= |q|^D - |c|), and r > R = 2^(1/(D-1)) (where R^D - R = R), s_n grows with n
     and with r (ds_{n+1}/dr = D s_n^(D-1) ds_n/dr - 1 >= 1); so the c that stay within b for N
     steps have r <= max(R, r*), r* the least r >= R with some s_n > b, found by bisection
-    (widened by 1e-9 relative).  ``degree`` None (no norm bound): the bailout, widened as in
-    bounding_radius."""
+    (widened by 1e-9 relative).  ``degree`` None (no norm bound): |q_1| = |v + c| <= b
+    alone, so b + |v| (``start``, the critical value's norm), widened as in bounding_radius."""
     b = float(bailout)
     if degree is None:
-        return b * (1.0 + 2.0 ** -20)
+        return (b + float(start)) * (1.0 + 2.0 ** -20)
     R = 2.0 ** (1.0 / (degree - 1))
     if b <= R:
         return b
@@ -211,7 +211,8 @@ def march_radius(scene: Scene) -> float:
     estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
     f = scene.fractal
     if f.kind == "mandelbrot":
-        r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f))
+        r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f),
+                              float(np.linalg.norm(MANDELBROT_START[f.function])))
     elif f.kind == "julia_stack":
         r = stack_radius(scene)
     elif f.kind == "cubic_locus":   # kernels/kind/cubic_locus.cl: drawn within |p| <= locus_radius,

@@ -59,6 +59,17 @@ FUNCTIONS_OF = {"quaternion": ("sqr", "cube"), "hypercomplex": FUNCTIONS, "cquat
 # The polynomial maps, by degree: they escape to infinity like |q|^degree, which gives the
 # bounding ball and the distance estimate (camera.bounding_radius, iterate.cl).
 POLYNOMIAL_DEGREE = {"sqr": 2, "cube": 3}
+# fractal.kind = "mandelbrot": the critical (or asymptotic) value v of f, in the point's own
+# coordinates, so that q_1 = v + c (kernels/kind/mandelbrot.cl).  0 for the powers (critical
+# point 0), exp and reciprocal (the asymptotic value 0: their orbit of the singular value c);
+# 1 for cos and cosh (critical point 0) and sin (pi/2); i for sinh (i pi/2), component by
+# component in the hypercomplex split, where (1, 0, 0, 0) and (0, 1, 0, 0) are 1 and i in both
+# components.  Functions with several singular values (tan, tanh) or none (ln, the inverse
+# functions) have no one Mandelbrot set and are refused.
+MANDELBROT_START = {"sqr": (0.0, 0.0, 0.0, 0.0), "cube": (0.0, 0.0, 0.0, 0.0), "exp": (0.0, 0.0, 0.0, 0.0),
+                    "reciprocal": (0.0, 0.0, 0.0, 0.0), "pwr": (0.0, 0.0, 0.0, 0.0),
+                    "cos": (1.0, 0.0, 0.0, 0.0), "cosh": (1.0, 0.0, 0.0, 0.0), "sin": (1.0, 0.0, 0.0, 0.0),
+                    "sinh": (0.0, 1.0, 0.0, 0.0)}
 # Algebras where |q^D| >= |q|^D, so that the escape bound holds: quaternions (the norm is
 # multiplicative) and the hypercomplex numbers (the power mean of their two complex
 # components).  CQuats and the commutative rules have zero divisors with |q^2| < |q|^2.
@@ -882,9 +893,13 @@ def _check_fractal(scene: "Scene") -> None:
                          f"fractal.algebra=hypercomplex for it")
     pair = f"{f.algebra} {f.function}"
     if f.kind == "mandelbrot":
-        if f.function not in POLYNOMIAL_DEGREE:
-            raise SceneError("fractal.kind", f"mandelbrot starts the orbit at the critical point 0 of sqr and cube; "
-                             f"{f.function} has no critical point there: use fractal.function=sqr or cube")
+        if f.function not in MANDELBROT_START:
+            raise SceneError("fractal.kind", f"mandelbrot follows the orbit of f's one critical or asymptotic "
+                             f"value; {f.function} has several or none: use one of "
+                             f"{', '.join(MANDELBROT_START)}")
+        if f.function == "pwr" and f.exponent[0] <= 1:
+            raise SceneError("fractal.exponent", f"mandelbrot with pwr needs a critical point at 0, "
+                             f"real part above 1, got {f.exponent[0]!r}")
         if f.theta != 0:
             raise SceneError("fractal.theta", "the rotation leaves a Mandelbrot set unchanged (its orbits are "
                              "the unrotated ones times e^(i theta)): set 0")

@@ -8,7 +8,7 @@ import pytest
 from harness import Runner, packet_widths
 from pyjulia4d import build, reference as ref
 from pyjulia4d.camera import mandelbrot_radius
-from pyjulia4d.reference.formula import Formula
+from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.kind import rotate
 from pyjulia4d.render import STATUS_HIT, render
 from pyjulia4d.scene import Scene, SceneError
@@ -299,7 +299,10 @@ def test_truth_uses_the_quaternion_oracles_for_plain_julia_sets_only():
 
 
 @pytest.mark.parametrize("over,key", [
-    (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=sin"], "fractal.kind"),
+    (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=tan"], "fractal.kind"),
+    (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=ln"], "fractal.kind"),
+    (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=pwr", "fractal.exponent=1,0.5"],
+     "fractal.exponent"),
     (["fractal.kind=mandelbrot", "fractal.theta=10"], "fractal.theta"),
     (["fractal.kind=mandelbrot", "march.quality=draft"], "march.quality"),
     (["fractal.kind=mandelbrot", "fractal.algebra=cquat", "march.method=de"], "march.method"),
@@ -331,3 +334,41 @@ def test_kinds_gallery_runs(tmp_path):
     rows = list(csv.DictReader(open(tmp_path / "kinds_error.csv")))
     assert len(rows) == sum(len(mod.settings(Scene.default().with_overrides(o))) for o, _ in mod.ERROR.values())
     assert all(float(r["kernel_s"]) > 0 and 0 <= float(r["silhouette_err"]) <= 1 for r in rows)
+
+
+@pytest.mark.parametrize("function,start", [("cos", 1), ("sin", 1), ("sinh", 1j), ("exp", 0), ("reciprocal", 0)])
+def test_transcendental_mandelbrot_on_the_complex_plane(function, start):
+    """On the plane (x, y, 0, 0) both hypercomplex components are x + iy, so the twin's set is
+    the complex one: c whose orbit of f's critical (or asymptotic) value, z_1 = v + c, stays
+    within the bailout (scene.MANDELBROT_START), against plain complex numpy."""
+    s = Scene.default().with_overrides(["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex",
+                                        f"fractal.function={function}", "fractal.max_iter=8"])
+    F = formula_of(s.fractal)
+    x, y = np.meshgrid(np.linspace(-4, 4, 121), np.linspace(-3, 3, 91))
+    pts = np.stack([x.ravel(), y.ravel(), 0 * x.ravel(), 0 * x.ravel()], -1)
+    inside = ref.julia_inside(pts, (0, 0, 0, 0), 8, 4.0, F)
+    c = x.ravel() + 1j * y.ravel()
+    fn = {"cos": np.cos, "sin": np.sin, "sinh": np.sinh, "exp": np.exp, "reciprocal": lambda z: 1 / z}[function]
+    z = start + c
+    ok = np.abs(z) <= 4
+    with np.errstate(all="ignore"):
+        for _ in range(7):
+            z = np.where(ok, fn(z) + c, z)
+            ok &= np.abs(z) <= 4
+    assert 0.05 < ok.mean() < 0.95
+    np.testing.assert_array_equal(inside, ok)
+
+
+@pytest.mark.parametrize("function", ["cos", "sinh"])
+def test_transcendental_mandelbrot_kernel_matches_twin(function):
+    # the whole pipeline (fixed scan: no estimate for these) against the float64 render, the
+    # twin framing the camera from its own float64 pass as render() does
+    s = Scene.from_dict({}, ["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex",
+                             f"fractal.function={function}", "fractal.max_iter=8", "image.width=40",
+                             "image.height=30"])
+    k, r = render(s), ref.render(s)
+    assert k.hit_fraction > 0.1
+    assert np.mean(k.status == r.status) > 0.99
+    both = (k.status == 1) & (r.status == 1)
+    assert np.median(np.abs(k.depth[both] - r.depth[both])) < 1e-4
+    assert np.all(np.isfinite(k.color))

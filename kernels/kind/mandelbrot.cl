@@ -5,22 +5,28 @@
  * primitive as the Julia sets).  The point p is c (in the algebra's coordinates ALG_IN(p),
  * per lane), q_0 = 0 and q_1 = f(0) + c = c exactly, so the orbit starts there: p is inside
  * when |q_n| <= bailout for n = 1 .. max_iter (q_0 = 0 always is).  fractal.c is unused.
+ * Other functions start from their critical value, q_1 = v + c (MANDEL_START below).
  *
  * Compiled after iterate.cl (its de_value, DE_GROW, JULIA_DF2): the set test, level function
  * and distance estimate below take over the names julia_inside, julia_level,
  * julia_distance_formula and julia_distance for every later piece (march, refine, gradient
  * normals, shadows); normals/jacobian.cl has its own -D KIND_MANDELBROT branch. */
-#ifndef FUNC_POWER
-#error "a Mandelbrot set takes sqr and cube only (critical point 0; scene._check_fractal)"
-#endif
-
 /* f(q) + c with c a lane value (the point), f the algebra's own (julia_f at c = 0) */
 inline quat mandel_f(quat q, quat c) { return QADD(julia_f(q, (real4)(0)), c); }
+
+/* q_1 = v + c: v the critical or asymptotic value of f (scene.MANDELBROT_START, compiled in as
+ * -D MANDEL_V_X.. in the point's coordinates: 1 for cos, cosh and sin, i for sinh); 0 for the
+ * powers, exp and reciprocal, which compile nothing here. */
+#ifdef MANDEL_V_X
+#define MANDEL_START(c) QADD(c, ALG_IN(QUAT((lreal)MANDEL_V_X, (lreal)MANDEL_V_Y, (lreal)MANDEL_V_Z, (lreal)MANDEL_V_W)))
+#else
+#define MANDEL_START(c) (c)
+#endif
 
 inline lmask mandel_inside(quat p, julia_params jp)
 {
     quat c = ALG_IN(p);
-    quat q = c;
+    quat q = MANDEL_START(c);
     lmask live = ALG_NORM2(q) <= jp.bailout2;
     int n = 1;
     for (; n < jp.max_iter && L_ANY(live); ++n) {
@@ -35,7 +41,7 @@ inline lmask mandel_inside(quat p, julia_params jp)
 inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
 {
     quat c = ALG_IN(p);
-    quat q = c;
+    quat q = MANDEL_START(c);
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
     lmask steps = 1;                /* q_1 = c: one iteration done */
@@ -73,7 +79,7 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
 inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat c = ALG_IN(p);
-    quat q = c;
+    quat q = MANDEL_START(c);
     lreal m2 = ALG_NORM2(q);
     lreal dr = (lreal)1;
     lmask e = 0;                    /* dr is really dr * 2^e */
@@ -97,7 +103,7 @@ inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
 inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat c = ALG_IN(p);
-    quat q = c;
+    quat q = MANDEL_START(c);
     lreal m2 = ALG_NORM2(q);
     lreal da = (lreal)1, db = (lreal)1;
     lmask ea = 0, eb = 0;

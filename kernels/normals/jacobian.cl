@@ -20,6 +20,7 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
     /* the point is c (kind/mandelbrot.cl): q_1 = c, J_1 = dq_1/dp = ALG_IN, and
      * J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings below) */
     quat c = q;
+    q = MANDEL_START(c);            /* q_1 = v + c: J_1 is the same */
     quat e0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
     quat e1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
     quat e2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));

@@ -80,7 +80,7 @@ inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real 
  * Mandelbrot set (kind/mandelbrot.cl) the orbit of the critical point 0 with c = p, from
  * q_1 = c (so its count starts at 1). */
 #ifdef KIND_MANDELBROT
-#define ORBIT_START(p) quat oc_ = ALG_IN(p); quat q = oc_
+#define ORBIT_START(p) quat oc_ = ALG_IN(p); quat q = MANDEL_START(oc_)
 #define ORBIT_F(q) mandel_f(q, oc_)
 #define ORBIT_N0 1
 #else

@@ -624,8 +624,14 @@ def render(scene: Scene) -> RenderResult:
     """The whole pipeline in float64 numpy (slow: for small images).  With image.samples = S
     > 1 the colour and alpha are the mean of S more passes through stratified samples of
     each pixel (rays.cl sample_offset); everything else comes from the pixel centres.  With
-    image.adaptive, only the pixels flag_edges flags in the centre pass take that mean."""
+    image.adaptive, only the pixels flag_edges flags in the centre pass take that mean.
+    camera.fit frames the set as render.render does (framing.py), from a float64 first
+    pass: the camera may differ from the kernels' in its last bits (their pass is float32),
+    so compare with ``reference.render(result.scene)`` for the kernels' own camera."""
     t0 = time.perf_counter()
+    if scene.camera.fit:
+        from ..framing import fit_camera
+        scene, _ = fit_camera(scene, lambda s, outs: render(s))
     frame = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
     sh = scene.shading
@@ -693,7 +699,7 @@ def render(scene: Scene) -> RenderResult:
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
                        samples=smp.reshape(h, w), bracket=bracket.reshape(h, w),
-                       device_name="numpy float64 reference",
+                       device_name="numpy float64 reference", scene=scene,
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

@@ -65,9 +65,9 @@ def _orbit_start(p, c, F: Formula, mandelbrot: bool):
     """(q_start, step(q, live) -> f(q) + c on the live points, first index): the Julia orbit
     of p, or for a Mandelbrot set that of 0 with c = p from q_1 = c (shade/light.cl ORBIT_*)."""
     if mandelbrot:
-        from .kind.mandelbrot import mandel_f
+        from .kind.mandelbrot import mandel_f, mandel_start
         cp = F.ALG_IN(np.asarray(p, np.float64))
-        return cp.copy(), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
+        return mandel_start(F, cp), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
     cc = F.ALG_C(np.asarray(c, np.float64))
     return F.ALG_IN(p).copy(), (lambda q, live: F.julia_f(q[live], cc)), 0
 

@@ -9,6 +9,13 @@ import numpy as np
 REAL_MIN = np.finfo(np.float64).tiny
 
 
+def mandel_start(F, c):
+    """q_1 = v + c, v f's critical or asymptotic value (scene.MANDELBROT_START; kind/mandelbrot.cl
+    MANDEL_START), in the algebra's coordinates."""
+    from ...scene import MANDELBROT_START
+    return c + F.ALG_IN(np.asarray(MANDELBROT_START[F.function], np.float64))
+
+
 def mandel_f(F, q, c):
     """f(q) + c with c per point (the kernel's julia_f(q, 0) + c)."""
     return F.julia_f(q, np.zeros(4)) + c
@@ -17,7 +24,7 @@ def mandel_f(F, q, c):
 def mandel_inside(p, max_iter, bailout, F):
     """|q_n| <= bailout for n = 1 .. max_iter, q_1 = c = ALG_IN(p)."""
     c = F.ALG_IN(np.array(p, dtype=np.float64))
-    q = c.copy()
+    q = mandel_start(F, c)
     b2 = bailout * bailout
     out = np.ones(q.shape[:-1], bool)
     with np.errstate(all="ignore"):
@@ -33,7 +40,7 @@ def mandel_level(p, max_iter, bailout, F):
     """F = |q_N|^2 / b^2 - 1, an escape at n < N extrapolated as in reference.julia_level.
     Returns (F, inside)."""
     c = F.ALG_IN(np.array(p, dtype=np.float64))
-    q = c.copy()
+    q = mandel_start(F, c)
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
     n = np.ones(m2.shape, np.int64)
@@ -70,7 +77,7 @@ def mandel_distance_formula(p, max_iter, bailout, F):
     the bound (float64 needs no mantissa-exponent split below 1e300); the split algebra's is
     sqrt(d_a^2 + d_b^2) / sqrt(2).  Returns (d, escaped)."""
     c = F.ALG_IN(np.array(p, dtype=np.float64))
-    q = c.copy()
+    q = mandel_start(F, c)
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
     live = np.ones(m2.shape, bool)
@@ -106,8 +113,8 @@ def mandel_normal_jacobian(p, max_iter, bailout, F, guard=None, tiny_flag=0):
     """grad_p |q_N|^2 = 2 J^T q_N with J_1 = ALG_IN, J_{n+1} = f'(q_n) J_n + ALG_IN
     (normals/jacobian.cl, -D KIND_MANDELBROT), rescaled both ways with the added identity
     kept at J's scale; the same underflow stop as the Julia normal."""
-    q = F.ALG_IN(np.array(p, np.float64)).copy()
-    c = q.copy()
+    c = F.ALG_IN(np.array(p, np.float64)).copy()
+    q = mandel_start(F, c)
     E = F.ALG_IN(np.eye(4))
     J = np.broadcast_to(E, q.shape[:-1] + (4, 4)).copy()
     unit = np.ones(q.shape[:-1])
