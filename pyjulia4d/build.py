@@ -37,9 +37,10 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
     f = scene.fractal
     power = ("algebra/power",) if f.algebra in ("cquat", "commutative") else ()
     # fractal.theta != 0: the rotated map (kind/rotate.cl); fractal.kind other than "julia":
-    # its set test after iterate.cl (kind/<kind>.cl).  The default compiles neither.
+    # its set test after iterate.cl (kind/<kind>.cl, with kind/level.cl).  The default compiles
+    # neither.
     rotate = ("kind/rotate",) if f.theta != 0 else ()
-    kind = (f"kind/{f.kind}",) if f.kind != "julia" else ()
+    kind = ("kind/level", f"kind/{f.kind}") if f.kind != "julia" else ()
     return (("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power + rotate
             + ("iterate",) + kind)
 

@@ -91,6 +91,20 @@ def _signals_held() -> Iterator[None]:
             old[caught[0]](caught[0], None)  # the first one's exception, now
 
 
+def check_directory(shown: str, parent: Path) -> None:
+    """The one-line errors for an output whose directory ``parent`` is missing, unreadable or
+    not a directory (images, scene files, videos); ``shown`` names the output."""
+    try:
+        st = os.stat(parent)
+    except FileNotFoundError:
+        raise OutputError(f"{shown}: directory {_quoted(parent)} does not exist") from None
+    except (OSError, ValueError) as e:
+        raise OutputError(f"{shown}: directory {_quoted(parent)}: "
+                          f"{getattr(e, 'strerror', None) or e}") from None
+    if not stat.S_ISDIR(st.st_mode):
+        raise OutputError(f"{shown}: {_quoted(parent)} is not a directory")
+
+
 def check_output_path(path: str | Path) -> Path:
     """Fail before rendering if ``path`` cannot take the image: its format, its
     directory, the length of its name and path (the temp file's too), and a temp
@@ -107,15 +121,7 @@ def check_output_path(path: str | Path) -> Path:
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent
-    try:
-        st = os.stat(parent)
-    except FileNotFoundError:
-        raise OutputError(f"{shown}: directory {_quoted(parent)} does not exist") from None
-    except (OSError, ValueError) as e:
-        raise OutputError(f"{shown}: directory {_quoted(parent)}: "
-                          f"{getattr(e, 'strerror', None) or e}") from None
-    if not stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: {_quoted(parent)} is not a directory")
+    check_directory(shown, parent)
     name_max = _limit(parent, "PC_NAME_MAX", _NAME_MAX)
     path_max = _limit(parent, "PC_PATH_MAX", _PATH_MAX)  # counts the terminating NUL
     name = len(os.fsencode(p.name))

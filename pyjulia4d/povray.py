@@ -1210,7 +1210,7 @@ def import_pov(path: str | Path, width: int | None = None, height: int | None = 
 def check_toml_path(path: str | Path, source: str | Path) -> Path:
     """Fail before writing if ``path`` cannot take the scene file (output.check_output_path's
     checks, for .toml)."""
-    from .output import _NAME_MAX, OutputError, _limit, _quoted, _shown
+    from .output import _NAME_MAX, OutputError, _limit, _quoted, _shown, check_directory
 
     raw = os.fspath(path)
     shown = _shown(raw)
@@ -1222,14 +1222,7 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
         raise OutputError(f"{shown}: unsupported output format {got} (use .toml)")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
-    try:
-        st = os.stat(p.parent)
-    except FileNotFoundError:
-        raise OutputError(f"{shown}: directory {_quoted(p.parent)} does not exist") from None
-    except (OSError, ValueError) as e:
-        raise OutputError(f"{shown}: directory {_quoted(p.parent)}: {getattr(e, 'strerror', None) or e}") from None
-    if not stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: {_quoted(p.parent)} is not a directory")
+    check_directory(shown, p.parent)
     try:
         st = os.stat(p)
     except (FileNotFoundError, ValueError):

@@ -10,13 +10,12 @@ video is written atomically (output.py: a temp file beside it, renamed).
 from __future__ import annotations
 
 import os
-import stat
 from pathlib import Path
 from typing import Iterable, Iterator
 
 import numpy as np
 
-from .output import OutputError, _atomic, _quoted, _shown
+from .output import OutputError, _atomic, _quoted, _shown, check_directory
 
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 # H.264's constant rate factor and VP9's constant quality (lower is better; both about
@@ -36,14 +35,7 @@ def check_video_path(path: str | os.PathLike) -> Path:
     if ext not in CODECS:
         got = _quoted(ext) if ext else "'(none)'"
         raise OutputError(f"{shown}: unsupported video format {got} (use .mp4 or .webm)")
-    try:
-        st = os.stat(p.parent)
-    except FileNotFoundError:
-        raise OutputError(f"{shown}: directory {_quoted(p.parent)} does not exist") from None
-    except (OSError, ValueError) as e:
-        raise OutputError(f"{shown}: directory {_quoted(p.parent)}: {getattr(e, 'strerror', None) or e}") from None
-    if not stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: {_quoted(p.parent)} is not a directory")
+    check_directory(shown, p.parent)
     if p.is_dir():
         raise OutputError(f"{shown}: is a directory")
     if not os.access(p.parent, os.W_OK | os.X_OK):

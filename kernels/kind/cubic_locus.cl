@@ -57,9 +57,7 @@ inline lreal locus_level(quat p, julia_params jp, lmask *inside)
     }
     COUNT_ITER(jp, n);
     lmask zin = m2 <= jp.bailout2;
-    lmask k = jp.max_iter - steps;
-    lreal e = log(m2 / jp.bailout2) * pow((lreal)3, convert_lreal(min(k, 60)));
-    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
+    lreal out = kind_level(m2, jp.bailout2, jp.max_iter - steps, 3);
     lreal fz = L_SEL(out, m2 / jp.bailout2 - (real)1, zin);
     lreal fb = QNORM2(p) / (real)(LOCUS_R2) - (real)1;
     *inside = zin & (fb <= (real)0);

@@ -54,13 +54,7 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
     }
     COUNT_ITER(jp, n - 1);
     *inside = m2 <= jp.bailout2;
-    lmask k = jp.max_iter - steps;
-#if JULIA_GROWTH == 2
-    lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
-#else
-    lreal e = log(m2 / jp.bailout2) * pow((lreal)JULIA_GROWTH, convert_lreal(min(k, 60)));
-#endif
-    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
+    lreal out = kind_level(m2, jp.bailout2, jp.max_iter - steps, JULIA_GROWTH);
     return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
 }
 

@@ -34,6 +34,7 @@ from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
 from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
 from .. import colormap  # noqa: E402
 from .kind import mandelbrot as _mandelbrot  # noqa: E402
+from .kind.level import kind_level  # noqa: E402
 from .kind import julia_stack as _stack  # noqa: E402
 from .kind import cubic_locus as _locus  # noqa: E402
 
@@ -88,17 +89,7 @@ def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
             m2[live] = F.ALG_NORM2(q[live])
             n[live] += 1
     inside = m2 <= b2
-    k = max_iter - n
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        kk = np.minimum(k, 60)
-        if F.growth == 2:
-            e = np.ldexp(np.log(m2 / b2), kk.astype(np.int32))
-        else:
-            e = np.log(m2 / b2) * float(F.growth) ** kk
-        # the kernel's fmin(e, 69) takes 69 for a NaN e (an orbit gone to NaN)
-        e = np.where(np.isnan(e), 69.0, e)
-        out = np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
-    return np.where(inside, m2 / b2 - 1.0, out), inside
+    return np.where(inside, m2 / b2 - 1.0, kind_level(m2, b2, max_iter - n, F.growth)), inside
 
 
 def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):

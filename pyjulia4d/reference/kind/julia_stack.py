@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .level import kind_level
+
 REAL_MIN = np.finfo(np.float64).tiny
 
 
@@ -51,12 +53,7 @@ def stack_level(p, max_iter, bailout, F):
             m2[live] = z[live].real ** 2 + z[live].imag ** 2
             n[live] += 1
     zin = m2 <= b2
-    k = max_iter - n
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        e = np.ldexp(np.log(m2 / b2), np.minimum(k, 60).astype(np.int32))
-        e = np.where(np.isnan(e), 69.0, e)
-        out = np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
-    fz = np.where(zin, m2 / b2 - 1.0, out)
+    fz = np.where(zin, m2 / b2 - 1.0, kind_level(m2, b2, max_iter - n, 2))
     fu = np.abs(u) - 1.0
     return np.maximum(fz, fu), zin & (fu <= 0)
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .level import kind_level
+
 REAL_MIN = np.finfo(np.float64).tiny
 
 
@@ -54,16 +56,7 @@ def mandel_level(p, max_iter, bailout, F):
             m2[live] = F.ALG_NORM2(q[live])
             n[live] += 1
     inside = m2 <= b2
-    k = max_iter - n
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        kk = np.minimum(k, 60)
-        if F.growth == 2:
-            e = np.ldexp(np.log(m2 / b2), kk.astype(np.int32))
-        else:
-            e = np.log(m2 / b2) * float(F.growth) ** kk
-        e = np.where(np.isnan(e), 69.0, e)
-        out = np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
-    return np.where(inside, m2 / b2 - 1.0, out), inside
+    return np.where(inside, m2 / b2 - 1.0, kind_level(m2, b2, max_iter - n, F.growth)), inside
 
 
 def _de_value(m2, dr):
