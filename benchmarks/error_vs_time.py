@@ -449,6 +449,55 @@ def fmt(v) -> str:
     return str(v)
 
 
+def measure_settings(name: str, base: Scene, settings, tr: truth.Truth, dev, repeats: int) -> list[dict]:
+    """One row per (label, march overrides) of ``settings`` on ``base``: its kernel and render
+    time and its error against ``tr`` (measure), printed as it goes (algebra_error.py,
+    kinds_gallery.py)."""
+    rows = []
+    for label, march in settings:
+        scene = base.with_overrides(march)
+        res, ks, rs, _ = timed(scene, dev, repeats, 1.0)
+        row = dict(scene=name, setting=label, kernel_s=ks, render_s=rs)
+        row.update(measure(scene, res, tr, {"jacobian": res.normal.astype(np.float64)}))
+        rows.append(row)
+        print(f"    {label:>24} kernel {ks:8.4f} s  sil {row['silhouette_err']:.4f}  "
+              f"p50 {row['depth_err_median']:.3g}  p99 {row['depth_err_p99']:.3g}  "
+              f"bracket p99 {row['bracket_p99']:.3g}  normal {row['normal_err_jacobian_median']:.2g} deg",
+              flush=True)
+    return rows
+
+
+ERROR_TABLE_COLUMNS = ["scene", "setting", "kernel_s", "render_s", "hit_fraction", "silhouette_err",
+                       "depth_err_median", "depth_err_p99", "depth_err_max", "bracket_p99", "stepped_over",
+                       "normal_err_jacobian_median"]
+
+
+def write_error_tables(out: Path, stem: str, title: str, script: str, rows: list[dict], truths: dict,
+                       device: str, size: tuple[int, int], seconds: float) -> None:
+    """<stem>.csv (replaced) and a run appended to <stem>.md in ``out``: the truths and, per
+    scene and setting, time and error; ``script`` wrote them (algebra_error.py, kinds_gallery.py)."""
+    from run_log import append_run, git_commit, utc_now
+    with open(out / f"{stem}.csv", "w", newline="") as f:
+        wr = csv.writer(f)
+        wr.writerow(ERROR_TABLE_COLUMNS)
+        for r in rows:
+            wr.writerow([fmt(r[c]) for c in ERROR_TABLE_COLUMNS])
+    w, h = size
+    L = [f"\n## {utc_now()}, {device}, commit {git_commit()}, {w}x{h}, {seconds:.0f} s\n",
+         "| scene | truth | truth hit | truth s |", "|---|---|---|---|"]
+    for name, (tr, desc) in truths.items():
+        L.append(f"| {name}: {desc} | {tr.kind}, converged {tr.record.get('converged', '')} | "
+                 f"{tr.hit.mean():.3f} | {tr.seconds:.1f} |")
+    L += ["", "| scene | setting | kernels s | silhouette err | depth err p50 | p99 | max | bracket p99 | "
+              "stepped over | normal err (deg, median) |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        L.append(f"| {r['scene']} | {r['setting']} | {r['kernel_s']:.4f} | {r['silhouette_err']:.4f} | "
+                 f"{fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | {fmt(r['depth_err_max'])} | "
+                 f"{fmt(r['bracket_p99'])} | {r['stepped_over']} | {fmt(r['normal_err_jacobian_median'])} |")
+    append_run(out / f"{stem}.md", f"# {title}\n\nWritten by `python benchmarks/{script}` (see its "
+                                   f"docstring for the truth and the metrics).\n", "\n".join(L) + "\n")
+
+
 def write_csv(path: Path, rows: list[dict], columns=None) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=columns or COLUMNS, extrasaction="ignore")

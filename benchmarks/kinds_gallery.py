@@ -23,22 +23,18 @@ kinds_error.md (a section per run: device, date, commit).
 from __future__ import annotations
 
 import argparse
-import csv
-import math
 import sys
 import time
 import warnings
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 for p in (ROOT, ROOT / "benchmarks"):
     if str(p) not in sys.path:
         sys.path.insert(0, str(p))
 
-from run_log import append_run, git_commit, utc_now  # noqa: E402
-from error_vs_time import measure, timed  # noqa: E402
+from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 
 from pyjulia4d import truth  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
@@ -119,12 +115,6 @@ def settings(scene: Scene) -> list[tuple[str, list[str]]]:
     return out
 
 
-def fmt(v) -> str:
-    if isinstance(v, float):
-        return "nan" if math.isnan(v) else f"{v:.3g}"
-    return str(v)
-
-
 def sheet(out: Path, names: list[str], cell=(320, 240), cols=3) -> None:
     """The pictures side by side, in GALLERY's order, on a dark ground: <out>/sheet.png."""
     from PIL import Image
@@ -169,39 +159,9 @@ def main(argv=None) -> int:
         truths[name] = (tr, desc)
         print(f"[{time.perf_counter() - t_all:6.0f} s] {name}: truth {tr.kind} in {tr.seconds:.1f} s, "
               f"hit {tr.hit.mean():.3f}, converged {tr.record.get('converged', '')}", flush=True)
-        for label, march in settings(base):
-            scene = base.with_overrides(march)
-            res, ks, rs, _ = timed(scene, dev, a.repeats, 1.0)
-            row = dict(scene=name, setting=label, kernel_s=ks, render_s=rs)
-            row.update(measure(scene, res, tr, {"jacobian": res.normal.astype(np.float64)}))
-            rows.append(row)
-            print(f"    {label:>22} kernel {ks:8.4f} s  sil {row['silhouette_err']:.4f}  "
-                  f"p50 {row['depth_err_median']:.3g}  p99 {row['depth_err_p99']:.3g}  "
-                  f"bracket p99 {row['bracket_p99']:.3g}  normal {row['normal_err_jacobian_median']:.2g} deg",
-                  flush=True)
-    cols = ["scene", "setting", "kernel_s", "render_s", "hit_fraction", "silhouette_err", "depth_err_median",
-            "depth_err_p99", "depth_err_max", "bracket_p99", "stepped_over", "normal_err_jacobian_median"]
-    with open(a.out / "kinds_error.csv", "w", newline="") as f:
-        wr = csv.writer(f)
-        wr.writerow(cols)
-        for r in rows:
-            wr.writerow([fmt(r[c]) for c in cols])
-    L = [f"\n## {utc_now()}, {dev.name.strip()}, commit {git_commit()}, {w}x{h}, "
-         f"{time.perf_counter() - t_all:.0f} s\n",
-         "| scene | truth | truth hit | truth s |", "|---|---|---|---|"]
-    for name, (tr, desc) in truths.items():
-        L.append(f"| {name}: {desc} | {tr.kind}, converged {tr.record.get('converged', '')} | "
-                 f"{tr.hit.mean():.3f} | {tr.seconds:.1f} |")
-    L += ["", "| scene | setting | kernels s | silhouette err | depth err p50 | p99 | max | bracket p99 | "
-              "stepped over | normal err (deg, median) |", "|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        L.append(f"| {r['scene']} | {r['setting']} | {r['kernel_s']:.4f} | {r['silhouette_err']:.4f} | "
-                 f"{fmt(r['depth_err_median'])} | {fmt(r['depth_err_p99'])} | {fmt(r['depth_err_max'])} | "
-                 f"{fmt(r['bracket_p99'])} | {r['stepped_over']} | {fmt(r['normal_err_jacobian_median'])} |")
-    append_run(a.out / "kinds_error.md",
-               "# Depth error against run time: Mandelbrot sets and rotated Julia sets\n\nWritten by "
-               "`python benchmarks/kinds_gallery.py` (see its docstring for the truth and the metrics).\n",
-               "\n".join(L) + "\n")
+        rows += measure_settings(name, base, settings(base), tr, dev, a.repeats)
+    write_error_tables(a.out, "kinds_error", "Depth error against run time: Mandelbrot sets and rotated Julia sets",
+                       "kinds_gallery.py", rows, truths, dev.name.strip(), (w, h), time.perf_counter() - t_all)
     print(f"wrote {a.out} in {time.perf_counter() - t_all:.0f} s")
     return 0
 
