@@ -96,12 +96,12 @@ CHILD = r"""
 import json, sys, time
 import numpy as np
 import pyopencl as cl
-from pyjulia4d.devices import select_device
+from pyjulia4d.devices import build, select_device
 spec, width, double, src = sys.argv[1] or None, int(sys.argv[2]), sys.argv[3] == "1", sys.stdin.read()
 dev = select_device(spec)
 ctx = cl.Context([dev]); q = cl.CommandQueue(ctx)
 opts = [f"-DW={width}"] + (["-DDOUBLE"] if double else [])
-prg = cl.Program(ctx, src).build(options=opts)
+prg = build(cl.Program(ctx, src), opts)
 k = prg.fma_peak
 dt = np.float64 if double else np.float32
 n = 1 << 16

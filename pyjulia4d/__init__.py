@@ -6,7 +6,11 @@
 ``render`` runs the OpenCL kernels; ``pyjulia4d.reference.render`` is the float64
 numpy twin (slow, for small images).
 """
-from .scene import Scene, SceneError
+from . import runtimes
+
+runtimes.register()  # before any OpenCL call: Intel's CPU runtime from PyPI (runtimes.py)
+
+from .scene import Scene, SceneError  # noqa: E402
 from .render import RenderResult, render  # noqa: E402  (the function shadows the module name on purpose)
 
 __version__ = "0.1.0"

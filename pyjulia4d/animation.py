@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from .keyframes import Animation, parse_frames
-from .output import _NAME_MAX, OutputError, _atomic, _limit, _shown, _temp_affixes, check_output_path
+from .output import _NAME_MAX, OutputError, _atomic, _limit, _shown, _temp_affixes, check_output_path, read_header
 from .scene import SceneError
 
 HEADER_SCENE = "pyjulia4d.scene"
@@ -53,21 +53,6 @@ def frame_path(pattern: str, n: int) -> Path:
     p = Path(pattern)
     name = _HASHES.sub(lambda m: f"{n:0{len(m.group(0))}d}", p.name)
     return p.with_name(name)
-
-
-def read_header(path: Path) -> dict[str, str] | None:
-    """A frame file's header entries (PNG iTXt, EXR attributes); None if it cannot be read."""
-    try:
-        if path.suffix.lower() == ".exr":
-            import OpenEXR
-            hdr = OpenEXR.File(str(path), header_only=True).header()
-            return {k: v for k, v in hdr.items() if isinstance(v, str)}
-        from PIL import Image
-        with Image.open(path) as im:
-            im.load()  # text chunks after the image data too; a truncated file fails here
-            return dict(im.text)
-    except Exception:  # a damaged or foreign file: rendered again
-        return None
 
 
 def outputs_tag(outputs) -> str:
@@ -206,6 +191,7 @@ def animate(anim: Animation, pattern: str, frames: Sequence[int] | None = None, 
     if workers is not None:
         workers = distributed.check_workers(workers)
     distributed.check_where(workers, scheduler)
+    distributed.require_cluster(workers, scheduler)
     _check_scenes(anim, frames, check_device(device, scheduler), force, outputs)
     if video is not None:
         video = check_video_path(video)

@@ -4,7 +4,7 @@ A scene compiles only the pieces it uses (the way Mandelbulber2 stitches only th
 formula files a scene uses): one .cl file per concern, concatenated in data-flow
 order, with -D switches for the optional terms.  Built programs are kept per
 (context, pieces, switches) for the process, and their binaries on disk across
-processes in ``<cache>/programs`` (devices.cache_dir), keyed by the source, the options and
+processes in ``<cache>/programs`` (resources.cache_dir), keyed by the source, the options and
 the device and driver (devices.device_key): not every driver caches its own (PoCL does;
 others may not).  A binary that no longer loads is rebuilt from source.
 """
@@ -18,8 +18,8 @@ import os
 
 import pyopencl as cl
 
-from .devices import cache_dir, cannot_compile, compile_error, device_key
-from .resources import kernel_dir
+from .devices import build, cannot_compile, compile_error, device_key
+from .resources import cache_dir, kernel_dir
 from .scene import MANDELBROT_START, Scene, march_method
 
 
@@ -182,7 +182,7 @@ def _from_binary(ctx: cl.Context, dev: cl.Device, path, opts) -> cl.Program | No
     except OSError:
         return None
     try:
-        return cl.Program(ctx, [dev], [binary]).build(options=opts)
+        return build(cl.Program(ctx, [dev], [binary]), opts)
     except (cl.Error, RuntimeError, ValueError):
         return None
 
@@ -216,7 +216,7 @@ def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
         path = cache_dir() / "programs" / f"{digest}.bin"
         prg = _from_binary(ctx, dev, path, opts)
         if prg is None:
-            prg = cl.Program(ctx, src).build(options=opts)
+            prg = build(cl.Program(ctx, src), opts)
             _save_binary(prg, path)
         _programs[key] = prg
     return prg

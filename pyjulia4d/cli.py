@@ -1,4 +1,4 @@
-"""Command line: ``python -m pyjulia4d render|animate|devices|import-pov``.
+"""Command line: ``pyjulia4d render|animate|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
 
 Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
 status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
@@ -17,7 +17,7 @@ from typing import Any, Iterator, NoReturn, Sequence
 from .output import check_output_path, write_image
 from .scene import Scene, SceneError, override_key
 
-PROG = "python -m pyjulia4d"
+PROG = "pyjulia4d"
 
 
 class UsageError(Exception):
@@ -41,12 +41,20 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = _Parser(prog=PROG, description="Ray trace 3D views of 4D quaternion Julia sets.")
+    from . import __version__
+
+    ap = _Parser(prog=PROG, description="Ray trace 3D views of 4D Julia sets: quaternions, the hypercomplex "
+                                        "numbers with POV-Ray's 18 functions, CQuats and more.")
+    ap.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser("render", help="render a scene to .png or .exr")
-    r.add_argument("scene", nargs="?", metavar="SCENE.toml", help="scene file (default: the built-in scene)")
-    r.add_argument("-o", "--output", metavar="OUT", help="OUT.png or OUT.exr (default: <scene stem>.png, or julia.png)")
+    r.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
+                   help="scene file, or an image pyjulia4d rendered: its header holds the scene as "
+                        "rendered, which is rendered again (default: the built-in scene)")
+    r.add_argument("-o", "--output", metavar="OUT",
+                   help="OUT.png or OUT.exr (default: <scene stem>.png, <image stem>-rerender.png for an "
+                        "image, or julia.png)")
     # kept as text so bad sizes get the same one-line scene error as --set
     r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W; not both)")
     r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H; not both)")
@@ -78,7 +86,12 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--force", action="store_true", help="render frames whose work is refused as hopeless")
     _cluster_options(a, "whole frames")
 
-    sub.add_parser("devices", help="list the OpenCL devices")
+    sub.add_parser("devices", help="list the OpenCL devices, which cannot compile, and the default")
+
+    k = sub.add_parser("keys", help="list every scene key with its default, valid range and meaning")
+    k.add_argument("section", nargs="?", metavar="SECTION",
+                   help="only this section's keys: fractal, camera, slice, march, normals, shading, "
+                        "image, clip or render")
 
     i = sub.add_parser("import-pov", help="convert a POV-Ray julia_fractal scene to a scene file")
     i.add_argument("pov", metavar="FILE.pov", help="POV-Ray 3.7 scene with one julia_fractal")
@@ -119,11 +132,39 @@ def _size_overrides(args: argparse.Namespace) -> list[str]:
     return overrides
 
 
+IMAGE_SUFFIXES = (".png", ".exr")
+
+
+def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
+    """The scene an image was rendered from: the resolved scene write_image put in its header
+    (``pyjulia4d.scene``: the camera camera.fit chose included, so the same picture comes
+    back), with overrides applied.  One SceneError naming the file if there is none."""
+    from .output import read_header
+    from .scene import MAX_SCENE_BYTES, scene_table_from_text
+
+    shown = path if path.isprintable() else repr(path)
+    if not Path(path).is_file():
+        raise SceneError(shown, "cannot read: no such file")
+    header = read_header(Path(path))
+    if header is None:
+        raise SceneError(shown, f"cannot read it as a {Path(path).suffix.lower()[1:].upper()} image")
+    text = header.get("pyjulia4d.scene")
+    if text is None:
+        raise SceneError(shown, "holds no pyjulia4d scene (not rendered by pyjulia4d, or its metadata "
+                                "was stripped)")
+    if len(text.encode("utf-8", "replace")) > MAX_SCENE_BYTES:
+        raise SceneError(shown, "its scene is larger than 1 MiB")
+    return Scene.from_dict(scene_table_from_text(text, f"{shown} (its scene)"), overrides)
+
+
 def _render(args: argparse.Namespace) -> int:
     overrides = _size_overrides(args)
     if args.scene is None:   # the built-in scene; framed (camera.fit) unless a position is set
         scene = Scene.from_dict({}, overrides)
         default_out = "julia.png"
+    elif Path(args.scene).suffix.lower() in IMAGE_SUFFIXES:   # render it again
+        scene = scene_from_image(args.scene, overrides)
+        default_out = Path(args.scene).stem + "-rerender.png"
     else:
         scene = Scene.from_toml(args.scene, overrides)
         default_out = Path(args.scene).stem + ".png"
@@ -218,6 +259,10 @@ def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
     return tuple(o for g in groups for o in CHANNEL_GROUPS[g])
 
 
+def _show_arg(text: str) -> str:
+    return text if text.isprintable() and len(text) <= 80 else repr(text[:80])
+
+
 def _one_line(e: BaseException) -> str:
     return " ".join(str(e).splitlines()) or type(e).__name__
 
@@ -282,6 +327,15 @@ def main(argv: Sequence[str] | None = None) -> int:
                 from .devices import describe_devices
 
                 print(describe_devices())
+                return 0
+            if args.command == "keys":
+                from .keys import describe_keys
+                from .scene import SECTION_NAMES
+
+                if args.section is not None and args.section not in SECTION_NAMES:
+                    raise SceneError(_show_arg(args.section), f"unknown section; use one of "
+                                                              f"{', '.join(SECTION_NAMES)}")
+                print(describe_keys(args.section))
                 return 0
             if args.command == "import-pov":
                 return _import_pov(args)

@@ -1,8 +1,7 @@
 """OpenCL device discovery and selection."""
 from __future__ import annotations
 
-import os
-from pathlib import Path
+import warnings
 
 import pyopencl as cl
 
@@ -51,6 +50,15 @@ def has_fp64(device: cl.Device) -> bool:
         return False
 
 
+def build(prg: cl.Program, options=()) -> cl.Program:
+    """``prg.build(options)`` without pyopencl's CompilerWarning: Intel's CPU runtime returns a
+    build log ("Compilation started ... Device build done") on every successful build,
+    which pyopencl would show as a warning; failures still raise with their log."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cl.CompilerWarning)
+        return prg.build(options=list(options))
+
+
 _PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *= 2.0f; }"
 _compiles: dict[int, str] = {}
 
@@ -66,7 +74,7 @@ def compile_error(device: cl.Device) -> str:
     if key not in _compiles:
         try:
             ctx = cl.Context([device])
-            cl.Program(ctx, _PROBE_SOURCE).build()
+            build(cl.Program(ctx, _PROBE_SOURCE))
             _compiles[key] = ""
         except (cl.Error, RuntimeError) as e:
             lines = [ln.strip() for ln in str(e).splitlines() if "error" in ln.lower() and ln.strip()]
@@ -88,12 +96,6 @@ def device_key(device: cl.Device) -> str:
     p = device.platform
     return " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version,
                                            device.driver_version))
-
-
-def cache_dir() -> Path:
-    """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
-    root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
-    return Path(root)
 
 
 def describe_devices() -> str:
@@ -147,7 +149,7 @@ def select_device(spec: str | None = None) -> cl.Device:
     rows = _indexed()
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
-    hint = "(run 'python -m pyjulia4d devices' to list them)"
+    hint = "(run 'pyjulia4d devices' to list them)"
     if spec is None:
         for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
             for _, _, d in rows:

@@ -136,11 +136,32 @@ def fit_unit(scene: Scene, device: str | None = None, force: bool = False) -> Sc
 # ---------------------------------------------------------------- the cluster
 
 
+def have_cluster() -> bool:
+    """Whether Dask distributed is installed (the ``cluster`` extra)."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("distributed") is not None
+    except ValueError:   # sys.modules["distributed"] is None (blocked)
+        return False
+
+
+def require_cluster(workers: int | None, scheduler: str | None) -> None:
+    """--workers N (N > 0) and --scheduler need Dask distributed: one line saying how to get it."""
+    if (scheduler is not None or (workers or 0) > 0) and not have_cluster():
+        flag = "--scheduler" if scheduler is not None else "--workers"
+        raise SceneError(flag, "needs Dask distributed, which is not installed: pip install "
+                               "'pyjulia4d[cluster]' (or --workers 0 to render in this process)")
+
+
 def default_workers(device: str | None = None) -> int:
     """Workers of the embedded cluster when --workers is not given: one per OpenCL GPU when
-    the device chosen is a GPU, else 1 (a CPU device already uses every core)."""
+    the device chosen is a GPU, else 1 (a CPU device already uses every core); 0 (in this
+    process) without Dask distributed installed."""
     from .devices import device_type, list_devices, select_device
 
+    if not have_cluster():
+        return 0
     dev = select_device(device)
     if device is None and device_type(dev) == "GPU":
         return max(1, sum(1 for _, d in list_devices() if device_type(d) == "GPU"))
@@ -174,6 +195,7 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
     LocalCluster of ``workers`` processes (None: default_workers), one thread each.  Yields
     None for ``workers == 0`` (render in this process)."""
     check_where(workers, scheduler)
+    require_cluster(workers, scheduler)
     if scheduler is None and workers is None:
         workers = default_workers(device)
     if scheduler is None and workers == 0:
@@ -311,9 +333,10 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
     nworkers = len({(i.worker, i.pid) for i in infos})
     where = (f" ({len(regions)} tile{'s' if len(regions) != 1 else ''} on {nworkers} "
              f"worker{'s' if nworkers != 1 else ''})")
+    # scene: the camera every tile used (camera.fit resolved once), which the header records
     result = RenderResult(**arrays, counts=counts, guards=guards, lanes=first.lanes,
                           device_name=", ".join(names) + where,
-                          kernel_seconds=sum(r.kernel_seconds for r in parts.values()))
+                          kernel_seconds=sum(r.kernel_seconds for r in parts.values()), scene=scene)
     result.seconds = time.perf_counter() - t0
     return result, scene
 
@@ -328,6 +351,7 @@ def render_on_cluster(scene: Scene, workers: int | None = None, scheduler: str |
     from .workload import check
 
     check_where(workers, scheduler)
+    require_cluster(workers, scheduler)
     check(scene, check_device(device, scheduler), force=force, outputs=outputs)
     with cluster(workers, scheduler, device) as client:
         result, _ = render_tiled(client, scene, device, outputs, force, tile, progress)

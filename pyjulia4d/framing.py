@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from .camera import camera_frame, march_radius, slice_rotation, unit
-from .scene import Scene
+from .scene import COORD, Scene, SceneError
 
 PROBE = (96, 72)
 MARGIN = 0.9
@@ -24,6 +24,21 @@ def to_scene(scene: Scene, x) -> np.ndarray:
     """World point -> scene (slice) coordinates: the inverse of camera.to_world."""
     r = slice_rotation(scene.slice.normal)
     return r.T @ (np.asarray(x, float) - scene.slice.distance * unit(scene.slice.normal))
+
+
+def _within_reach(scene: Scene, eye: np.ndarray, radius: float, what: str) -> None:
+    """A camera at ``eye`` (world coordinates) must be a valid camera.position (every
+    component within +-COORD): else the set is too large to frame, which comes of its
+    bound - the bailout where the pair has no polynomial escape bound (camera.bounding_radius)
+    - not of a key the user set; refused with one line naming fractal.bailout."""
+    pos = to_scene(scene, eye)
+    if np.all(np.abs(pos) <= COORD):
+        return
+    f = scene.fractal
+    raise SceneError("fractal.bailout", f"camera.fit: {what} would need a camera {float(np.max(np.abs(pos))):.3g} "
+                     f"from the origin, beyond camera.position's range [-1e6, 1e6], to frame the "
+                     f"{f.algebra} {f.function} set within its bound of radius {radius:.3g} "
+                     f"(fractal.bailout={f.bailout!r}); lower fractal.bailout, or give camera.position")
 
 
 def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
@@ -41,6 +56,7 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     rel = -np.asarray(fr.position, float)
     centre = np.asarray(fr.position, float) + sum((rel @ v) * v for v in (fr.right, fr.up, fr.forward))
     eye = centre - d0 * fr.forward
+    _within_reach(scene, eye, radius, "the first pass")
     w, h = PROBE
     probe = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, eye)],
                              "camera.target": [float(v) for v in to_scene(scene, centre)],
@@ -59,6 +75,7 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),
                float(np.max(np.abs(y) / (MARGIN * tan_v) - z)), 1e-6)
     pos = c - dist * fr.forward
+    _within_reach(scene, pos, radius, "the framed camera")
     record.update(distance=dist, target=[float(v) for v in c])
     fitted = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, pos)],
                               "camera.target": [float(v) for v in to_scene(scene, c)],

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import pyopencl as cl
 
-from .devices import cache_dir, device_key, device_type
+from .devices import device_key, device_type
+from .resources import cache_dir
 
 WIDTHS = (16, 8, 4)
 

@@ -254,3 +254,20 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
             write_exr(p, result.exr_channels(), header)
     except OSError as e:
         raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
+
+
+def read_header(path: str | Path) -> dict[str, str] | None:
+    """An image's header entries (PNG text chunks, EXR string attributes), as write_image
+    wrote them; None if it cannot be read."""
+    path = Path(path)
+    try:
+        if path.suffix.lower() == ".exr":
+            import OpenEXR
+            hdr = OpenEXR.File(str(path), header_only=True).header()
+            return {k: v for k, v in hdr.items() if isinstance(v, str)}
+        from PIL import Image
+        with Image.open(path) as im:
+            im.load()  # text chunks after the image data too; a truncated file fails here
+            return dict(im.text)
+    except Exception:  # a damaged or foreign file
+        return None

@@ -1,5 +1,5 @@
 """Import the julia_fractal of a POV-Ray 3.7 scene as a pyjulia4d scene:
-``python -m pyjulia4d import-pov FILE.pov [-o SCENE.toml]``.
+``pyjulia4d import-pov FILE.pov [-o SCENE.toml]``.
 
 POV-Ray's scene language has no Python library; this is a small hand-written tokenizer
 and recursive-descent reader of the part of it a julia_fractal scene uses: ``#version``,
@@ -1153,7 +1153,7 @@ def _wrap(text: str, width: int = 88) -> list[str]:
 
 def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
     out = [f"# pyjulia4d scene imported from the POV-Ray scene {source}",
-           "# by `python -m pyjulia4d import-pov` (pyjulia4d/povray.py documents the mapping)."]
+           "# by `pyjulia4d import-pov` (pyjulia4d/povray.py documents the mapping)."]
     for h in header:
         out.extend(_wrap(h))
     for section, table in data.items():

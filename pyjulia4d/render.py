@@ -529,7 +529,12 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     render of the scene predicts the time first (calibrate.py: refuse, warn, size the tiles
     so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``."""
     t_start = time.perf_counter()
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     dev = device if isinstance(device, cl.Device) else select_device(device)
+    double = scene.render.float == "double"
+    if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
+        raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
         import warnings
 
@@ -544,7 +549,6 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             warnings.simplefilter("ignore")
             make_plan(scene, dev, lanes or 1, outputs=outputs, force=force, tile=tile, region=region)
         scene, _ = fit_camera(scene, first_pass)
-    double = scene.render.float == "double"
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
     plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
@@ -565,8 +569,6 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         side = tile_side(prediction, tile)
         if side < tile:
             plan = plan.retile(side)
-    if double and not has_fp64(dev):
-        raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     runner = TileRunner(plan, dev)
     rx, ry, W, H = plan.region
     keep = plan.outputs

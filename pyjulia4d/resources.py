@@ -1,6 +1,7 @@
 """Where the OpenCL sources live, installed or in a source checkout."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 
@@ -15,3 +16,9 @@ def kernel_dir() -> Path:
     if any(installed.glob("*.cl")):
         return installed
     return here.parent / "kernels"
+
+
+def cache_dir() -> Path:
+    """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
+    root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
+    return Path(root)

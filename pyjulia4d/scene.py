@@ -110,6 +110,9 @@ class Fractal:
     component: str = "plus"
     locus_radius: float = 2.0
 
+    def __post_init__(self) -> None:
+        _check_section(self, "fractal")
+
 
 # The kinds of set a [fractal] table describes (Fractal.kind).
 KINDS = ("julia", "mandelbrot", "julia_stack", "cubic_locus")
@@ -149,6 +152,9 @@ class Camera:
     # no camera.fit gets true (Scene.from_dict)
     fit: bool = False
 
+    def __post_init__(self) -> None:
+        _check_section(self, "camera")
+
 
 @dataclass(frozen=True)
 class Slice:
@@ -156,6 +162,9 @@ class Slice:
 
     normal: Vec4 = (0.0, 0.0, 0.0, 1.0)
     distance: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_section(self, "slice")
 
 
 @dataclass(frozen=True)
@@ -173,6 +182,9 @@ class March:
     near: Union[float, Auto] = "auto"
     far: Union[float, Auto] = "auto"
 
+    def __post_init__(self) -> None:
+        _check_section(self, "march")
+
 
 @dataclass(frozen=True)
 class Normals:
@@ -180,6 +192,9 @@ class Normals:
 
     method: str = "jacobian"
     step: Union[float, Auto] = "auto"
+
+    def __post_init__(self) -> None:
+        _check_section(self, "normals")
 
 
 @dataclass(frozen=True)
@@ -206,6 +221,9 @@ class Shading:
     lights: tuple["Light", ...] = ()   # more lights beside ``light`` (at most MAX_LIGHTS)
     reflection: float = 0.0        # share of one mirror bounce in the colour (shade/reflect.cl); 0 = off
 
+    def __post_init__(self) -> None:
+        _check_section(self, "shading")
+
 
 @dataclass(frozen=True)
 class Light:
@@ -218,6 +236,10 @@ class Light:
     direction: Vec4 | None = None
     color: Vec3 = (1.0, 1.0, 1.0)
     intensity: float = 1.0
+
+    def __post_init__(self) -> None:
+        """Checked as a table of shading.lights is (scene._Lights)."""
+        _check_light(self)
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -242,6 +264,9 @@ class Image:
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
 
+    def __post_init__(self) -> None:
+        _check_section(self, "image")
+
 
 @dataclass(frozen=True)
 class Clip:
@@ -250,6 +275,9 @@ class Clip:
 
     planes: tuple[tuple[float, float, float, float], ...] = ()
 
+    def __post_init__(self) -> None:
+        _check_section(self, "clip")
+
 
 @dataclass(frozen=True)
 class Render:
@@ -257,6 +285,9 @@ class Render:
 
     float: str = "single"
     variant: str = "auto"
+
+    def __post_init__(self) -> None:
+        _check_section(self, "render")
 
 
 # Colour maps shading.colormap accepts: matplotlib's, named here so that a scene is checked
@@ -558,6 +589,8 @@ _SECTIONS: dict[str, type] = {
     "render": Render,
 }
 
+SECTION_NAMES = tuple(_SECTIONS)
+
 # Every key's check and valid range, in one place (README's table is tested against it).
 _CHECKS: dict[str, dict[str, Checker]] = {
     "fractal": {
@@ -645,10 +678,43 @@ _CHECKS: dict[str, dict[str, Checker]] = {
 }
 
 
+def key_names() -> list[str]:
+    """Every scene key, ``section.name``, in the order of the sections and their fields."""
+    return [f"{section}.{key}" for section, table in _CHECKS.items() for key in table]
+
+
 def valid_range(dotted: str) -> str:
     """The valid range of a scene key in words, e.g. ``valid_range("march.epsilon")``."""
     section, _, key = dotted.partition(".")
     return _CHECKS[section][key].valid
+
+
+def _check_section(part: Any, section: str) -> None:
+    """Check every field of a section dataclass as a scene file's value would be (the same
+    one-line SceneError naming the key), storing the normalised values (vectors as tuples of
+    floats, 3-vectors given w = 0): a scene built in Python, dataclasses.replace included, is
+    as valid as one read from a file."""
+    checks = _CHECKS[section]
+    for f in fields(part):
+        value = getattr(part, f.name)
+        checked = checks[f.name](f"{section}.{f.name}", value)
+        if checked is not value:
+            object.__setattr__(part, f.name, checked)
+
+
+def _check_light(light: "Light") -> None:
+    """One of shading.lights, checked as _Lights checks a table."""
+    lights = _CHECKS["shading"]["lights"]
+    where = "shading.lights[]"
+    if (light.position is None) == (light.direction is None):
+        raise SceneError(where, "give exactly one of position and direction")
+    for name, check in (("position", lights.point), ("direction", lights.direction), ("color", lights.color),
+                        ("intensity", lights.intensity)):
+        value = getattr(light, name)
+        if value is not None:
+            checked = check(f"{where}.{name}", value)
+            if checked is not value:
+                object.__setattr__(light, name, checked)
 
 
 def _apply_quality(march: dict[str, Any], keep: set[str]) -> None:
@@ -747,9 +813,17 @@ def read_scene_table(path: str | Path) -> dict[str, Any]:
     if len(data) > MAX_SCENE_BYTES:
         raise SceneError(where, f"larger than {MAX_SCENE_BYTES // 2**20} MiB, not a scene file")
     try:
-        return tomllib.loads(data.decode("utf-8"))
+        text = data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise SceneError(where, f"invalid TOML: not UTF-8 ({e.reason})") from None
+    return scene_table_from_text(text, where)
+
+
+def scene_table_from_text(text: str, where: str) -> dict[str, Any]:
+    """The TOML table of a scene's text (a file's, or an image header's); every failure one
+    SceneError naming ``where``."""
+    try:
+        return tomllib.loads(text)
     except RecursionError:
         raise SceneError(where, "invalid TOML: nested too deeply") from None
     except tomllib.TOMLDecodeError as e:
@@ -940,9 +1014,30 @@ class Scene:
     clip: Clip = field(default_factory=Clip)
     render: Render = field(default_factory=Render)
 
+    def __post_init__(self) -> None:
+        """The rules across keys, checked however the scene was built (from a file, a dict,
+        the constructor or dataclasses.replace): each section of its type, the camera's frame,
+        the algebra x function pair and the methods it can use, reflection's normals, near < far."""
+        for name, kind in _SECTIONS.items():
+            if not isinstance(getattr(self, name), kind):
+                raise SceneError(name, f"expected a pyjulia4d.scene.{kind.__name__}, got "
+                                       f"{_show(getattr(self, name))}")
+        _check_camera(self.camera)
+        _check_fractal(self)
+        if self.shading.reflection > 0 and self.normals.method == "zbuffer":
+            raise SceneError("shading.reflection", "needs normals.method \"jacobian\" or \"gradient\": the "
+                                                   "Z-buffer has no neighbours for reflected rays")
+        m = self.march
+        if not isinstance(m.near, str) and not isinstance(m.far, str) and m.far <= m.near:
+            raise SceneError("march.far", f"must be greater than march.near ({m.near!r}), got {m.far!r}")
+
     @classmethod
     def default(cls) -> Scene:
-        """The default scene."""
+        """The built-in scene with its camera placed (``camera.fit = false``): reproducible
+        without a framing pass, which is what the tests, benchmarks and the reference compare.
+        The command line's built-in scene is ``Scene.from_dict({})``, which frames the set
+        (camera.fit is true whenever no camera.position is given), so the two differ in
+        camera only."""
         return cls()
 
     @classmethod
@@ -954,7 +1049,7 @@ class Scene:
         for section, table in data.items():
             if section in ("animation", "keyframe"):   # keyframes.py reads these
                 raise SceneError(section, "a keyframed scene: render its frames with "
-                                          "'python -m pyjulia4d animate' (or --frames N:N for one)")
+                                          "'pyjulia4d animate' (or --frames N:N for one)")
             if section not in _CHECKS:
                 raise SceneError(_show_key(str(section)), "unknown key")
             if not isinstance(table, Mapping):
@@ -987,25 +1082,18 @@ class Scene:
 
     @classmethod
     def _build(cls, raw: Mapping[str, Mapping[str, Any]]) -> Scene:
+        # each key is checked in the order given (the first bad one is named), then again,
+        # with the defaults, by the sections' __post_init__
         parts = {}
         for section, table in raw.items():
             checks = _CHECKS[section]
             kwargs = {k: checks[k](f"{section}.{k}", v) for k, v in table.items()}
             parts[section] = _SECTIONS[section](**kwargs)
-        scene = cls(**parts)
-        _check_camera(scene.camera)
-        _check_fractal(scene)
-        if scene.shading.reflection > 0 and scene.normals.method == "zbuffer":
-            raise SceneError("shading.reflection", "needs normals.method \"jacobian\" or \"gradient\": the "
-                                                   "Z-buffer has no neighbours for reflected rays")
-        m = scene.march
+        m = parts["march"]
         if m.quality != "custom" and any(getattr(m, k) != v for k, v in preset_values(m.quality).items()):
             # a march key set after the preset: the resolved scene says what really runs
-            scene = dataclasses.replace(scene, march=dataclasses.replace(m, quality="custom"))
-            m = scene.march
-        if not isinstance(m.near, str) and not isinstance(m.far, str) and m.far <= m.near:
-            raise SceneError("march.far", f"must be greater than march.near ({m.near!r}), got {m.far!r}")
-        return scene
+            parts["march"] = dataclasses.replace(m, quality="custom")
+        return cls(**parts)
 
     def with_overrides(self, overrides: Iterable[str]) -> Scene:
         """A new scene with ``section.key=VALUE`` strings applied."""

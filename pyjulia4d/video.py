@@ -23,6 +23,16 @@ CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 QUALITY = {".mp4": ["-crf", "18", "-preset", "medium"], ".webm": ["-crf", "24", "-b:v", "0"]}
 
 
+def have_ffmpeg() -> bool:
+    """Whether imageio-ffmpeg (the ``video`` extra) is installed."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("imageio_ffmpeg") is not None
+    except ValueError:   # sys.modules["imageio_ffmpeg"] is None (blocked)
+        return False
+
+
 def check_video_path(path: str | os.PathLike) -> Path:
     """Fail before rendering if ``path`` cannot take the video: .mp4 or .webm, in an
     existing, writable directory."""
@@ -40,6 +50,9 @@ def check_video_path(path: str | os.PathLike) -> Path:
         raise OutputError(f"{shown}: is a directory")
     if not os.access(p.parent, os.W_OK | os.X_OK):
         raise OutputError(f"{shown}: cannot create a file in {_quoted(p.parent)}")
+    if not have_ffmpeg():
+        raise OutputError(f"{shown}: video needs imageio-ffmpeg, which is not installed: pip install "
+                          f"'pyjulia4d[video]'")
     return p
 
 

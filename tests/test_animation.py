@@ -17,7 +17,8 @@ from PIL import Image
 
 import pyjulia4d
 from pyjulia4d import cli
-from pyjulia4d.animation import animate, frame_path, read_header, remove_stale_temps
+from pyjulia4d.animation import animate, frame_path, remove_stale_temps
+from pyjulia4d.output import read_header
 from pyjulia4d.keyframes import from_table, interpolate, load
 from pyjulia4d.scene import Scene
 

@@ -13,7 +13,8 @@ import pytest
 from PIL import Image
 
 from pyjulia4d import cli, render
-from pyjulia4d.animation import animate, frame_path, read_header
+from pyjulia4d.animation import animate, frame_path
+from pyjulia4d.output import read_header
 from pyjulia4d.distributed import render_many, render_tiled
 from pyjulia4d.keyframes import from_table
 from pyjulia4d.scene import Scene
