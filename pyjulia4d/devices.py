@@ -117,7 +117,28 @@ def describe_devices() -> str:
                    f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}, "
                    f"driver {d.driver_version.strip()}"
                    + (f", cannot compile: {err}" if err else "") + mark)
+    from . import runtimes
+
+    if chosen is not None:
+        out.append(default_reason(chosen))
+    lib = runtimes.registered["library"]
+    out.append(f"Intel's CPU runtime from PyPI: registered ({lib})" if lib else
+               f"Intel's CPU runtime from PyPI: not registered ({runtimes.registered['why_not']})")
     return "\n".join(out)
+
+
+# CPU runtimes by preference when more than one compiles, by platform name: Intel's CPU
+# runtime ran the kernels of every algebra x function pair faster than PoCL on the
+# development machine (AMD EPYC Zen 5; benchmarks/cpu_runtimes.py, results in
+# benchmarks/results/cpu_runtimes.md), and built them faster from cold caches.  Others
+# follow in platform order.
+CPU_PREFERENCE = ("Intel(R) OpenCL",)
+
+
+def runtime_rank(device: cl.Device) -> int:
+    """Where ``device``'s platform stands in CPU_PREFERENCE (len(CPU_PREFERENCE) if absent)."""
+    name = device.platform.name.strip()
+    return CPU_PREFERENCE.index(name) if name in CPU_PREFERENCE else len(CPU_PREFERENCE)
 
 
 def default_reason(dev: cl.Device) -> str:
@@ -127,10 +148,15 @@ def default_reason(dev: cl.Device) -> str:
     at = next((k for k, (_, _, d) in enumerate(rows) if d.int_ptr == dev.int_ptr), len(rows))
     idx = rows[at][0] if at < len(rows) else "?"
     kind = device_type(dev)
-    skipped = [i for i, _, d in rows[:at] if device_type(d) == kind and compile_error(d)]
-    why = f"{idx}, the default: the first {kind} that compiles"
-    if kind != "GPU":
-        why += ", no GPU"
+    skipped = [i for i, _, d in rows if device_type(d) == kind and compile_error(d)]
+    passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
+    if kind == "CPU" and passed:
+        why = f"{idx}, the default: no GPU; of the CPU runtimes that compile, {dev.platform.name.strip()} " \
+              f"is preferred (faster on every pair measured: benchmarks/cpu_runtimes.py) over {', '.join(passed)}"
+    else:
+        why = f"{idx}, the default: the first {kind} that compiles"
+        if kind != "GPU":
+            why += ", no GPU"
     if skipped:
         why += f"; {', '.join(skipped)} cannot compile"
     return why
@@ -152,9 +178,9 @@ def select_device(spec: str | None = None) -> cl.Device:
     hint = "(run 'pyjulia4d devices' to list them)"
     if spec is None:
         for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
-            for _, _, d in rows:
-                if device_type(d) == want and not compile_error(d):
-                    return d
+            found = [d for _, _, d in rows if device_type(d) == want and not compile_error(d)]
+            if found:
+                return min(found, key=runtime_rank) if want == "CPU" else found[0]
         raise cannot_compile(rows[0][2])
     s = spec.strip()
     if s.lower() in ("cpu", "gpu"):

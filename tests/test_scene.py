@@ -268,10 +268,11 @@ def test_error_single_argument_form() -> None:
 
 
 def _readme_key_rows() -> dict[str, list[str]]:
-    """README's "Scene keys" table: key -> its cells, backticks and escapes removed."""
-    readme = Path(__file__).resolve().parent.parent / "README.md"
+    """docs/scene-keys.md's table of scene keys: key -> its cells, backticks and escapes
+    removed."""
+    readme = Path(__file__).resolve().parent.parent / "docs" / "scene-keys.md"
     if not readme.exists():
-        pytest.skip("README.md is not beside the tests (installed package)")
+        pytest.skip("docs/scene-keys.md is not beside the tests (installed package)")
     text = readme.read_text(encoding="utf-8")
     table = text[text.index("| key | default | valid range | meaning |"):]
     rows = {}
@@ -285,12 +286,16 @@ def _readme_key_rows() -> dict[str, list[str]]:
 
 
 def test_readme_valid_ranges_match_the_checkers() -> None:
-    """The README's valid-range column is the checkers' own description, for every key."""
+    """docs/scene-keys.md's valid-range column is the checkers' own description and its
+    default column the scene's default as ``pyjulia4d keys`` prints it, for every key."""
+    from pyjulia4d.keys import default_text
+
     rows = _readme_key_rows()
     keys = [f"{s}.{k}" for s, table in _CHECKS.items() for k in table]
     assert sorted(rows) == sorted(keys)
     for key in keys:
         assert rows[key][1] == valid_range(key), key
+        assert rows[key][0] == default_text(key), key
 
 
 # ------------------------------------------------------------------ valid ranges

@@ -1,0 +1,373 @@
+"""What a new user meets first: OpenCL from PyPI with no system driver (runtimes.py), the
+CPU runtime chosen and why (devices.py), the command line people expect (--version, keys,
+re-rendering an image), scenes checked when built in Python, the optional extras, and the
+bugs of first contact (the cluster's header camera, camera.fit beyond the coordinate
+range, double precision refused before any build)."""
+from __future__ import annotations
+
+import dataclasses
+import os
+import platform
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import pyjulia4d
+from pyjulia4d import Scene, SceneError, cli, keys, runtimes
+from pyjulia4d.scene import key_names, valid_range
+
+PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
+
+
+def _env(**extra: str) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [PKG_ROOT, env.get("PYTHONPATH")]))
+    env.pop("OCL_ICD_VENDORS", None)   # set by this process's own registration
+    env.update(extra)
+    return env
+
+
+def _python(code: str, **extra: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-c", code], env=_env(**extra), capture_output=True, text=True,
+                          timeout=300)
+
+
+def _cli(args: list[str], cwd: Path, prelude: str = "", **extra: str) -> subprocess.CompletedProcess[str]:
+    code = prelude + "import sys; from pyjulia4d.cli import main; sys.exit(main(sys.argv[1:]))"
+    return subprocess.run([sys.executable, "-c", code, *args], cwd=cwd, env=_env(**extra),
+                          capture_output=True, text=True, timeout=300)
+
+
+# ------------------------------------------------------------------ OpenCL from PyPI
+
+INTEL = runtimes.intel_library()
+needs_intel = pytest.mark.skipif(INTEL is None, reason="intel-opencl-rt is not installed (not x86-64 Linux)")
+
+
+def test_intel_runtime_is_a_dependency_on_x86_64_linux() -> None:
+    if platform.system() == "Linux" and platform.machine() == "x86_64":
+        assert INTEL is not None and INTEL.name == "libintelocl.so"
+
+
+@needs_intel
+def test_registration_adds_intel_beside_the_system_drivers(tmp_path: Path) -> None:
+    """The vendors folder holds the wheel's runtime by its real path and a copy of every
+    system .icd file (OCL_ICD_VENDORS replaces the system folder, so none may be lost)."""
+    system = tmp_path / "system"
+    system.mkdir()
+    (system / "gpu.icd").write_text("/opt/some/libgpu.so\n")
+    cache = tmp_path / "cache"
+    p = _python("import os, pyjulia4d; print(os.environ['OCL_ICD_VENDORS'])",
+                OPENCL_VENDOR_PATH=str(system), PYJULIA4D_CACHE=str(cache))
+    assert p.returncode == 0, p.stderr
+    folder = Path(p.stdout.strip())
+    assert folder.parent == cache / "icd"
+    icds = {f.name: f.read_text().strip() for f in folder.iterdir()}
+    assert icds == {"gpu.icd": "/opt/some/libgpu.so", "pyjulia4d-intel-cpu.icd": str(INTEL)}
+    assert not [f for f in (cache / "icd").iterdir() if f.name.startswith(".")]   # no temp folder left
+
+
+@pytest.mark.parametrize("env,why", [({"OCL_ICD_VENDORS": "/nonexistent"}, "OCL_ICD_VENDORS is set"),
+                                     ({"PYJULIA4D_NO_BUNDLED_OPENCL": "1"}, "PYJULIA4D_NO_BUNDLED_OPENCL is set")])
+def test_registration_leaves_a_users_choice_alone(tmp_path: Path, env, why) -> None:
+    p = _python("import os, pyjulia4d; from pyjulia4d import runtimes; "
+                "print(os.environ.get('OCL_ICD_VENDORS')); print(runtimes.registered['why_not'])",
+                PYJULIA4D_CACHE=str(tmp_path), **env)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.splitlines() == [env.get("OCL_ICD_VENDORS", "None"), why]
+    assert not (tmp_path / "icd").exists()
+
+
+@needs_intel
+def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
+    """No system .icd file at all (an empty vendors folder): the default device comes from
+    PyPI alone and renders a picture with hits."""
+    empty = tmp_path / "vendors"
+    empty.mkdir()
+    p = _python("from pyjulia4d import Scene, render; from pyjulia4d.devices import select_device; "
+                "d = select_device(None); r = render(Scene.default().with_overrides(['image.width=24', "
+                "'image.height=18']), device=d); print(d.platform.name.strip(), r.hit_fraction > 0.1)",
+                OPENCL_VENDOR_PATH=str(empty), PYJULIA4D_CACHE=str(tmp_path / "cache"))
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split()[-1] == "True"
+
+
+def test_an_unwritable_cache_costs_the_runtime_only(tmp_path: Path) -> None:
+    """A cache folder that cannot be written: no exception at import, a reason recorded."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    p = _python("import pyjulia4d; from pyjulia4d import runtimes; print(repr(runtimes.registered['why_not']))",
+                PYJULIA4D_CACHE=str(blocker / "cache"))
+    assert p.returncode == 0, p.stderr
+    if INTEL is not None:
+        assert "cannot write the vendors folder" in p.stdout
+
+
+# ------------------------------------------------------------------ which CPU runtime
+
+class _Platform:
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+
+class _Device:
+    def __init__(self, platform_name: str, n: int) -> None:
+        self.platform = _Platform(platform_name)
+        self.int_ptr = n
+        self.name = "cpu"
+
+
+def test_cpu_runtime_preference(monkeypatch) -> None:
+    """Of the CPUs that compile, Intel's runtime is preferred whatever the platform order;
+    a GPU still comes first; a CPU that cannot compile is never picked."""
+    from pyjulia4d import devices
+
+    pocl, intel, broken = _Device("Portable Computing Language", 1), _Device("Intel(R) OpenCL", 2), \
+        _Device("Intel(R) OpenCL", 3)
+    rows = [("0:0", None, pocl), ("1:0", None, broken), ("2:0", None, intel)]
+    monkeypatch.setattr(devices, "_indexed", lambda: rows)
+    monkeypatch.setattr(devices, "device_type", lambda d: "GPU" if d.platform.name == "GPU" else "CPU")
+    monkeypatch.setattr(devices, "compile_error", lambda d: "boom" if d is broken else "")
+    assert devices.select_device(None) is intel
+    why = devices.default_reason(intel)
+    assert why.startswith("2:0, the default: no GPU; of the CPU runtimes that compile, Intel(R) OpenCL is "
+                          "preferred") and "over 0:0" in why and "1:0 cannot compile" in why
+    gpu = _Device("GPU", 4)
+    rows.append(("3:0", None, gpu))
+    assert devices.select_device(None) is gpu
+    assert devices.select_device("0:0") is pocl   # an explicit choice stands
+
+
+def test_devices_says_the_default_and_the_registration() -> None:
+    from pyjulia4d.devices import describe_devices
+
+    lines = describe_devices().splitlines()
+    assert sum(line.endswith("(default)") for line in lines) == 1
+    assert any(", the default: " in line for line in lines)
+    assert lines[-1].startswith("Intel's CPU runtime from PyPI: ")
+
+
+# ------------------------------------------------------------------ the command line
+
+def test_version(capsys) -> None:
+    with pytest.raises(SystemExit) as e:
+        cli.main(["--version"])
+    assert e.value.code == 0
+    assert capsys.readouterr().out.strip() == f"pyjulia4d {pyjulia4d.__version__}"
+
+
+def test_help_names_the_command(capsys) -> None:
+    with pytest.raises(SystemExit):
+        cli.main(["--help"])
+    assert capsys.readouterr().out.startswith("usage: pyjulia4d ")
+
+
+def test_keys_lists_every_key_with_default_range_and_meaning(capsys) -> None:
+    assert cli.main(["keys"]) == 0
+    out = capsys.readouterr().out
+    for key in key_names():
+        i = out.index(f"\n{key} = " if out.index(key) else f"{key} = ")
+        block = out[i:].strip().splitlines()[:3]
+        assert block[0] == f"{key} = {keys.default_text(key)}"
+        assert block[1] == f"    range: {valid_range(key)}"
+        assert block[2].startswith("    ") and len(block[2].strip()) > 3
+    assert set(keys.MEANINGS) == set(key_names())
+
+
+def test_keys_defaults_are_the_scenes() -> None:
+    """Every default printed reads back as the default scene's value (camera.fit aside)."""
+    d = Scene.default().to_dict()
+    for key in key_names():
+        if key == "camera.fit":
+            continue
+        section, _, name = key.partition(".")
+        text = keys.default_text(key)
+        back = Scene.from_dict({"camera": {"position": list(Scene.default().camera.position)}},
+                               [f"{key}={text.strip('[]').strip(chr(34))}"] if text != "[]" else [])
+        assert back.to_dict()[section][name] == d[section][name], key
+
+
+def test_keys_section_and_bad_section(capsys) -> None:
+    assert cli.main(["keys", "image"]) == 0
+    out = capsys.readouterr().out
+    assert [ln.split(" = ")[0] for ln in out.splitlines() if not ln.startswith(" ")] == \
+        ["image.width", "image.height", "image.samples", "image.adaptive"]
+    assert cli.main(["keys", "octonion"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pyjulia4d: error: octonion: unknown section") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("fmt", [".png", ".exr"])
+def test_render_an_image_again(tmp_path: Path, fmt: str) -> None:
+    """render IMAGE reads the scene from its header - the camera camera.fit chose included -
+    and gives the same picture."""
+    first = tmp_path / f"first{fmt}"
+    assert cli.main(["render", "--width", "40", "--height", "30", "-o", str(first)]) == 0
+    again = tmp_path / "again.png"
+    assert cli.main(["render", str(first), "-o", str(again)]) == 0
+    if fmt == ".png":
+        assert np.array_equal(np.asarray(Image.open(first)), np.asarray(Image.open(again)))
+    from pyjulia4d.output import read_header
+
+    assert read_header(first)["pyjulia4d.scene"] == read_header(again)["pyjulia4d.scene"]
+    assert "fit = false" in read_header(again)["pyjulia4d.scene"]
+
+
+def test_render_an_image_default_output_and_overrides(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["render", "--width", "20", "--height", "16", "-o", "a.png"]) == 0
+    assert cli.main(["render", "a.png", "--width", "10"]) == 0
+    with Image.open(tmp_path / "a-rerender.png") as im:
+        assert im.size == (10, 16)
+
+
+@pytest.mark.parametrize("make,why", [
+    (lambda p: None, "cannot read: no such file"),
+    (lambda p: p.write_bytes(b"not a png"), "cannot read it as a PNG image"),
+    (lambda p: Image.new("RGB", (4, 4)).save(p), "holds no pyjulia4d scene"),
+])
+def test_render_an_image_bad(tmp_path: Path, capsys, make, why) -> None:
+    src = tmp_path / "src.png"
+    make(src)
+    before = set(tmp_path.iterdir())
+    assert cli.main(["render", str(src), "-o", str(tmp_path / "out.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pyjulia4d: error: {src}: {why}") and err.count("\n") == 1
+    assert set(tmp_path.iterdir()) == before
+
+
+def test_render_an_image_with_a_bad_embedded_scene(tmp_path: Path, capsys) -> None:
+    from PIL import PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    info.add_text("pyjulia4d.scene", "[fractal]\nmax_iter = -3\n")
+    src = tmp_path / "src.png"
+    Image.new("RGBA", (4, 4)).save(src, pnginfo=info)
+    assert cli.main(["render", str(src), "-o", str(tmp_path / "out.png")]) == 2
+    assert capsys.readouterr().err == "pyjulia4d: error: fractal.max_iter: must be in [1, 1000000], got -3\n"
+    assert not (tmp_path / "out.png").exists()
+
+
+# ------------------------------------------------------------------ Python scenes
+
+D = Scene.default()
+
+
+@pytest.mark.parametrize("build,message", [
+    (lambda: dataclasses.replace(D.fractal, max_iter=-5), "fractal.max_iter: must be in [1, 1000000], got -5"),
+    (lambda: dataclasses.replace(D.fractal, c=(float("nan"), 0, 0, 0)), "fractal.c: element 0: not a finite number"),
+    (lambda: dataclasses.replace(D.image, width=0), "image.width: must be in [1, 2147483647], got 0"),
+    (lambda: dataclasses.replace(D.fractal, algebra="octonion"), "fractal.algebra: expected one of"),
+    (lambda: dataclasses.replace(D.march, epsilon="small"), "march.epsilon: expected a number"),
+    (lambda: dataclasses.replace(D, fractal="x"), "fractal: expected a pyjulia4d.scene.Fractal"),
+    (lambda: dataclasses.replace(D, camera=dataclasses.replace(D.camera, target=D.camera.position)),
+     "camera.target: equals camera.position"),
+    (lambda: dataclasses.replace(D, fractal=dataclasses.replace(D.fractal, algebra="cquat", function="sin")),
+     "fractal.function: 'sin' is not defined for the cquat algebra"),
+    (lambda: dataclasses.replace(D, march=dataclasses.replace(D.march, near=2.0, far=1.0)),
+     "march.far: must be greater than march.near"),
+    (lambda: pyjulia4d.scene.Light(), "shading.lights[]: give exactly one of position and direction"),
+])
+def test_python_scenes_are_checked_when_built(build, message) -> None:
+    with pytest.raises(SceneError) as e:
+        build()
+    assert str(e.value).startswith(message)
+
+
+def test_python_values_are_normalised() -> None:
+    f = dataclasses.replace(D.fractal, c=[0, 1, 0, 0], bailout=3)
+    assert f.c == (0.0, 1.0, 0.0, 0.0) and isinstance(f.bailout, float)
+    cam = dataclasses.replace(D.camera, position=[1, 2, 3])
+    assert cam.position == (1.0, 2.0, 3.0, 0.0)
+    assert hash(Scene(fractal=f, camera=cam))   # frozen and hashable, as from a file
+
+
+def test_render_refuses_a_non_scene() -> None:
+    from pyjulia4d import render
+
+    with pytest.raises(SceneError, match=r"^scene: expected a pyjulia4d.Scene, got dict$"):
+        render({"fractal": {}})
+
+
+def test_default_scene_and_command_line_scene_differ_in_camera_only() -> None:
+    a, b = Scene.default().to_dict(), Scene.from_dict({}).to_dict()
+    assert b["camera"]["fit"] is True and a["camera"]["fit"] is False
+    a["camera"]["fit"] = True
+    assert a == b
+
+
+# ------------------------------------------------------------------ extras
+
+@pytest.mark.parametrize("args,message", [
+    (["--workers", "2"], "pyjulia4d: error: --workers: needs Dask distributed, which is not installed: "
+                         "pip install 'pyjulia4d[cluster]'"),
+    (["--scheduler", "tcp://127.0.0.1:1"], "pyjulia4d: error: --scheduler: needs Dask distributed"),
+    (["--video", "out.mp4", "--workers", "0"], "pyjulia4d: error: out.mp4: video needs imageio-ffmpeg, which is "
+                                                "not installed: pip install 'pyjulia4d[video]'"),
+])
+def test_missing_extras_get_one_line(tmp_path: Path, args, message) -> None:
+    scene = tmp_path / "a.toml"
+    scene.write_text("[image]\nwidth = 8\nheight = 6\n[animation]\nframes = 2\n"
+                     "[[keyframe]]\nframe = 0\nfractal.max_iter = 8\n[[keyframe]]\nframe = 1\nfractal.max_iter = 9\n")
+    p = _cli(["animate", str(scene), "-o", str(tmp_path / "f_##.png"), *args], tmp_path,
+             prelude="import sys; sys.modules['distributed'] = None; sys.modules['imageio_ffmpeg'] = None; ")
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.startswith(message) and p.stderr.count("\n") == 1
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["a.toml"]
+
+
+def test_animate_without_the_cluster_extra_renders_in_process(tmp_path: Path) -> None:
+    scene = tmp_path / "a.toml"
+    scene.write_text("[image]\nwidth = 8\nheight = 6\n[animation]\nframes = 2\n"
+                     "[[keyframe]]\nframe = 0\nfractal.max_iter = 8\n[[keyframe]]\nframe = 1\nfractal.max_iter = 9\n")
+    p = _cli(["animate", str(scene), "-o", str(tmp_path / "f_##.png")], tmp_path,
+             prelude="import sys; sys.modules['distributed'] = None; ")
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "f_00.png").is_file() and (tmp_path / "f_01.png").is_file()
+
+
+# ------------------------------------------------------------------ bugs of first contact
+
+def test_camera_fit_beyond_the_coordinate_range_names_the_bailout() -> None:
+    """bailout 1e6 on a pair without a polynomial escape bound: the bound is the bailout
+    ball, which no camera within +-1e6 frames; refused before any pass, naming the key that
+    made it so (not camera.position, which the user never set)."""
+    from pyjulia4d import render
+
+    scene = Scene.from_dict({"fractal": {"algebra": "cquat", "bailout": 1e6}, "image": {"width": 16, "height": 12}})
+    with pytest.raises(SceneError, match=r"^fractal\.bailout: camera\.fit: the first pass would need a camera"):
+        render(scene)
+
+
+def test_double_refused_before_any_build(monkeypatch) -> None:
+    """A device without cl_khr_fp64: the one-line message comes before camera.fit's pass, the
+    probe or any program build."""
+    from pyjulia4d import build
+    render_module = sys.modules["pyjulia4d.render"]   # the package's name "render" is the function
+
+    def no_build(*a, **k):
+        raise AssertionError("a program was built")
+
+    monkeypatch.setattr(render_module, "has_fp64", lambda dev: False)
+    monkeypatch.setattr(build, "program", no_build)
+    scene = Scene.from_dict({"render": {"float": "double"}, "image": {"width": 16, "height": 12}})
+    assert scene.camera.fit
+    with pytest.raises(SceneError, match=r"^render\.float: device '.*' has no cl_khr_fp64"):
+        render_module.render(scene)
+
+
+def test_cluster_tiles_record_the_fitted_camera() -> None:
+    """render --workers: the result's scene (the header's) is the camera the tiles used."""
+    from pyjulia4d import render
+    from pyjulia4d.distributed import render_tiled
+
+    scene = Scene.from_dict({"image": {"width": 48, "height": 36}})
+    result, used = render_tiled(None, scene, tile=16)
+    assert result.scene == used and not used.camera.fit
+    whole = render(scene)
+    assert whole.scene == used
+    assert np.array_equal(whole.color, result.color)
