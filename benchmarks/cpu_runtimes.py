@@ -9,7 +9,7 @@ PoCL from Debian's pocl-opencl-icd or PyPI where it compiles; a device that cann
 is listed and skipped).  Each pair's scene is the gallery's (benchmarks/gallery.py: fixed
 scan of 250 samples with 10 post-steps where the pair has no distance estimate), plus the
 cube of the CQuats and of the commutative rules.  Per pair and device a child process with
-empty program caches (pyjulia4d's and PoCL's) renders once - "first", which builds the
+empty program caches (pyjulia4d's, PoCL's and pyopencl's) renders once - "first", which builds the
 programs - then ``--repeats`` times: the median kernel time.  The devices alternate in order
 from pair to pair, so drift on this shared machine falls on both.  Writes
 benchmarks/results/cpu_runtimes.md (a section per run, with commit, devices and date).
@@ -95,7 +95,10 @@ def run_child(spec: str, overrides: list[str], repeats: int, lanes_file: Path | 
     import os
 
     with tempfile.TemporaryDirectory(prefix="cpu-runtimes-") as tmp:
-        env = dict(os.environ, PYJULIA4D_CACHE=str(Path(tmp) / "pyjulia4d"), POCL_CACHE_DIR=str(Path(tmp) / "pocl"))
+        # pyopencl keeps binaries of drivers that cache none of their own (Intel's) under
+        # $XDG_CACHE_HOME/pyopencl: every cache is empty, so "first" is a cold build
+        env = dict(os.environ, PYJULIA4D_CACHE=str(Path(tmp) / "pyjulia4d"), POCL_CACHE_DIR=str(Path(tmp) / "pocl"),
+                   XDG_CACHE_HOME=str(Path(tmp) / "xdg"))
         env.pop("OCL_ICD_VENDORS", None)   # the child registers the runtimes as any process does
         if lanes_file is not None and lanes_file.exists():   # the packet width probe's answer, not re-probed
             (Path(tmp) / "pyjulia4d").mkdir()
