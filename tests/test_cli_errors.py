@@ -138,7 +138,11 @@ def test_devices_command(tmp_path: Path) -> None:
     p = run_cli(["devices"], tmp_path)
     assert "Traceback" not in p.stderr
     if p.returncode == 0:
-        assert p.stdout.strip() and all(line[:1].isdigit() for line in p.stdout.splitlines())
+        lines = p.stdout.splitlines()
+        # one line per device, then why the default was chosen and whether Intel's runtime
+        # from PyPI is registered
+        assert lines and all(line[:1].isdigit() for line in lines[:-1])
+        assert ", the default: " in lines[-2] and lines[-1].startswith("Intel's CPU runtime from PyPI: ")
     else:  # no OpenCL platform on this machine
         assert p.returncode == 2 and len(p.stderr.splitlines()) == 1
 
