@@ -1,0 +1,108 @@
+"""Restructuring the Python side keeps every output bit for bit: a set of scenes (several
+algebras and functions, both marches, both precisions, the shading features, a region, a
+cluster tile, the other kinds) is rendered by the code of BASE - the last commit before
+the package was rearranged, taken from git - and by this checkout, each in a child process
+on the same device, and every channel of every result must be identical.
+
+Skipped where git or BASE is not at hand (an installed package, a shallow clone)."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tarfile
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+BASE = "67aa651af55251b676dc8768df5ed2ad2cd8572e"
+ROOT = Path(__file__).resolve().parent.parent
+
+SCENES = {
+    "default": [],
+    "fit": None,   # the command line's built-in scene: camera.fit's pass included
+    "fixed_bisect": ["march.method=fixed", "march.z_resolution=120", "march.refine=bisect"],
+    "quaternion_cube_gradient": ["fractal.function=cube", "fractal.c=-0.3,0.6,0.2,0.1", "normals.method=gradient"],
+    "hypercomplex_sin": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=-0.5,0.4,0,0",
+                         "fractal.max_iter=6", "camera.position=6,6,-8"],
+    "hypercomplex_pwr_zbuffer": ["fractal.algebra=hypercomplex", "fractal.function=pwr", "fractal.exponent=3,0.5",
+                                 "fractal.c=-0.7,0,0,0", "fractal.max_iter=8", "normals.method=zbuffer"],
+    "cquat": ["fractal.algebra=cquat", "fractal.c=-0.7323,-0.2179,0.1,0", "shading.shadow=hard"],
+    "commutative_cube": ["fractal.algebra=commutative", "fractal.function=cube", "fractal.max_iter=8"],
+    "double": ["render.float=double", "fractal.max_iter=8"],
+    "shading": ["shading.coloring=trap", "shading.colormap=magma", "shading.fog=0.3", "shading.reflection=0.3",
+                "shading.lights=position 3,1,-2 color 0.3,0.5,1 intensity 0.9; direction 0,-1,0.3",
+                "shading.sky=0.6,0.7,1", "clip.planes=0,0,1,0.2", "image.samples=2"],
+    "w_colour_adaptive": ["shading.coloring=w", "image.samples=3", "image.adaptive=true", "shading.light=eye"],
+    "mandelbrot": ["fractal.kind=mandelbrot", "camera.position=1.8,1.6,-3.2"],
+    "rotated": ["fractal.theta=40"],
+    "stack": ["fractal.kind=julia_stack", "fractal.max_iter=20"],
+    "locus": ["fractal.kind=cubic_locus", "march.z_resolution=200"],
+}
+
+CHILD = r"""
+import json, sys, warnings
+warnings.simplefilter("ignore")
+import numpy as np
+from pyjulia4d import Scene, render
+scenes, out = json.loads(sys.argv[1]), sys.argv[2]
+arrays = {}
+for name, keys in scenes.items():
+    size = ["image.width=40", "image.height=30"]
+    scene = Scene.from_dict({}, size) if keys is None else Scene.default().with_overrides(size + keys)
+    r = render(scene)
+    for k in ("color", "alpha", "depth", "bracket", "normal", "position", "status", "samples"):
+        a = getattr(r, k, None)
+        if a is not None:
+            arrays[f"{name}.{k}"] = a
+    arrays[f"{name}.counts"] = np.array(sorted(r.counts.items()), dtype=object).astype(str)
+    arrays[f"{name}.guards"] = np.array(sorted(r.guards.items()), dtype=object).astype(str)
+    arrays[f"{name}.scene"] = np.array((r.scene or scene).to_toml())
+# a region of the default render: the unit of a cluster's tiles (distributed.render_tiled)
+r = render(Scene.default().with_overrides(["image.width=40", "image.height=30"]), region=(8, 4, 17, 13))
+for k in ("color", "depth", "bracket", "normal", "status"):
+    arrays[f"region.{k}"] = getattr(r, k)
+np.savez(out, **arrays)
+"""
+
+
+def _base_tree(tmp: Path) -> Path | None:
+    """BASE's pyjulia4d/ and kernels/ unpacked under ``tmp``, or None without git or BASE."""
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        return None
+    p = subprocess.run(["git", "-C", str(ROOT), "archive", "--format=tar", BASE, "pyjulia4d", "kernels"],
+                       capture_output=True)
+    if p.returncode != 0:
+        return None
+    dest = tmp / "base"
+    dest.mkdir()
+    with tarfile.open(fileobj=io.BytesIO(p.stdout)) as tar:
+        tar.extractall(dest)
+    return dest
+
+
+def _render_with(code_root: Path, out: Path) -> dict[str, np.ndarray]:
+    env = dict(os.environ, PYTHONPATH=str(code_root))
+    env.pop("OCL_ICD_VENDORS", None)   # each child registers the runtimes itself, as any process does
+    p = subprocess.run([sys.executable, "-c", CHILD, __import__("json").dumps(SCENES), str(out)],
+                       cwd=code_root, env=env, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-2000:]
+    with np.load(out, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def test_outputs_bit_identical_to_base(tmp_path: Path) -> None:
+    base = _base_tree(tmp_path)
+    if base is None:
+        pytest.skip(f"git or commit {BASE[:8]} is not available")
+    before = _render_with(base, tmp_path / "before.npz")
+    after = _render_with(ROOT, tmp_path / "after.npz")
+    assert sorted(before) == sorted(after)
+    different = [k for k in before if not np.array_equal(before[k], after[k], equal_nan=before[k].dtype.kind == "f")]
+    assert not different, different
+    # the scenes really exercise what they name: hits in every one
+    for name in SCENES:
+        assert np.count_nonzero(after[f"{name}.status"] == 1) > 10, name
