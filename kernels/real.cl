@@ -44,19 +44,7 @@ typedef struct {
 #define COUNTER_INIT(i)
 #endif
 
-/* Pixel status codes written by the march kernel (mirrored in reference.py). */
-#define STATUS_MISS 0
-#define STATUS_HIT 1
-#define STATUS_CAPPED 2   /* the step cap ended the march before a hit or the far plane */
-
-/* Guard flags (nothing clamped without being counted).  The normals kernels
- * write them into the w component of the normal buffer, otherwise 0, and the host
- * counts the pixels each fired on (RenderResult.guards; mirrored in reference.py). */
-#define GUARD_NORMAL_FALLBACK 1   /* degenerate or non-finite normal replaced by the view axis */
-#define GUARD_JACOBIAN_TINY 2     /* Jacobian iteration stopped: q_n about to underflow (c ~ 0) */
-/* The march kernel writes its own flags buffer (same counting on the host). */
-#define GUARD_ULP_STEP 4          /* de: a step below the spacing of t was raised to one ulp */
-#define GUARD_SHELL_MISS 8        /* de: came within epsilon by the estimate, never inside: a miss */
+/* Pixel status codes and guard flags: codes.cl (read by pyjulia4d/codes.py too). */
 
 /* Lanes: the per-ray code is written once on these types.  LANES = 1 (the default) is one
  * ray per work-item, quat = real4 (GPUs, and the normals and shading everywhere); LANES = N

@@ -31,7 +31,7 @@ class KernelConfig:
 
 
 def iteration_pieces(scene: Scene) -> tuple[str, ...]:
-    """real.cl, complex arithmetic, the scene's one function (function/<name>.cl: a complex
+    """codes.cl (status and guard codes), real.cl, complex arithmetic, the scene's one function (function/<name>.cl: a complex
     function and its derivative) and one algebra (algebra/<name>.cl: the map q -> f(q) + c
     built from them), the iteration."""
     f = scene.fractal
@@ -41,8 +41,8 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
     # neither.
     rotate = ("kind/rotate",) if f.theta != 0 else ()
     kind = ("kind/level", f"kind/{f.kind}") if f.kind != "julia" else ()
-    return (("real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power + rotate
-            + ("iterate",) + kind)
+    return (("codes", "real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power
+            + rotate + ("iterate",) + kind)
 
 
 def fractal_defines(scene: Scene) -> tuple[str, ...]:

@@ -26,12 +26,8 @@ from .calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
 from .plan import TILE, Plan, Tile, make_plan, make_tiles  # noqa: F401 (TILE, make_tiles: API)
 from .scene import Scene, SceneError, march_method
 
-STATUS_MISS, STATUS_HIT, STATUS_CAPPED = 0, 1, 2  # kernels/real.cl
-# Guard flags (kernels/real.cl): the march's flags buffer and the normals' w component
-GUARD_NORMAL_FALLBACK = 1   # degenerate or non-finite normal replaced by the view axis
-GUARD_JACOBIAN_TINY = 2     # Jacobian iteration stopped: q_n about to underflow (c ~ 0)
-GUARD_ULP_STEP = 4          # de: a step below the spacing of t raised to one ulp
-GUARD_SHELL_MISS = 8        # de: within epsilon by the estimate, never inside: a miss
+from .codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,  # noqa: E402
+                    STATUS_CAPPED, STATUS_HIT, STATUS_MISS)
 
 
 @dataclass

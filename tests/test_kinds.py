@@ -53,7 +53,7 @@ def test_default_compiles_todays_kernels():
     d = Scene.default()
     explicit = d.with_overrides(["fractal.kind=julia", "fractal.theta=0"])
     assert build.scene_config(explicit) == build.scene_config(d)
-    assert build.iteration_pieces(d) == ("real", "algebra/complex", "function/sqr", "algebra/quaternion",
+    assert build.iteration_pieces(d) == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion",
                                          "iterate")
     assert build.fractal_defines(d) == ()
     src = build.source(build.scene_config(d))

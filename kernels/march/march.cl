@@ -28,7 +28,7 @@
  * each clips [near, far]; a hit at the first point of an interval that a plane started
  * lies on that plane's cut face, flagged FLAG_CUT_FACE | k << 5 for march/clip.cl. */
 #ifdef CLIP
-#define FLAG_CUT_FACE 16
+/* FLAG_CUT_FACE: codes.cl */
 #define CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
                   const real4 clip_n3, const real4 clip_off
 #else

@@ -21,7 +21,7 @@ from ..render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK,
 from ..scene import Scene, march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
-FLAG_CUT_FACE = 16   # march.cl (-D CLIP): a hit on a cut face; the plane's index in bits 5-6
+from ..codes import FLAG_CUT_FACE  # noqa: E402  (kernels/codes.cl)
 
 
 def _dot(a, b):
