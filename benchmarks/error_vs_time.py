@@ -64,6 +64,7 @@ if str(ROOT) not in sys.path:
 import pyopencl.array as cla  # noqa: E402
 
 from pyjulia4d import build, truth  # noqa: E402
+from pyjulia4d import kernel_config, truth  # noqa: E402
 from pyjulia4d import reference as ref  # noqa: E402
 from pyjulia4d.camera import camera_frame  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
@@ -222,8 +223,8 @@ class NormalKernels:
 
     def __call__(self, scene: Scene, res, method: str) -> np.ndarray:
         pr = Precision(scene.render.float == "double")
-        cfg = build.KernelConfig(build.iteration_pieces(scene) + (f"normals/{method}",),
-                                 build.precision_defines(scene) + build.fractal_defines(scene))
+        cfg = kernel_config.KernelConfig(kernel_config.iteration_pieces(scene) + (f"normals/{method}",),
+                                 kernel_config.precision_defines(scene) + kernel_config.fractal_defines(scene))
         prg = build.program(self.ctx, cfg)
         q = self.queue
         w, h = scene.image.width, scene.image.height

@@ -43,6 +43,7 @@ import pyopencl as cl  # noqa: E402
 import pyopencl.array as cla  # noqa: E402
 
 from pyjulia4d import build  # noqa: E402
+from pyjulia4d import kernel_config  # noqa: E402
 from pyjulia4d.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.devices import select_device  # noqa: E402
 from pyjulia4d.lanes import lanes_for  # noqa: E402
@@ -136,8 +137,8 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
     costs."""
     ctx, queue = queue_for(dev)
     pr = Precision(scene.render.float == "double")
-    cfg = build.scene_config(scene, ray_buffers=True)
-    counted = build.KernelConfig(cfg.pieces, cfg.defines + ("COUNT_ITERATIONS",))
+    cfg = kernel_config.scene_config(scene, ray_buffers=True)
+    counted = kernel_config.KernelConfig(cfg.pieces, cfg.defines + ("COUNT_ITERATIONS",))
     w, h = scene.image.width, scene.image.height
     n = w * h
     frame = camera_frame(scene)
@@ -154,7 +155,7 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
             np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps), depth.data,
             point.data, status.data, samples.data, flags.data, bracket.data)
     prg = build.program(ctx, cfg)
-    mprg = prg if lanes == 1 else build.program(ctx, build.march_config(scene, lanes, ray_buffers=True))
+    mprg = prg if lanes == 1 else build.program(ctx, kernel_config.march_config(scene, lanes, ray_buffers=True))
     launch(queue, cl.Kernel(prg, "generate_rays"), n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
            np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), origins.data, dirs.data)
     if shuffle:

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import build, workload
+from . import kernel_config, workload
 from .workload import resolve_outputs
 from .camera import Frame, camera_frame, light_position, march_radius
-from .scene import Scene
+from .scene import Scene, march_method
 
 # Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
 # which difference neighbours): device memory stays under ~20 MB single / ~36 MB double
@@ -81,8 +81,8 @@ class Plan:
     double: bool
     lanes: int                    # rays per work-item of the march (lanes.lanes_for)
     outputs: frozenset[str]
-    program: build.KernelConfig   # rays' tests, normals (other than packet Jacobian), shading
-    march_program: build.KernelConfig
+    program: kernel_config.KernelConfig   # rays' tests, normals (other than packet Jacobian), shading
+    march_program: kernel_config.KernelConfig
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
@@ -117,15 +117,15 @@ class Plan:
         return self.shades and "shade/reflect" in self.program.pieces
 
     @property
-    def reflect_program(self) -> build.KernelConfig:
+    def reflect_program(self) -> kernel_config.KernelConfig:
         """The march of the reflected rays: this plan's march reading given rays."""
         if self.lanes > 1:
-            return build.march_config(self.scene, self.lanes, ray_buffers=True)
-        return build.scene_config(self.scene, ray_buffers=True)
+            return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
+        return kernel_config.scene_config(self.scene, ray_buffers=True)
 
     @property
     def normals_in_march_program(self) -> bool:
-        """The Jacobian normals are built with the march, in its packets (build.march_config)."""
+        """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
         return self.scene.normals.method == "jacobian"
 
 
@@ -162,8 +162,43 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
         near=-1.0 if m.near == "auto" else float(m.near),
         far=-1.0 if m.far == "auto" else float(m.far),
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
-        program=build.scene_config(scene),
-        march_program=build.march_config(scene, lanes) if lanes > 1 else build.scene_config(scene),
+        program=kernel_config.scene_config(scene),
+        march_program=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
         tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height),
         estimate=est)
+
+
+# ---------------------------------------------------------------- numbers the kernels take
+# (resolved here, once, for both executors: render.py's OpenCL one and the float64 reference)
+
+GRADIENT_STEP_FLOOR = {"single": 1e-5, "double": 1e-8}
+
+
+def gradient_step(scene: Scene) -> float:
+    """The gradient normals' difference step: normals.step, or for "auto" march.epsilon
+    floored at GRADIENT_STEP_FLOOR[render.float]."""
+    if scene.normals.step != "auto":
+        return float(scene.normals.step)
+    return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.render.float])
+
+
+def fog_start(eye, radius: float) -> float:
+    """Where depth cueing starts: the eye's distance to the bounding ball (0 inside it)."""
+    return max(float(np.linalg.norm(eye)) - radius, 0.0)
+
+
+def light_parameters(sc: Scene, radius: float) -> dict:
+    """shade/light.cl's numbers: the shadow rays' step (the march's epsilon, or the fixed
+    scan's spacing across the bounding ball) and cap, the offset of their start off the
+    surface along the normal (two steps, at least 1e-3 of the ball's radius: the hit is
+    the outside end of its bracket, so this starts clear of the surface), the penumbra,
+    occlusion and trap settings."""
+    m, sh = sc.march, sc.shading
+    if march_method(sc) == "de":
+        step, cap = m.epsilon, m.max_steps
+    else:
+        step, cap = 2.0 * radius / m.z_resolution, m.z_resolution + 1
+    return dict(step=step, max_steps=cap, bias=max(2.0 * step, 1e-3 * radius),
+                softness=sh.shadow_softness, ao_distance=sh.ao_distance, ao_strength=sh.ao,
+                trap=tuple(sh.trap) + (0.0,) * (4 - len(sh.trap)))

@@ -8,6 +8,7 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d import build
+from pyjulia4d import kernel_config
 from pyjulia4d.devices import select_device
 from pyjulia4d.render import launch, queue_for
 
@@ -30,7 +31,7 @@ def packet_widths(widths=(4, 8, 16)):
 class Runner:
     """Kernels of one build configuration; arrays in, arrays out."""
 
-    def __init__(self, config: build.KernelConfig):
+    def __init__(self, config: kernel_config.KernelConfig):
         self.ctx, self.queue = queue_for(device())
         self.prg = build.program(self.ctx, config)
         self.double = "REAL_DOUBLE" in config.defines

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.reference.algebra import commutative as cm, cquat as cq, hypercomplex as hc, quaternion as qa
 from pyjulia4d.reference.formula import Formula, complex_value
 from pyjulia4d.render import STATUS_HIT, render
@@ -150,7 +150,7 @@ def test_function_piece_matches_its_twin(name, fl, tol):
     # dozen of them here; points within rounding of a branch cut may land on its other side
     assert set(FUNCTION_FILES) == set(FUNCTIONS)
     s = scene_of("hypercomplex", name, f"render.float={fl}")
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     rng = np.random.default_rng(21)
     z = rng.uniform(-2, 2, 5000) + 1j * rng.uniform(-2, 2, 5000)
     z = (z.real.astype(R.real) + 1j * z.imag.astype(R.real)).astype(np.complex128)
@@ -195,7 +195,7 @@ def test_step_matches_reference(algebra, function, fl, tol):
     # ~1e-7 relative per operation; the transcendental functions take a few dozen, and
     # cosh, exp amplify an argument's error by at most its size (|q| <= 2 here)
     s = scene_of(algebra, function, f"render.float={fl}")
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     p = rand4(4000, 12, 0.7).astype(R.real).astype(np.float64)
     h = rand4(4000, 13).astype(R.real).astype(np.float64)
     c = np.array(s.fractal.c)
@@ -217,7 +217,7 @@ def test_inside_matches_reference(algebra, function):
     # the set test over 20000 points of the ball: chaotic maps separate float32 and float64
     # orbits near the boundary, so a few in a thousand may be classified differently
     s = scene_of(algebra, function, "fractal.max_iter=6")
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     p = rand4(20000, 14, 1.6).astype(np.float32).astype(np.float64)
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
@@ -289,10 +289,10 @@ def test_render_matches_reference(algebra, function):
 # ------------------------------------------------------------ assembly and validation
 
 def test_a_scene_compiles_only_its_algebra_and_function():
-    src = build.source(build.scene_config(scene_of("hypercomplex", "sin")))
+    src = kernel_config.source(kernel_config.scene_config(scene_of("hypercomplex", "sin")))
     assert '"algebra/quaternion.cl"' not in src and "alg_sqr" not in src   # no quaternion code
     assert '"function/sin.cl"' in src and '"function/cos.cl"' not in src
-    src = build.source(build.scene_config(Scene.default()))
+    src = kernel_config.source(kernel_config.scene_config(Scene.default()))
     assert '"algebra/hypercomplex.cl"' not in src and '"function/sqr.cl"' in src
 
 
@@ -315,7 +315,7 @@ def test_hypercomplex_distance_estimate(function, c):
     # point is inside the truncated set (200 random points in each of 300 balls)
     s = scene_of("hypercomplex", function, f"fractal.c={','.join(map(str, c))}", "fractal.max_iter=12")
     F = ref.formula_of(s.fractal)
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     p = np.random.default_rng(16).uniform(-1.5, 1.5, (8000, 4)).astype(np.float32).astype(np.float64)
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)

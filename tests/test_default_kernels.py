@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from pyjulia4d import build
+from pyjulia4d import kernel_config
 from pyjulia4d.scene import Scene
 
 REFERENCE = Path(__file__).resolve().parent / "data" / "default_kernels.i"
@@ -32,23 +32,23 @@ PIECES = ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternio
 HEADER = "// tests/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)\n"
 
 
-def default_config() -> build.KernelConfig:
-    cfg = build.march_config(Scene.default(), 1)
-    return build.KernelConfig(tuple(p for p in cfg.pieces if p in PIECES), cfg.defines)
+def default_config() -> kernel_config.KernelConfig:
+    cfg = kernel_config.march_config(Scene.default(), 1)
+    return kernel_config.KernelConfig(tuple(p for p in cfg.pieces if p in PIECES), cfg.defines)
 
 
-def preprocessed(config: build.KernelConfig) -> str:
+def preprocessed(config: kernel_config.KernelConfig) -> str:
     cpp = shutil.which("cpp")
     if cpp is None:
         pytest.skip("no C preprocessor (cpp) on this machine")
-    src = build.source(config)
+    src = kernel_config.source(config)
     out = subprocess.run([cpp, "-P", "-undef", "-x", "c", *[f"-D{d}" for d in config.defines], "-"],
                          input=src, capture_output=True, text=True, check=True).stdout
     return "".join(" ".join(line.split()) + "\n" for line in out.splitlines() if line.strip())
 
 
 def test_default_scene_uses_the_pre_kinds_pieces_and_switches():
-    cfg = build.march_config(Scene.default(), 1)
+    cfg = kernel_config.march_config(Scene.default(), 1)
     # the iteration and the march as before the kinds (the shading pieces after them are its own),
     # after codes.cl, which holds the status and guard codes real.cl defined before (#defines only)
     assert cfg.pieces[:11] == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate",
@@ -72,8 +72,8 @@ def test_the_check_sees_a_kind_switch():
     # the same pieces built for a stack (-D KIND_NORMAL ... with its piece) differ: the
     # comparison above is sensitive to what a kind compiles in
     s = Scene.default().with_overrides(["fractal.kind=julia_stack"])
-    cfg = build.march_config(s, 1)
-    assert preprocessed(build.KernelConfig(tuple(p for p in cfg.pieces if p in PIECES + ("kind/julia_stack",)),
+    cfg = kernel_config.march_config(s, 1)
+    assert preprocessed(kernel_config.KernelConfig(tuple(p for p in cfg.pieces if p in PIECES + ("kind/julia_stack",)),
                                            cfg.defines)) != preprocessed(default_config())
 
 

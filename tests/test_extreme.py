@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import build, catalogue as cat, reference as ref, workload
+from pyjulia4d import kernel_config, catalogue as cat, reference as ref, workload
 from pyjulia4d.camera import camera_frame
 from pyjulia4d.render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, render
 from pyjulia4d.scene import Scene, SceneError, march_method
@@ -156,7 +156,7 @@ def probe_points(n=4000, seed=1):
 @pytest.mark.parametrize("max_iter,bailout", [(10000, 4.0), (100, 1e6), (10000, 1e6), (10000, 9e8)])
 def test_distance_estimate_finite_float32(max_iter, bailout):
     s = Scene.default().with_overrides([f"fractal.max_iter={max_iter}", f"fractal.bailout={bailout}"])
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     p = probe_points()
     n = len(p)
     inside, dist, formula = R.out(n, np.int32), R.out(n), R.out(n)
@@ -180,7 +180,7 @@ def test_derivative_beyond_range_is_rescaled(fl):
     p = np.zeros((64, 4))
     p[:, 0] = x
     p[1::2, 1] = 1e-9      # and just off it (escaping late, or not at all in float32)
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     n = len(p)
     inside, dist, formula = R.out(n, np.int32), R.out(n), R.out(n)
     R("probe_iterate", (n,), R.buf4(p), R.vec(s.fractal.c), np.int32(10000), R.scalar(4.0),
@@ -189,7 +189,7 @@ def test_derivative_beyond_range_is_rescaled(fl):
     assert np.mean(inside.get()) > 0.4
     d64, esc = ref.julia_distance_formula(p, s.fractal.c, 10000, 4.0)
     assert np.all(np.isfinite(d64))
-    R = Runner(build.scene_config(s.with_overrides(["normals.method=jacobian"])))
+    R = Runner(kernel_config.scene_config(s.with_overrides(["normals.method=jacobian"])))
     fr = camera_frame(s)
     out = R.out4(n)
     R("normals_jacobian", (n,), R.buf4(p), R.buf(np.ones(n), np.int32), R.vec(s.fractal.c),

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.scene import Scene
 
 CS = [(-0.2, 0.8, 0, 0), (-0.125, -0.256, 0.847, 0.0895), (0.4, 0.5, 0, 0), (0, 0, 0, 0),
@@ -19,7 +19,7 @@ def ball_points(n, radius, seed):
 
 
 def run_probe(fl, p, c, max_iter, bailout):
-    R = Runner(build.probe_config(Scene.default().with_overrides([f"render.float={fl}"])))
+    R = Runner(kernel_config.probe_config(Scene.default().with_overrides([f"render.float={fl}"])))
     p = p.astype(R.real).astype(np.float64)  # both sides see the same, representable inputs
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)

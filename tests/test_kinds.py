@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.camera import mandelbrot_radius
 from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.kind import rotate
@@ -37,7 +37,7 @@ def complex_mandelbrot(c, n_iter, bailout, power=2):
 
 def probe(s, p, c=(0, 0, 0, 0)):
     """probe.cl's probe_iterate on points p: (inside, distance, formula) from the kernels."""
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
     R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(s.fractal.max_iter), R.scalar(s.fractal.bailout),
@@ -52,16 +52,16 @@ def test_default_compiles_todays_kernels():
     # default scene is built from the same files and -D switches as before these keys existed
     d = Scene.default()
     explicit = d.with_overrides(["fractal.kind=julia", "fractal.theta=0"])
-    assert build.scene_config(explicit) == build.scene_config(d)
-    assert build.iteration_pieces(d) == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion",
+    assert kernel_config.scene_config(explicit) == kernel_config.scene_config(d)
+    assert kernel_config.iteration_pieces(d) == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion",
                                          "iterate")
-    assert build.fractal_defines(d) == ()
-    src = build.source(build.scene_config(d))
-    assert '#line 1 "kind/' not in src and "KIND_MANDELBROT" not in build.scene_config(d).defines
+    assert kernel_config.fractal_defines(d) == ()
+    src = kernel_config.source(kernel_config.scene_config(d))
+    assert '#line 1 "kind/' not in src and "KIND_MANDELBROT" not in kernel_config.scene_config(d).defines
     # and the new switches do appear where asked
-    m = build.scene_config(mandel())
+    m = kernel_config.scene_config(mandel())
     assert "kind/mandelbrot" in m.pieces and "KIND_MANDELBROT" in m.defines
-    r = build.scene_config(d.with_overrides(["fractal.theta=30"]))
+    r = kernel_config.scene_config(d.with_overrides(["fractal.theta=30"]))
     assert "kind/rotate" in r.pieces and any(x.startswith("ROTATE_COS=") for x in r.defines)
 
 
@@ -256,7 +256,7 @@ def test_rotated_jvp_is_the_derivative(function):
 def test_rotated_step_and_set_match_reference(function, fl, tol):
     s = Scene.default().with_overrides([f"fractal.function={function}", "fractal.theta=50",
                                         "fractal.max_iter=8", f"render.float={fl}"])
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     F = ref.formula_of(s.fractal)
     p = rand4(4000, 13, 0.7).astype(R.real).astype(np.float64)
     h = rand4(4000, 14).astype(R.real).astype(np.float64)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.camera import camera_frame, march_radius
 from pyjulia4d.render import march_items
 from pyjulia4d.scene import Scene
@@ -14,8 +14,8 @@ W, H = 48, 36
 
 def run_march(s: Scene, lanes: int = 1):
     """Kernel and reference on the same (float32-representable) rays of a small image."""
-    R = Runner(build.march_config(s, lanes, ray_buffers=True) if lanes > 1
-               else build.scene_config(s, ray_buffers=True))
+    R = Runner(kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
+               else kernel_config.scene_config(s, ray_buffers=True))
     o, d = ref.generate_rays(camera_frame(s), W, H)
     o, d = o.astype(R.real).astype(float), d.astype(R.real).astype(float)
     f, m = s.fractal, s.march

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.camera import camera_frame, march_radius
 from pyjulia4d.scene import Scene
 
@@ -25,7 +25,7 @@ def angles(a, b):
     return np.degrees(np.arccos(np.clip(np.sum(a * b, -1), -1, 1)))
 
 
-# (method, lanes): the Jacobian normals also run in packets of rays (build.march_config)
+# (method, lanes): the Jacobian normals also run in packets of rays (kernel_config.march_config)
 METHODS = [("jacobian", 1), ("gradient", 1), ("zbuffer", 1)] + [("jacobian", w) for w in packet_widths((16,))]
 
 
@@ -37,8 +37,8 @@ def test_normals_match_reference(method, lanes, fl, c):
         pytest.skip("packets are single precision")
     s = Scene.default().with_overrides([f"normals.method={method}", f"render.float={fl}",
                                         "fractal.c=" + ",".join(map(str, c))])
-    R = Runner(build.march_config(s, lanes, ray_buffers=True) if lanes > 1
-               else build.scene_config(s, ray_buffers=True))
+    R = Runner(kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
+               else kernel_config.scene_config(s, ray_buffers=True))
     fr = camera_frame(s)
     depth, point, status = hits(s, R.real)
     n = len(point)

@@ -134,12 +134,12 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     # options and device; a later process loads it instead of compiling, and a binary that
     # no longer loads is rebuilt from source
     from harness import device
-    from pyjulia4d import build
+    from pyjulia4d import build, kernel_config
     from pyjulia4d.render import queue_for
 
     monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
     ctx, _ = queue_for(device())
-    cfg = build.KernelConfig(build.probe_config(Scene.default()).pieces, ("PROBE_CACHE_TEST",))
+    cfg = kernel_config.KernelConfig(kernel_config.probe_config(Scene.default()).pieces, ("PROBE_CACHE_TEST",))
     build._programs.pop((ctx.int_ptr, cfg), None)
     build.program(ctx, cfg)
     [binary] = list((tmp_path / "programs").glob("*.bin"))

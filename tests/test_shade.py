@@ -6,7 +6,7 @@ import pyopencl as cl
 import pytest
 
 from harness import Runner
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.camera import camera_frame, extra_lights, light_position
 from pyjulia4d.scene import Scene
 
@@ -24,7 +24,7 @@ from pyjulia4d.scene import Scene
 def test_shade_matches_reference(over, fl):
     # shade.cl alone: no light terms (those are test_light_terms_in_render_match_reference's)
     s = Scene.default().with_overrides(["shading.shadow=none", "shading.ao=0"] + over + [f"render.float={fl}"])
-    R = Runner(build.scene_config(s))
+    R = Runner(kernel_config.scene_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(5)
     n = 4000
@@ -40,7 +40,7 @@ def test_shade_matches_reference(over, fl):
     geo, rgb = extra_lights(s)
     geo = geo.astype(R.real).astype(float)
     # the extra lights' visibility (light.cl's, given here): 1 with no shadows compiled
-    vis = rng.uniform(0, 1, (n, 4)) if "EXTRA_SHADOWS" in build.scene_config(s).defines else np.ones((n, 4))
+    vis = rng.uniform(0, 1, (n, 4)) if "EXTRA_SHADOWS" in kernel_config.scene_config(s).defines else np.ones((n, 4))
     # light.cl's terms (the key light's visibility, occlusion, colour value): none here
     terms = np.tile([1.0, 1.0, 0.0, 0.0], (n, 1))
     refl = rng.uniform(0, 1, (n, 4))   # reflect.cl's colour of the bounce (given here)
@@ -129,17 +129,17 @@ def test_light_terms_in_render_match_reference(name):
 
 def test_scene_without_light_terms_compiles_none():
     plain = Scene.default().with_overrides(["shading.shadow=none", "shading.ao=0"])
-    src = build.source(build.scene_config(plain))
+    src = kernel_config.source(kernel_config.scene_config(plain))
     assert '"shade/light.cl"' not in src
-    src = build.source(build.scene_config(plain.with_overrides(["shading.ao=0.5"])))
+    src = kernel_config.source(kernel_config.scene_config(plain.with_overrides(["shading.ao=0.5"])))
     assert '"shade/light.cl"' in src and "#define" in src
 
 
 def test_shadows_compiled_only_where_they_show():
     # the light at the eye casts no visible shadow: none traced; soft without an estimate is hard
-    assert "SHADOW_SOFT" not in build.scene_config(Scene.default().with_overrides(["shading.light=eye"])).defines
+    assert "SHADOW_SOFT" not in kernel_config.scene_config(Scene.default().with_overrides(["shading.light=eye"])).defines
     s = Scene.default().with_overrides(["fractal.algebra=hypercomplex", "shading.shadow=soft"])
-    assert "SHADOW_SOFT" in build.scene_config(s).defines     # light.cl takes the hard path: no estimate
+    assert "SHADOW_SOFT" in kernel_config.scene_config(s).defines     # light.cl takes the hard path: no estimate
 
 
 @pytest.mark.parametrize("over,key", [
@@ -188,7 +188,7 @@ def test_reflect_kernels_match_reference(light, fl):
     reflected rays to float rounding of their precision, the bounce's colour to float32."""
     s = Scene.default().with_overrides([f"shading.light={light}", "shading.reflection=0.5",
                                         "shading.sky=0.3,0.5,0.9", f"render.float={fl}"])
-    R = Runner(build.scene_config(s))
+    R = Runner(kernel_config.scene_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(7)
     n = 3000
@@ -242,11 +242,11 @@ def test_lights_and_reflection_compile_only_where_used():
     """shade/reflect.cl and the extra lights' code are compiled only in scenes that use them
     (-D REFLECTION, -D EXTRA_LIGHTS=k, -D EXTRA_SHADOWS)."""
     plain = Scene.default()
-    src = build.source(build.scene_config(plain))
-    assert '"shade/reflect.cl"' not in src and "EXTRA_LIGHTS" not in build.scene_config(plain).defines
+    src = kernel_config.source(kernel_config.scene_config(plain))
+    assert '"shade/reflect.cl"' not in src and "EXTRA_LIGHTS" not in kernel_config.scene_config(plain).defines
     lit = plain.with_overrides(["shading.lights=position 1,2,3; direction 0,1,0", "shading.reflection=0.2"])
-    cfg = build.scene_config(lit)
-    assert '"shade/reflect.cl"' in build.source(cfg)
+    cfg = kernel_config.scene_config(lit)
+    assert '"shade/reflect.cl"' in kernel_config.source(cfg)
     assert {"REFLECTION", "EXTRA_LIGHTS=2", "EXTRA_SHADOWS"} <= set(cfg.defines)
     # no shadows: the extra lights shine, but no shadow rays are compiled for them
-    assert "EXTRA_SHADOWS" not in build.scene_config(lit.with_overrides(["shading.shadow=none"])).defines
+    assert "EXTRA_SHADOWS" not in kernel_config.scene_config(lit.with_overrides(["shading.shadow=none"])).defines

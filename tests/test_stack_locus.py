@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import build, reference as ref
+from pyjulia4d import kernel_config, reference as ref
 from pyjulia4d.camera import march_radius
 from pyjulia4d.render import STATUS_HIT, render
 from pyjulia4d.scene import Scene, SceneError, march_method
@@ -37,7 +37,7 @@ def c_of(u):
 
 
 def probe(s, p):
-    R = Runner(build.probe_config(s))
+    R = Runner(kernel_config.probe_config(s))
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
     R("probe_iterate", (n,), R.buf4(p), R.vec((9, 9, 9, 9)), np.int32(s.fractal.max_iter),
@@ -169,7 +169,7 @@ def test_stack_packets_give_the_same_pixels(lanes):
 def test_stack_radius_holds_the_stack(over):
     # no point just outside the ball (in the view's hyperplane w = w0) is inside
     s = stack(*over)
-    assert march_method(s) == "fixed" and "STACK_DE" not in build.fractal_defines(s)
+    assert march_method(s) == "fixed" and "STACK_DE" not in kernel_config.fractal_defines(s)
     r = march_radius(s)
     w0 = s.slice.distance
     u = np.random.default_rng(6).normal(size=(20000, 3))
@@ -354,4 +354,4 @@ def test_locus_keys_refused_with_the_key(over, key):
 
 def test_locus_radius_with_bailout_raised_is_accepted():
     s = locus("fractal.locus_radius=3", "fractal.bailout=6")
-    assert march_method(s) == "fixed" and "LOCUS_SIGN=1" in build.fractal_defines(s)
+    assert march_method(s) == "fixed" and "LOCUS_SIGN=1" in kernel_config.fractal_defines(s)

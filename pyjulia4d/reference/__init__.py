@@ -15,9 +15,10 @@ import time
 import numpy as np
 
 from ..camera import Frame, camera_frame, clip_planes, light_position, march_radius
-from ..render import (gradient_step, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP,
-                     STATUS_CAPPED,
-                     STATUS_HIT, STATUS_MISS, RenderResult, count_guards)
+from ..codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED,
+                     STATUS_HIT, STATUS_MISS)
+from ..plan import fog_start, gradient_step, light_parameters
+from ..result import RenderResult, count_guards
 from ..scene import Scene, march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
@@ -649,7 +650,6 @@ def render(scene: Scene) -> RenderResult:
         normal = clip_normals(guard, status, frame, planes, normal)
         refl = None
         if sh.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray
-            from ..render import light_parameters
             from .shade import reflect_color, reflect_rays
             radius = march_radius(scene)
             o2, d2 = reflect_rays(point, normal, status, frame, light_parameters(scene, radius)["bias"], radius)
@@ -668,7 +668,6 @@ def render(scene: Scene) -> RenderResult:
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
         from ..camera import extra_lights
-        from ..render import fog_start
         geo, rgb = extra_lights(scene) if sh.lights else (None, None)
         rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
                      sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut,

@@ -1,5 +1,5 @@
 """The iteration a scene compiles, assembled for the float64 reference the way
-build.iteration_pieces assembles kernels: one algebra module (reference/algebra/) and one
+kernel_config.iteration_pieces assembles kernels: one algebra module (reference/algebra/) and one
 function module (reference/function/), by the scene's names."""
 from __future__ import annotations
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..camera import Frame
-from ..render import STATUS_HIT
+from ..codes import STATUS_HIT
+from ..plan import light_parameters
 # imported by the package at its end, once these are defined
 from . import _dot, _to_camera, julia_distance_formula, julia_inside
 from .formula import QUATERNION_SQR, Formula
@@ -174,7 +175,6 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
 def extra_visibility_of_scene(scene, point, normal, status, F: Formula):
     """extra_visibility with the scene's settings, or None without shadows or shading.lights."""
     from ..camera import camera_frame, extra_lights, march_radius
-    from ..render import light_parameters
     sh = scene.shading
     if sh.shadow == "none" or not sh.lights:
         return None
@@ -190,9 +190,8 @@ def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     """light_terms with the scene's settings (render.light_parameters), or None when the
     scene uses none of them."""
     from ..camera import camera_frame, light_position, march_radius
-    from ..render import light_parameters
     sh = scene.shading
-    shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # build.light_defines
+    shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # kernel_config.light_defines
     if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
         return None
     fr = camera_frame(scene)
