@@ -34,10 +34,10 @@ for p in (ROOT, ROOT / "benchmarks"):
 
 from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 
-from pyjulia4d import truth  # noqa: E402
-from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.quality import PRESETS  # noqa: E402
-from pyjulia4d.scene import Scene, has_distance_estimate  # noqa: E402
+from pyjulia4d.measure import truth  # noqa: E402
+from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.scene.quality import PRESETS  # noqa: E402
+from pyjulia4d.scene.model import Scene, has_distance_estimate  # noqa: E402
 
 HC = ["fractal.algebra=hypercomplex"]
 SCENES = {

@@ -31,8 +31,8 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 def _frames_run(client, anim, frames, out: Path):
     """(wall seconds, worker seconds summed) of rendering and writing ``frames``."""
-    from pyjulia4d.distributed import render_many
-    from pyjulia4d.output import _atomic
+    from pyjulia4d.app.cluster import render_many
+    from pyjulia4d.app.output import _atomic
 
     worker = []
 
@@ -71,10 +71,11 @@ def main(argv=None) -> int:
     warnings.simplefilter("ignore")
     from distributed import Client, LocalCluster
 
-    from pyjulia4d import keyframes, render
-    from pyjulia4d.distributed import render_tiled
-    from pyjulia4d.devices import select_device
-    from pyjulia4d.output import write_image
+    from pyjulia4d.scene import keyframes
+    from pyjulia4d import render
+    from pyjulia4d.app.cluster import render_tiled
+    from pyjulia4d.opencl.devices import select_device
+    from pyjulia4d.app.output import write_image
 
     w, h = (int(x) for x in args.size.split("x"))
     anim = keyframes.load(ROOT / "examples" / "c_morph.toml", [f"image.width={w}", f"image.height={h}"])

@@ -35,9 +35,10 @@ if str(ROOT / "benchmarks") not in sys.path:
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
-from pyjulia4d import Scene, antialias, render  # noqa: E402
-from pyjulia4d.colormap import linear_to_srgb  # noqa: E402
-from pyjulia4d.scene import march_method  # noqa: E402
+from pyjulia4d import Scene, render  # noqa: E402
+from pyjulia4d.pipeline import antialias
+from pyjulia4d.pipeline.colormap import linear_to_srgb  # noqa: E402
+from pyjulia4d.scene.model import march_method  # noqa: E402
 
 SCENES = {
     "default": [],
@@ -126,7 +127,7 @@ def main(argv=None) -> int:
                         f"{wall:.3f} | {wall / wall1:.2f} | {share} |")
             print(f"{name}: {rows[-1]}", flush=True)
             if a.pictures is not None:
-                from pyjulia4d.output import write_png
+                from pyjulia4d.app.output import write_png
                 a.pictures.mkdir(parents=True, exist_ok=True)
                 slug = name.split(" ")[0] + ("_sin" if "sin" in name else "")
                 tag = "".join(ch if ch.isalnum() else "_" for ch in label)

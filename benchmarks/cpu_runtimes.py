@@ -37,7 +37,7 @@ CHILD = r"""
 import json, statistics, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
-from pyjulia4d.devices import select_device
+from pyjulia4d.opencl.devices import select_device
 spec, repeats, overrides = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
 scene = Scene.default().with_overrides(overrides)
 dev = select_device(spec)
@@ -53,7 +53,7 @@ print(json.dumps({"first": first_s, "kernel": statistics.median(r.kernel_seconds
 
 def pairs() -> dict[str, list[str]]:
     """Scene name -> overrides: the gallery's pairs and the CQuat and commutative cubes."""
-    from pyjulia4d.scene import FUNCTIONS_OF
+    from pyjulia4d.scene.model import FUNCTIONS_OF
 
     out = {name: COMMON + keys for name, keys in SCENES.items()}
     for algebra, functions in FUNCTIONS_OF.items():
@@ -67,7 +67,7 @@ def pairs() -> dict[str, list[str]]:
 
 def cpu_devices() -> list[tuple[str, str, str]]:
     """(P:D spec, short name, why skipped or "") for every CPU device."""
-    from pyjulia4d.devices import compile_error, device_type, list_devices
+    from pyjulia4d.opencl.devices import compile_error, device_type, list_devices
 
     out = []
     for pi_di, (p, d) in zip(_specs(), list_devices()):
@@ -119,8 +119,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     w, h = (int(x) for x in a.size.lower().split("x"))
 
-    from pyjulia4d.devices import select_device
-    from pyjulia4d.lanes import cache_path, lanes_for
+    from pyjulia4d.opencl.devices import select_device
+    from pyjulia4d.opencl.lanes import cache_path, lanes_for
 
     devices = cpu_devices()
     usable = [(s, n) for s, n, err in devices if not err]

@@ -63,13 +63,15 @@ if str(ROOT) not in sys.path:
 
 import pyopencl.array as cla  # noqa: E402
 
-from pyjulia4d import build, truth  # noqa: E402
-from pyjulia4d import kernel_config, truth  # noqa: E402
+from pyjulia4d.opencl import build  # noqa: E402
+from pyjulia4d.measure import truth
+from pyjulia4d.pipeline import kernel_config  # noqa: E402
+from pyjulia4d.measure import truth
 from pyjulia4d import reference as ref  # noqa: E402
-from pyjulia4d.camera import camera_frame  # noqa: E402
-from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.render import STATUS_HIT, Precision, launch_normals, queue_for, render  # noqa: E402
-from pyjulia4d.scene import Scene  # noqa: E402
+from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
+from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.opencl.executor import STATUS_HIT, Precision, launch_normals, queue_for, render  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
 
 # name -> (overrides, description).  The first nine: seed 000's figures, POV-Ray's example
 # and the two exact oracles, all max_iter 8-12 with w = 0 cameras.  The rest: max_iter 20
@@ -135,7 +137,7 @@ def scene_max_iter(name: str) -> int:
 
 def bounded(name: str) -> bool:
     """Scenes the presets state a p99 bound for (quality.BOUND_MAX_ITER)."""
-    from pyjulia4d.quality import BOUND_MAX_ITER
+    from pyjulia4d.scene.quality import BOUND_MAX_ITER
     return scene_max_iter(name) <= BOUND_MAX_ITER
 
 
@@ -159,7 +161,7 @@ def grid(quick: bool) -> list[dict]:
     out += [setting("fixed", z, p, 1e-3, "bisect") for z, p in FIXED_BISECT]
     out += [setting(m, z, p, 1e-3, r) for (m, z, p, r) in ONLY]
     # every preset's own setting is measured on every scene
-    from pyjulia4d.quality import PRESETS
+    from pyjulia4d.scene.quality import PRESETS
     keys = {setting_key(s) for s in out}
     for q, pr in PRESETS.items():
         s = setting(pr["method"], pr["z_resolution"], pr["post_steps"], pr["epsilon"], pr.get("refine", "itp"))
@@ -510,7 +512,7 @@ def write_csv(path: Path, rows: list[dict], columns=None) -> None:
 def preset_table(rows: list[dict]) -> list[dict]:
     """Each quality.py preset's measured worst case over the scenes of ``rows``: over the
     scenes it states a bound for (max_iter <= quality.BOUND_MAX_ITER) and over the rest."""
-    from pyjulia4d.quality import PRESETS
+    from pyjulia4d.scene.quality import PRESETS
     out = []
     for q, pr in PRESETS.items():
         key = setting_key(setting(pr["method"], pr["z_resolution"], pr["post_steps"], pr["epsilon"],
@@ -574,7 +576,7 @@ def write_markdown(path: Path, rows: list[dict], meta: dict, truths: dict, prese
     L.append("")
     ptab = preset_table(rows) if meta["mode"] == "full" else []
     if ptab:
-        from pyjulia4d.quality import BOUND_MAX_ITER
+        from pyjulia4d.scene.quality import BOUND_MAX_ITER
         L += ["## The presets (pyjulia4d/quality.py) on every scene", "",
               f"Stated bounds apply to scenes with max_iter <= {BOUND_MAX_ITER} (quality.BOUND_MAX_ITER); the "
               "max_iter 50 scenes are reported beside them (no float32 bound is stated there).", "",

@@ -35,8 +35,8 @@ for _p in (ROOT, ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
-from pyjulia4d import catalogue as cat  # noqa: E402
-from pyjulia4d.render import STATUS_HIT, render  # noqa: E402
+from pyjulia4d.measure import catalogue as cat  # noqa: E402
+from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
 
 from error_vs_time import git_head  # noqa: E402  (same folder: benchmarks/)
 
@@ -164,7 +164,7 @@ def main(argv=None) -> int:
             continue
         for method in case.methods:
             r = measure(case, method, args.scale, args.repeats)
-            from pyjulia4d.devices import select_device
+            from pyjulia4d.opencl.devices import select_device
             r["device"] = select_device(None).name.strip()
             rows.append(r)
             print(f"{r['case']:20s} {method:5s} mism={r['status_mismatch']:.3f} "

@@ -245,7 +245,7 @@ def main(argv=None) -> int:
 
     warnings.simplefilter("ignore")
     from pyjulia4d import Scene, render
-    from pyjulia4d.output import write_image
+    from pyjulia4d.app.output import write_image
 
     folder = a.out / "gallery"
     folder.mkdir(parents=True, exist_ok=True)

@@ -165,7 +165,7 @@ VARIANTS = {"pyjulia4d default": [], "pyjulia4d march.quality=draft": ["march.qu
 
 
 def pov_scene(w: int, h: int) -> str:
-    from pyjulia4d.scene import Scene
+    from pyjulia4d.scene.model import Scene
 
     s = Scene.default().with_overrides(MATCHED)
     px, py, pz = s.camera.position[:3]
@@ -193,7 +193,7 @@ def run_povray(w: int, h: int, tmp: Path) -> dict:
 def mb_settings(w: int, h: int) -> str:
     """pyjulia4d's default scene as a Mandelbulber2 settings file (see the docstring: y-up
     left-handed (x, y, z) -> z-up right-handed (x, z, y), c's i and j swapped)."""
-    from pyjulia4d.scene import Scene
+    from pyjulia4d.scene.model import Scene
 
     s = Scene.default().with_overrides(MATCHED)
     cam, f = s.camera, s.fractal

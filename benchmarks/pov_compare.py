@@ -115,7 +115,7 @@ def _cpu() -> float:
 
 
 def scene_of(text: str, w: int, h: int, tmp: Path):
-    from pyjulia4d.povray import import_pov
+    from pyjulia4d.interop.povray import import_pov
 
     src = tmp / "import.pov"
     src.write_text(text)
@@ -125,7 +125,7 @@ def scene_of(text: str, w: int, h: int, tmp: Path):
 def view_cos(scene, normal) -> np.ndarray:
     """|n . d| per pixel: the camera-space normal against the pixel's view ray."""
     from pyjulia4d import reference as ref
-    from pyjulia4d.camera import camera_frame
+    from pyjulia4d.geometry.camera import camera_frame
 
     f = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
@@ -146,7 +146,7 @@ def grad_n_cos(scene, position, mask) -> np.ndarray:
     end (no escape test), at the truth's hit points: what POV-Ray's CalcNormal computes for
     the quaternions (the Jacobian of all N iterations at the hit)."""
     from pyjulia4d import reference as ref
-    from pyjulia4d.camera import camera_frame
+    from pyjulia4d.geometry.camera import camera_frame
     from pyjulia4d.reference.formula import formula_of
 
     f = camera_frame(scene)
@@ -327,7 +327,7 @@ def inside_test_evidence(w: int, h: int, tmp: Path) -> str:
     intersection { julia_fractal {...} plane { -z, 0 } } is drawn (red) exactly where
     POV-Ray's Inside() says the plane's point is in the set."""
     from pyjulia4d import reference as ref
-    from pyjulia4d.camera import camera_frame
+    from pyjulia4d.geometry.camera import camera_frame
     from pyjulia4d.reference.formula import formula_of
 
     items = "<0.8, 0.4, 0.2, 0.1> hypercomplex sin max_iteration 8 precision 200"

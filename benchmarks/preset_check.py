@@ -55,11 +55,11 @@ for p in (ROOT, ROOT / "benchmarks"):
         sys.path.insert(0, str(p))
 
 from error_vs_time import SLACK_ULPS, git_head  # noqa: E402
-from pyjulia4d import truth  # noqa: E402
-from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.quality import BOUND_MAX_ITER, PRESETS, apply_quality, stated_p99  # noqa: E402
-from pyjulia4d.render import STATUS_HIT, render  # noqa: E402
-from pyjulia4d.scene import Scene  # noqa: E402
+from pyjulia4d.measure import truth  # noqa: E402
+from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.scene.quality import BOUND_MAX_ITER, PRESETS, apply_quality, stated_p99  # noqa: E402
+from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
 
 SEEDS = (2027, 2028)
 KINDS = ("boundary", "dust", "interior")

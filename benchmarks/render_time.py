@@ -19,8 +19,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from pyjulia4d import Scene, render  # noqa: E402
-from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.output import write_png  # noqa: E402
+from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.app.output import write_png  # noqa: E402
 from run_log import append_run, git_commit  # noqa: E402
 
 

@@ -42,13 +42,13 @@ for _p in (ROOT, ROOT / "benchmarks"):
 import pyopencl as cl  # noqa: E402
 import pyopencl.array as cla  # noqa: E402
 
-from pyjulia4d import build  # noqa: E402
-from pyjulia4d import kernel_config  # noqa: E402
-from pyjulia4d.camera import camera_frame, march_radius  # noqa: E402
-from pyjulia4d.devices import select_device  # noqa: E402
-from pyjulia4d.lanes import lanes_for  # noqa: E402
-from pyjulia4d.render import Precision, launch, march_items, queue_for  # noqa: E402
-from pyjulia4d.scene import Scene  # noqa: E402
+from pyjulia4d.opencl import build  # noqa: E402
+from pyjulia4d.pipeline import kernel_config  # noqa: E402
+from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
+from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
+from pyjulia4d.opencl.executor import Precision, launch, march_items, queue_for  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 FLOPS_PER_ITERATION = 20
@@ -97,7 +97,7 @@ CHILD = r"""
 import json, sys, time
 import numpy as np
 import pyopencl as cl
-from pyjulia4d.devices import build, select_device
+from pyjulia4d.opencl.devices import build, select_device
 spec, width, double, src = sys.argv[1] or None, int(sys.argv[2]), sys.argv[3] == "1", sys.stdin.read()
 dev = select_device(spec)
 ctx = cl.Context([dev]); q = cl.CommandQueue(ctx)

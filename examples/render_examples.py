@@ -30,9 +30,9 @@ def main(argv=None) -> int:
     import imageio.v2 as imageio
     from PIL import Image
 
-    from pyjulia4d import cli
-    from pyjulia4d.animation import strip
-    from pyjulia4d.video import read_frame
+    from pyjulia4d.app import cli
+    from pyjulia4d.app.animation import strip
+    from pyjulia4d.app.video import read_frame
 
     w, h = args.size.split("x")
     out = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="pyjulia4d-examples-"))

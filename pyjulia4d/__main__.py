@@ -1,5 +1,5 @@
 """``python -m pyjulia4d``."""
-from pyjulia4d.cli import main
+from pyjulia4d.app.cli import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -7,10 +7,10 @@ import numpy as np
 import pyopencl as cl
 import pyopencl.array as cla
 
-from pyjulia4d import build
-from pyjulia4d import kernel_config
-from pyjulia4d.devices import select_device
-from pyjulia4d.render import launch, queue_for
+from pyjulia4d.opencl import build
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.opencl.devices import select_device
+from pyjulia4d.opencl.executor import launch, queue_for
 
 
 def device():
@@ -22,7 +22,7 @@ def packet_widths(widths=(4, 8, 16)):
     """The packet widths the device under test survives: those up to the width its probe
     found (pyjulia4d/lanes.py runs the probe in a child process; a width a driver crashes
     on - PyPI's PoCL on float16 - must never run in the test process itself)."""
-    from pyjulia4d.lanes import lanes_for
+    from pyjulia4d.opencl.lanes import lanes_for
 
     most = lanes_for(device(), "packet", False)
     return [w for w in widths if w <= most]

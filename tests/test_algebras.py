@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import kernel_config, reference as ref
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
 from pyjulia4d.reference.algebra import commutative as cm, cquat as cq, hypercomplex as hc, quaternion as qa
 from pyjulia4d.reference.formula import Formula, complex_value
-from pyjulia4d.render import STATUS_HIT, render
-from pyjulia4d.scene import FUNCTIONS, FUNCTIONS_OF, Scene, SceneError
+from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.scene.model import FUNCTIONS, FUNCTIONS_OF, Scene, SceneError
 
 PAIRS = [(a, f) for a in FUNCTIONS_OF for f in FUNCTIONS_OF[a]]
 E = np.eye(4)

@@ -16,11 +16,11 @@ import pytest
 from PIL import Image
 
 import pyjulia4d
-from pyjulia4d import cli
-from pyjulia4d.animation import animate, frame_path, remove_stale_temps
-from pyjulia4d.output import read_header
-from pyjulia4d.keyframes import from_table, interpolate, load
-from pyjulia4d.scene import Scene
+from pyjulia4d.app import cli
+from pyjulia4d.app.animation import animate, frame_path, remove_stale_temps
+from pyjulia4d.app.output import read_header
+from pyjulia4d.scene.keyframes import from_table, interpolate, load
+from pyjulia4d.scene.model import Scene
 
 ROOT = Path(pyjulia4d.__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from pyjulia4d import reference as ref
-from pyjulia4d.render import render
-from pyjulia4d.scene import Scene
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.scene.model import Scene
 
 SMALL = ["image.width=40", "image.height=30"]
 
@@ -50,9 +50,9 @@ def test_supersampling_is_deterministic_and_keeps_the_centres():
 
 # ---------------------------------------------------------------- adaptive (image.adaptive)
 
-from pyjulia4d import antialias  # noqa: E402
-from pyjulia4d.colormap import srgb_to_linear  # noqa: E402
-from pyjulia4d.scene import SceneError  # noqa: E402
+from pyjulia4d.pipeline import antialias  # noqa: E402
+from pyjulia4d.pipeline.colormap import srgb_to_linear  # noqa: E402
+from pyjulia4d.scene.model import SceneError  # noqa: E402
 
 HYPER = ["fractal.algebra=hypercomplex", "fractal.c=-0.123,0,-0.745,0", "camera.position=1.7,5.7,-5.7",
          "camera.fov=15"]
@@ -171,7 +171,7 @@ def test_adaptive_colour_matches_reference(over):
 def test_progress_total_is_the_adaptive_work(monkeypatch):
     import sys
 
-    rmod = sys.modules["pyjulia4d.render"]   # the package's render is the function
+    rmod = sys.modules["pyjulia4d.opencl.executor"]   # the package's render is the function
 
     bars = []
 

@@ -89,7 +89,7 @@ def test_iteration_counter_counts_exactly():
     """benchmarks/throughput.py's -D COUNT_ITERATIONS build: with the eye inside the c = 0
     set every ray's first set test is inside, after exactly max_iter iterations of f."""
     from harness import device
-    from pyjulia4d.scene import Scene
+    from pyjulia4d.scene.model import Scene
 
     tp = load("throughput")
     s = Scene.default().with_overrides(["fractal.c=0,0,0,0", "fractal.max_iter=37", "march.method=fixed",

@@ -9,9 +9,9 @@ import warnings
 import pytest
 
 from harness import device
-from pyjulia4d import calibrate, workload
-from pyjulia4d.render import render
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.pipeline import calibrate, workload
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.scene.model import Scene, SceneError
 
 # one scene or two of each march method and of the costly options, 200-600 ms each here
 SCENES = {
@@ -41,7 +41,7 @@ def test_prediction_within_a_factor_of_3(name):
 
 def test_probe_blocks_lie_in_the_region_and_spread_over_it():
     s = Scene.from_dict({"camera": {"fit": False}}, ["image.width=1000", "image.height=300"])
-    from pyjulia4d.plan import make_plan
+    from pyjulia4d.pipeline.plan import make_plan
     for region in (None, (100, 50, 300, 200), (0, 0, 5, 3)):
         plan = make_plan(s, "CPU", 16, region=region)
         tiles = calibrate.probe_tiles(plan)

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from pyjulia4d import reference as ref
-from pyjulia4d.camera import camera_frame, march_radius
-from pyjulia4d.render import STATUS_HIT, render
-from pyjulia4d.scene import Scene
+from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.scene.model import Scene
 
 W, H = 40, 30
 SCENES = {
@@ -47,8 +47,8 @@ def scene(name, march):
 def brute_force(s: Scene, n=6000):
     """First inside sample of an n-step scan over the march's interval, then 60 bisections
     (the set's own test, reference.julia_inside)."""
-    from pyjulia4d.truth import _bisect, _first_inside, _ray_interval
-    from pyjulia4d.camera import bounding_radius
+    from pyjulia4d.measure.truth import _bisect, _first_inside, _ray_interval
+    from pyjulia4d.geometry.camera import bounding_radius
 
     f = s.fractal
     o, d = ref.generate_rays(camera_frame(s), W, H)

@@ -16,7 +16,7 @@ import pytest
 from PIL import Image
 
 import pyjulia4d
-from pyjulia4d import cli
+from pyjulia4d.app import cli
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 
@@ -184,9 +184,9 @@ class FakeRender:
 @pytest.fixture
 def fake_render(monkeypatch: pytest.MonkeyPatch) -> FakeRender:
     fake = FakeRender()
-    mod = types.ModuleType("pyjulia4d.render")
+    mod = types.ModuleType("pyjulia4d.opencl.executor")
     mod.render = fake  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "pyjulia4d.render", mod)
+    monkeypatch.setitem(sys.modules, "pyjulia4d.opencl.executor", mod)
     monkeypatch.setattr(pyjulia4d, "render", mod, raising=False)
     monkeypatch.setattr(cli, "select_device", lambda spec: f"device<{spec}>")
     return fake

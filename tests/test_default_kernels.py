@@ -23,8 +23,8 @@ from pathlib import Path
 
 import pytest
 
-from pyjulia4d import kernel_config
-from pyjulia4d.scene import Scene
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.scene.model import Scene
 
 REFERENCE = Path(__file__).resolve().parent / "data" / "default_kernels.i"
 PIECES = ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate", "march/refine",

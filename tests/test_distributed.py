@@ -12,12 +12,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pyjulia4d import cli, render
-from pyjulia4d.animation import animate, frame_path
-from pyjulia4d.output import read_header
-from pyjulia4d.distributed import render_many, render_tiled
-from pyjulia4d.keyframes import from_table
-from pyjulia4d.scene import Scene
+from pyjulia4d.app import cli
+from pyjulia4d import render
+from pyjulia4d.app.animation import animate, frame_path
+from pyjulia4d.app.output import read_header
+from pyjulia4d.app.cluster import render_many, render_tiled
+from pyjulia4d.scene.keyframes import from_table
+from pyjulia4d.scene.model import Scene
 
 import distributed  # noqa: E402  (a dependency: the tests fail without it)
 

@@ -17,10 +17,12 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import kernel_config, catalogue as cat, reference as ref, workload
-from pyjulia4d.camera import camera_frame
-from pyjulia4d.render import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, render
-from pyjulia4d.scene import Scene, SceneError, march_method
+from pyjulia4d.pipeline import kernel_config, workload
+from pyjulia4d.measure import catalogue as cat
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import camera_frame
+from pyjulia4d.opencl.executor import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, render
+from pyjulia4d.scene.model import Scene, SceneError, march_method
 
 CASES = cat.catalogue()
 IDS = [c.name for c in CASES]

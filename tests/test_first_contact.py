@@ -17,8 +17,11 @@ import pytest
 from PIL import Image
 
 import pyjulia4d
-from pyjulia4d import Scene, SceneError, cli, keys, runtimes
-from pyjulia4d.scene import key_names, valid_range
+from pyjulia4d import Scene, SceneError
+from pyjulia4d.app import cli
+from pyjulia4d.scene import keys
+from pyjulia4d.opencl import runtimes
+from pyjulia4d.scene.model import key_names, valid_range
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 
@@ -37,7 +40,7 @@ def _python(code: str, **extra: str) -> subprocess.CompletedProcess[str]:
 
 
 def _cli(args: list[str], cwd: Path, prelude: str = "", **extra: str) -> subprocess.CompletedProcess[str]:
-    code = prelude + "import sys; from pyjulia4d.cli import main; sys.exit(main(sys.argv[1:]))"
+    code = prelude + "import sys; from pyjulia4d.app.cli import main; sys.exit(main(sys.argv[1:]))"
     return subprocess.run([sys.executable, "-c", code, *args], cwd=cwd, env=_env(**extra),
                           capture_output=True, text=True, timeout=300)
 
@@ -88,7 +91,7 @@ def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
     PyPI alone and renders a picture with hits."""
     empty = tmp_path / "vendors"
     empty.mkdir()
-    p = _python("from pyjulia4d import Scene, render; from pyjulia4d.devices import select_device; "
+    p = _python("from pyjulia4d import Scene, render; from pyjulia4d.opencl.devices import select_device; "
                 "d = select_device(None); r = render(Scene.default().with_overrides(['image.width=24', "
                 "'image.height=18']), device=d); print(d.platform.name.strip(), r.hit_fraction > 0.1)",
                 OPENCL_VENDOR_PATH=str(empty), PYJULIA4D_CACHE=str(tmp_path / "cache"))
@@ -124,7 +127,7 @@ class _Device:
 def test_cpu_runtime_preference(monkeypatch) -> None:
     """Of the CPUs that compile, Intel's runtime is preferred whatever the platform order;
     a GPU still comes first; a CPU that cannot compile is never picked."""
-    from pyjulia4d import devices
+    from pyjulia4d.opencl import devices
 
     pocl, intel, broken = _Device("Portable Computing Language", 1), _Device("Intel(R) OpenCL", 2), \
         _Device("Intel(R) OpenCL", 3)
@@ -143,7 +146,7 @@ def test_cpu_runtime_preference(monkeypatch) -> None:
 
 
 def test_devices_says_the_default_and_the_registration() -> None:
-    from pyjulia4d.devices import describe_devices
+    from pyjulia4d.opencl.devices import describe_devices
 
     lines = describe_devices().splitlines()
     assert sum(line.endswith("(default)") for line in lines) == 1
@@ -211,7 +214,7 @@ def test_render_an_image_again(tmp_path: Path, fmt: str) -> None:
     assert cli.main(["render", str(first), "-o", str(again)]) == 0
     if fmt == ".png":
         assert np.array_equal(np.asarray(Image.open(first)), np.asarray(Image.open(again)))
-    from pyjulia4d.output import read_header
+    from pyjulia4d.app.output import read_header
 
     assert read_header(first)["pyjulia4d.scene"] == read_header(again)["pyjulia4d.scene"]
     assert "fit = false" in read_header(again)["pyjulia4d.scene"]
@@ -346,8 +349,8 @@ def test_camera_fit_beyond_the_coordinate_range_names_the_bailout() -> None:
 def test_double_refused_before_any_build(monkeypatch) -> None:
     """A device without cl_khr_fp64: the one-line message comes before camera.fit's pass, the
     probe or any program build."""
-    from pyjulia4d import build
-    render_module = sys.modules["pyjulia4d.render"]   # the package's name "render" is the function
+    from pyjulia4d.opencl import build
+    render_module = sys.modules["pyjulia4d.opencl.executor"]   # the package's name "render" is the function
 
     def no_build(*a, **k):
         raise AssertionError("a program was built")
@@ -363,7 +366,7 @@ def test_double_refused_before_any_build(monkeypatch) -> None:
 def test_cluster_tiles_record_the_fitted_camera() -> None:
     """render --workers: the result's scene (the header's) is the camera the tiles used."""
     from pyjulia4d import render
-    from pyjulia4d.distributed import render_tiled
+    from pyjulia4d.app.cluster import render_tiled
 
     scene = Scene.from_dict({"image": {"width": 48, "height": 36}})
     result, used = render_tiled(None, scene, tile=16)

@@ -2,11 +2,11 @@
 direction."""
 import numpy as np
 
-from pyjulia4d.camera import camera_frame
-from pyjulia4d.framing import fit_camera, to_scene
-from pyjulia4d.camera import to_world
-from pyjulia4d.render import render
-from pyjulia4d.scene import Scene
+from pyjulia4d.geometry.camera import camera_frame
+from pyjulia4d.pipeline.framing import fit_camera, to_scene
+from pyjulia4d.geometry.camera import to_world
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.scene.model import Scene
 
 SPECK = ["fractal.c=-0.803762,-0.40615,0,0", "fractal.max_iter=8", "camera.position=-2,1,5,8",
          "image.width=96", "image.height=72"]

@@ -25,8 +25,8 @@ from pathlib import Path
 import pytest
 
 import pyjulia4d
-from pyjulia4d import cli
-from pyjulia4d.scene import _CHECKS
+from pyjulia4d.app import cli
+from pyjulia4d.scene.model import _CHECKS
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 SEED = 20261125
@@ -393,9 +393,9 @@ def _render_reached(*args, **kwargs):
 
 @pytest.fixture
 def no_render(monkeypatch: pytest.MonkeyPatch) -> None:
-    mod = types.ModuleType("pyjulia4d.render")
+    mod = types.ModuleType("pyjulia4d.opencl.executor")
     mod.render = _render_reached  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "pyjulia4d.render", mod)
+    monkeypatch.setitem(sys.modules, "pyjulia4d.opencl.executor", mod)
     monkeypatch.setattr(pyjulia4d, "render", mod, raising=False)
     monkeypatch.setattr(cli, "select_device", lambda spec: "fake device")
 
@@ -435,9 +435,9 @@ def test_case_count() -> None:
                                   "🙂"])
 def test_bad_device(spec: str, tmp_path, monkeypatch, capsys) -> None:
     """A bad --device is refused by the real device selection, before any render."""
-    mod = types.ModuleType("pyjulia4d.render")
+    mod = types.ModuleType("pyjulia4d.opencl.executor")
     mod.render = _render_reached  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "pyjulia4d.render", mod)
+    monkeypatch.setitem(sys.modules, "pyjulia4d.opencl.executor", mod)
     monkeypatch.chdir(tmp_path)
     assert cli.main(["render", "--device", spec, "--width", "4", "--height", "3"]) == 2
     out, err = capsys.readouterr()
@@ -534,7 +534,7 @@ def _last_line(text: str) -> str:
 
 def _slow_render_args() -> list[str]:
     """A render of tens of seconds in small tiles (so the signal is seen within a tile)."""
-    from pyjulia4d.devices import device_type, select_device
+    from pyjulia4d.opencl.devices import device_type, select_device
     dev = select_device(os.environ.get("PYJULIA4D_DEVICE") or None)
     if device_type(dev) == "GPU":  # ~300 x faster: full-width tiles, 20 x the samples
         return ["--width", "1024", "--height", "16384", "--set", "march.method=fixed",
@@ -578,7 +578,7 @@ _STAND_IN = r"""
 import sys, time, types
 import numpy as np
 from PIL import Image
-from pyjulia4d import cli
+from pyjulia4d.app import cli
 
 phase = sys.argv[1]
 
@@ -598,9 +598,9 @@ def render(scene, device=None, progress=False, force=False, outputs=None):
         time.sleep(60)
     return Result(scene.image.height, scene.image.width)
 
-module = types.ModuleType("pyjulia4d.render")
+module = types.ModuleType("pyjulia4d.opencl.executor")
 module.render = render
-sys.modules["pyjulia4d.render"] = module
+sys.modules["pyjulia4d.opencl.executor"] = module
 cli.select_device = lambda spec: None
 save = Image.Image.save
 

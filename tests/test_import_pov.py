@@ -21,11 +21,11 @@ import pytest
 from PIL import Image
 
 import pyjulia4d
-from pyjulia4d import cli
+from pyjulia4d.app import cli
 from pyjulia4d import reference as ref
-from pyjulia4d.camera import camera_frame, to_world
-from pyjulia4d.povray import import_pov, pov_escape_radius, tokenize
-from pyjulia4d.scene import Scene
+from pyjulia4d.geometry.camera import camera_frame, to_world
+from pyjulia4d.interop.povray import import_pov, pov_escape_radius, tokenize
+from pyjulia4d.scene.model import Scene
 
 DATA = Path(__file__).parent / "data" / "pov"
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
@@ -250,7 +250,7 @@ def test_object_transform_is_the_inverse_camera_transform(tmp_path, capsys, mods
     rc, out, err = _import(tmp_path, CAMERA + DOC_JULIA.replace("precision 15", f"precision 15 {mods}"), capsys)
     assert rc == 0, err
     s = Scene.from_toml(out)
-    from pyjulia4d.povray import _Reader
+    from pyjulia4d.interop.povray import _Reader
     r = _Reader(tokenize(f"julia_fractal {{ <0,0,0,0> {mods} }}", "t"), "t", 640, 480)
     r.run()
     tr = r.julias[0].transform
@@ -263,7 +263,7 @@ def test_object_transform_is_the_inverse_camera_transform(tmp_path, capsys, mods
 
 def test_rotate_follows_povray():
     """rotate <0, 0, 90> turns x into y (POV-Ray's documented left-hand rule), <90, 0, 0> y into z."""
-    from pyjulia4d.povray import rotation
+    from pyjulia4d.interop.povray import rotation
 
     assert rotation((0, 0, 90)) @ [1, 0, 0] == pytest.approx([0, 1, 0])
     assert rotation((90, 0, 0)) @ [0, 1, 0] == pytest.approx([0, 0, 1])

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.scene import Scene
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.scene.model import Scene
 
 CS = [(-0.2, 0.8, 0, 0), (-0.125, -0.256, 0.847, 0.0895), (0.4, 0.5, 0, 0), (0, 0, 0, 0),
       (-0.083, 0.0, -0.83, -0.025)]

@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.camera import mandelbrot_radius
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import mandelbrot_radius
 from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.kind import rotate
-from pyjulia4d.render import STATUS_HIT, render
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.scene.model import Scene, SceneError
 
 E = np.eye(4)
 
@@ -292,7 +293,7 @@ def test_rotated_render_matches_reference_and_differs_from_unrotated():
 def test_truth_uses_the_quaternion_oracles_for_plain_julia_sets_only():
     # the sphere (c = 0) and 2D (real c) oracles of pyjulia4d.truth hold for the unrotated
     # Julia set only: a Mandelbrot set at c = 0 or a rotated map must take the converged scan
-    from pyjulia4d import truth
+    from pyjulia4d.measure import truth
     assert truth.is_real_c(Scene.default().with_overrides(["fractal.c=0,0,0,0"]))
     assert not truth.is_real_c(mandel("quaternion", "sqr", "fractal.c=0,0,0,0"))
     assert not truth.is_real_c(Scene.default().with_overrides(["fractal.c=0,0,0,0", "fractal.theta=30"]))

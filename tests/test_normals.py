@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.camera import camera_frame, march_radius
-from pyjulia4d.scene import Scene
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.scene.model import Scene
 
 W, H = 64, 48
 

@@ -12,8 +12,8 @@ import OpenEXR
 import pytest
 from PIL import Image
 
-from pyjulia4d import output
-from pyjulia4d.output import OutputError, check_output_path, write_exr, write_image, write_png
+from pyjulia4d.app import output
+from pyjulia4d.app.output import OutputError, check_output_path, write_exr, write_image, write_png
 
 H, W = 5, 7
 EXR_NAMES = ["R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"]

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from harness import device
-from pyjulia4d import workload
-from pyjulia4d.lanes import lanes_for
-from pyjulia4d.plan import TILE, make_plan, make_tiles
-from pyjulia4d.render import TileRunner, render
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.pipeline import workload
+from pyjulia4d.opencl.lanes import lanes_for
+from pyjulia4d.pipeline.plan import TILE, make_plan, make_tiles
+from pyjulia4d.opencl.executor import TileRunner, render
+from pyjulia4d.scene.model import Scene, SceneError
 
 SMALL = ["image.width=96", "image.height=72"]
 

@@ -3,11 +3,11 @@ and real c (the 2D oracle); the presets differ where they say they do."""
 import numpy as np
 import pytest
 
-from pyjulia4d import truth
-from pyjulia4d.quality import (BOUND_MAX_ITER, MARCH_KEYS, PRESETS, QUALITIES, apply_quality, preset_overrides,
+from pyjulia4d.measure import truth
+from pyjulia4d.scene.quality import (BOUND_MAX_ITER, MARCH_KEYS, PRESETS, QUALITIES, apply_quality, preset_overrides,
                                preset_values, stated_p99)
-from pyjulia4d.render import render
-from pyjulia4d.scene import Scene
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.scene.model import Scene
 
 W, H = 40, 30
 ORACLES = {

@@ -3,9 +3,10 @@ import numpy as np
 import pytest
 
 from harness import Runner
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.camera import camera_frame, cross4, slice_rotation
-from pyjulia4d.scene import Scene, SceneError
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import camera_frame, cross4, slice_rotation
+from pyjulia4d.scene.model import Scene, SceneError
 
 
 @pytest.mark.parametrize("over", [[], ["camera.position=-2,1,5,8", "camera.fov=60"],

@@ -110,8 +110,8 @@ def test_tiles_give_the_same_image(normals):
 
 
 def test_image_too_large_for_memory_refused_before_rendering():
-    from pyjulia4d import workload
-    from pyjulia4d.scene import SceneError
+    from pyjulia4d.pipeline import workload
+    from pyjulia4d.scene.model import SceneError
 
     for w, h in [(1_000_000_000, 1), (100_000, 100_000), (46341, 46341), (65536, 65536)]:
         s = Scene.default().with_overrides([f"image.width={w}", f"image.height={h}"])
@@ -120,7 +120,7 @@ def test_image_too_large_for_memory_refused_before_rendering():
 
 
 def test_cli_claims_no_bound_beyond_the_measured_max_iter(tmp_path):
-    from pyjulia4d.quality import BOUND_MAX_ITER
+    from pyjulia4d.scene.quality import BOUND_MAX_ITER
 
     p = cli("--width", "16", "--height", "12", "--set", "march.quality=normal",
             "--set", f"fractal.max_iter={BOUND_MAX_ITER + 10}", "-o", "n.png", cwd=tmp_path)
@@ -134,8 +134,9 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     # options and device; a later process loads it instead of compiling, and a binary that
     # no longer loads is rebuilt from source
     from harness import device
-    from pyjulia4d import build, kernel_config
-    from pyjulia4d.render import queue_for
+    from pyjulia4d.opencl import build
+    from pyjulia4d.pipeline import kernel_config
+    from pyjulia4d.opencl.executor import queue_for
 
     monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
     ctx, _ = queue_for(device())
@@ -170,13 +171,13 @@ def test_cut_away_planes_match_reference(over):
     cos = np.sum(k.normal[face] * r.normal[face], axis=-1)
     assert np.median(cos) > 0.99999
     # every hit lies in every kept half-space
-    from pyjulia4d.camera import clip_planes
+    from pyjulia4d.geometry.camera import clip_planes
     for m, e in clip_planes(s):
         assert np.all(k.position[k.status == 1] @ m <= e + 1e-4)
 
 
 def test_clip_planes_refused():
-    from pyjulia4d.scene import SceneError
+    from pyjulia4d.scene.model import SceneError
     for bad, msg in [("0,0,0,1", "plane 0: zero normal"), ("1,2,3", "plane 0: expected"),
                      ("1,0,0,0;0,1,0,0;0,0,1,0;1,1,0,0;1,0,1,0", "at most 4 planes"),
                      ("1,0,0,nan", "plane 0: element 3: not a finite number")]:
@@ -188,7 +189,7 @@ def test_closing_line_says_which_device_and_why(tmp_path):
     """The default device is picked by a fixed rule (the first GPU that compiles, else a
     CPU that compiles, Intel's runtime first), and the closing line says which and why; a
     named device needs no why."""
-    from pyjulia4d.devices import _indexed, default_reason, select_device
+    from pyjulia4d.opencl.devices import _indexed, default_reason, select_device
     dev = select_device(None)
     why = default_reason(dev)
     idx = next(i for i, _, d in _indexed() if d.int_ptr == dev.int_ptr)

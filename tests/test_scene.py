@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyjulia4d.scene import _CHECKS, _SECTIONS, Scene, SceneError, valid_range, march_method
+from pyjulia4d.scene.model import _CHECKS, _SECTIONS, Scene, SceneError, valid_range, march_method
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -288,7 +288,7 @@ def _readme_key_rows() -> dict[str, list[str]]:
 def test_readme_valid_ranges_match_the_checkers() -> None:
     """docs/scene-keys.md's valid-range column is the checkers' own description and its
     default column the scene's default as ``pyjulia4d keys`` prints it, for every key."""
-    from pyjulia4d.keys import default_text
+    from pyjulia4d.scene.keys import default_text
 
     rows = _readme_key_rows()
     keys = [f"{s}.{k}" for s, table in _CHECKS.items() for k in table]
@@ -339,7 +339,7 @@ def test_range_edges(key: str, inside, outside) -> None:
 
 
 def test_every_catalogue_case_is_valid() -> None:
-    from pyjulia4d import catalogue
+    from pyjulia4d.measure import catalogue
     for case in catalogue.catalogue():
         for method in case.methods:
             catalogue.scene(case, method, "double")
@@ -391,7 +391,7 @@ def test_negative_zero_is_zero() -> None:
 def test_directions_of_any_length(scale: float) -> None:
     """up, limbo and slice.normal are directions: normalised by their largest component,
     so tiny and large lengths give the frame of the unit vector."""
-    from pyjulia4d.camera import camera_frame, slice_rotation
+    from pyjulia4d.geometry.camera import camera_frame, slice_rotation
     base = Scene.default().with_overrides(["slice.normal=0.2,0,0.3,1"])
     s = base.replace(**{"camera.up": [0, scale, 0, 0], "camera.limbo": [0, 0, 0, scale],
                         "slice.normal": [0.2 * scale, 0, 0.3 * scale, scale] if scale > 1e-300 else [0, 0, 0, scale]})

@@ -6,9 +6,10 @@ import pyopencl as cl
 import pytest
 
 from harness import Runner
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.camera import camera_frame, extra_lights, light_position
-from pyjulia4d.scene import Scene
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import camera_frame, extra_lights, light_position
+from pyjulia4d.scene.model import Scene
 
 
 @pytest.mark.parametrize("over", [["shading.light=eye"], ["shading.light=2,3,-4"], ["shading.specular=0"],
@@ -67,13 +68,13 @@ def test_shade_matches_reference(over, fl):
 def test_colormaps_exist_in_matplotlib():
     import matplotlib
 
-    from pyjulia4d.scene import COLORMAPS
+    from pyjulia4d.scene.model import COLORMAPS
     for name in COLORMAPS:
         assert name in matplotlib.colormaps, name
 
 
 def test_colormap_table_is_linear_light():
-    from pyjulia4d import colormap
+    from pyjulia4d.pipeline import colormap
     t = colormap.table("viridis")
     assert t.shape == (256, 4) and t.dtype == np.float32
     # the PNG writer's sRGB encoding gives the map's own colours back
@@ -116,7 +117,7 @@ def test_light_terms_in_render_match_reference(name):
     # kernels (in packets where the march has them) against the float64 reference render:
     # on pixels both hit with the same depth to 1e-5, the shadow, occlusion and colour terms
     # follow the surface, so colours agree except where a shadow ray grazes the set
-    from pyjulia4d.render import render
+    from pyjulia4d.opencl.executor import render
     s = Scene.default().with_overrides(LIGHT_SCENES[name] + ["image.width=40", "image.height=30"])
     k, r = render(s), ref.render(s)
     with np.errstate(invalid="ignore"):   # inf - inf on misses
@@ -148,7 +149,7 @@ def test_shadows_compiled_only_where_they_show():
     (["shading.ao=2"], "shading.ao"),
 ])
 def test_light_settings_refused(over, key):
-    from pyjulia4d.scene import SceneError
+    from pyjulia4d.scene.model import SceneError
     with pytest.raises(SceneError) as e:
         Scene.default().with_overrides(over)
     assert str(e.value).startswith(key + ": ")
@@ -175,7 +176,7 @@ EVERYTHING = ["shading.light=-3,4,-2", "shading.ao=0.5", "shading.fog=0.3", "cli
 def test_every_switch_together_builds_and_stays_finite(extra):
     # the -D switches of one scene meet in one program: none may clash (a shared name, a
     # missing piece); the picture stays finite
-    from pyjulia4d.render import render
+    from pyjulia4d.opencl.executor import render
     r = render(Scene.default().with_overrides(EVERYTHING + extra))
     assert np.all(np.isfinite(r.color)) and np.all(np.isfinite(r.alpha))
     assert r.hit_fraction > 0
@@ -226,8 +227,8 @@ def test_reflect_kernels_match_reference(light, fl):
 
 
 def test_reflection_shows_in_the_picture_and_zbuffer_is_refused():
-    from pyjulia4d.render import render
-    from pyjulia4d.scene import SceneError
+    from pyjulia4d.opencl.executor import render
+    from pyjulia4d.scene.model import SceneError
     base = Scene.default().with_overrides(["image.width=48", "image.height=36", "shading.background=0,0,1"])
     plain, mirror = render(base), render(base.with_overrides(["shading.reflection=0.5"]))
     np.testing.assert_array_equal(plain.depth, mirror.depth)

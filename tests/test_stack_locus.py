@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from harness import Runner, packet_widths
-from pyjulia4d import kernel_config, reference as ref
-from pyjulia4d.camera import march_radius
-from pyjulia4d.render import STATUS_HIT, render
-from pyjulia4d.scene import Scene, SceneError, march_method
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d import reference as ref
+from pyjulia4d.geometry.camera import march_radius
+from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.scene.model import Scene, SceneError, march_method
 
 C0, C1 = -1.0 + 0.0j, -0.1 + 0.75j      # the defaults of fractal.c_from, fractal.c_to
 
@@ -78,7 +79,7 @@ def test_stack_cap_seen_head_on_is_the_julia_set_of_the_end_point():
     s = stack("camera.position=0,0,-4,0", "camera.target=0,0,0,0", "fractal.max_iter=12", "image.width=48",
               "image.height=40", "camera.fov=50", "march.z_resolution=400")
     k = render(s)
-    fr = __import__("pyjulia4d.camera", fromlist=["camera_frame"]).camera_frame(s)
+    fr = __import__("pyjulia4d.geometry.camera", fromlist=["camera_frame"]).camera_frame(s)
     o, d = ref.generate_rays(fr, 48, 40)
     t_cap = (-1.0 - o[:, 2]) / d[:, 2]
     at = o + t_cap[:, None] * d
@@ -321,7 +322,7 @@ def test_locus_packets_give_the_same_pixels(lanes):
 def test_locus_escape_radius_is_one(radius):
     # beyond R every map of the ball grows |z| (the worst case |a| = |b| = radius, z, a^2 and b
     # lined up against z); below it one such map does not
-    from pyjulia4d.scene import locus_escape_radius
+    from pyjulia4d.scene.model import locus_escape_radius
     R = locus_escape_radius(radius)
     g = lambda r: r ** 3 - 3 * radius ** 2 * r - radius
     assert g(R * (1 + 1e-12)) > R * (1 + 1e-12) and g(R * 0.999) < R * 0.999

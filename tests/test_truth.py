@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from pyjulia4d import reference as ref
-from pyjulia4d import truth
-from pyjulia4d.camera import camera_frame, march_radius
-from pyjulia4d.render import render
-from pyjulia4d.scene import Scene
+from pyjulia4d.measure import truth
+from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.scene.model import Scene
 
 W, H = 32, 24
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from harness import packet_widths
-from pyjulia4d import lanes as lanes_mod
-from pyjulia4d.render import STATUS_HIT, render
-from pyjulia4d.scene import Scene
+from pyjulia4d.opencl import lanes as lanes_mod
+from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.scene.model import Scene
 
 SCENES = [
     [],

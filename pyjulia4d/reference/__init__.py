@@ -14,15 +14,15 @@ import time
 
 import numpy as np
 
-from ..camera import Frame, camera_frame, clip_planes, light_position, march_radius
-from ..codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED,
+from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, light_position, march_radius
+from pyjulia4d.pipeline.codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED,
                      STATUS_HIT, STATUS_MISS)
-from ..plan import fog_start, gradient_step, light_parameters
-from ..result import RenderResult, count_guards
-from ..scene import Scene, march_method
+from pyjulia4d.pipeline.plan import fog_start, gradient_step, light_parameters
+from pyjulia4d.pipeline.result import RenderResult, count_guards
+from pyjulia4d.scene.model import Scene, march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
-from ..codes import FLAG_CUT_FACE  # noqa: E402  (kernels/codes.cl)
+from pyjulia4d.pipeline.codes import FLAG_CUT_FACE  # noqa: E402  (kernels/codes.cl)
 
 
 def _dot(a, b):
@@ -31,13 +31,13 @@ def _dot(a, b):
 
 # ------------------------------------ algebra/*.cl, function/*.cl (formula.py)
 # The quaternion square's pieces stay importable here (ref.alg_mul, ref.alg_sqr, ...).
-from .algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
-from .formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
-from .. import colormap  # noqa: E402
-from .kind import mandelbrot as _mandelbrot  # noqa: E402
-from .kind.level import kind_level  # noqa: E402
-from .kind import julia_stack as _stack  # noqa: E402
-from .kind import cubic_locus as _locus  # noqa: E402
+from pyjulia4d.reference.algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp  # noqa: E402,F401
+from pyjulia4d.reference.formula import QUATERNION_SQR, Formula, formula_of  # noqa: E402,F401
+from pyjulia4d.pipeline import colormap  # noqa: E402
+from pyjulia4d.reference.kind import mandelbrot as _mandelbrot  # noqa: E402
+from pyjulia4d.reference.kind.level import kind_level  # noqa: E402
+from pyjulia4d.reference.kind import julia_stack as _stack  # noqa: E402
+from pyjulia4d.reference.kind import cubic_locus as _locus  # noqa: E402
 
 
 # ------------------------------------------------------------------ iterate.cl
@@ -622,7 +622,7 @@ def render(scene: Scene) -> RenderResult:
     so compare with ``reference.render(result.scene)`` for the kernels' own camera."""
     t0 = time.perf_counter()
     if scene.camera.fit:
-        from ..framing import fit_camera
+        from pyjulia4d.pipeline.framing import fit_camera
         scene, _ = fit_camera(scene, lambda s, outs: render(s))
     frame = camera_frame(scene)
     w, h = scene.image.width, scene.image.height
@@ -650,7 +650,7 @@ def render(scene: Scene) -> RenderResult:
         normal = clip_normals(guard, status, frame, planes, normal)
         refl = None
         if sh.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray
-            from .shade import reflect_color, reflect_rays
+            from pyjulia4d.reference.shade import reflect_color, reflect_rays
             radius = march_radius(scene)
             o2, d2 = reflect_rays(point, normal, status, frame, light_parameters(scene, radius)["bias"], radius)
             g2 = np.zeros(len(o2), np.int64)
@@ -664,10 +664,10 @@ def render(scene: Scene) -> RenderResult:
             n2 = clip_normals(g2, s2, frame, planes, n2)
             refl = reflect_color(s2, n2, p2, d2, frame, light_position(scene), sh.color, sh.background,
                                  sh.light_color, sh.sky, sh.ambient, sh.diffuse)
-        from .shade import extra_visibility_of_scene, light_terms_of_scene, shade
+        from pyjulia4d.reference.shade import extra_visibility_of_scene, light_terms_of_scene, shade
         terms = light_terms_of_scene(scene, point, normal, status, bracket, F)
         lut = colormap.table(sh.colormap) if sh.coloring != "flat" else None
-        from ..camera import extra_lights
+        from pyjulia4d.geometry.camera import extra_lights
         geo, rgb = extra_lights(scene) if sh.lights else (None, None)
         rgba = shade(status, normal, point, frame, light_position(scene), sh.color, sh.background,
                      sh.light_color, sh.ambient, sh.diffuse, sh.specular, sh.shininess, terms, lut,
@@ -681,7 +681,7 @@ def render(scene: Scene) -> RenderResult:
     if S > 1:
         mean = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
         if scene.image.adaptive:   # antialias.py: the flagged pixels alone take the mean
-            from ..antialias import THRESHOLD
+            from pyjulia4d.pipeline.antialias import THRESHOLD
             flags = flag_edges(rgba[:, :3].reshape(h, w, 3), rgba[:, 3].reshape(h, w), THRESHOLD).ravel()
             mean = np.where(flags[:, None], mean, rgba)
         rgba = mean
@@ -695,4 +695,4 @@ def render(scene: Scene) -> RenderResult:
     return res
 
 
-from .shade import light_terms, reflect_color, reflect_rays, shade  # noqa: E402,F401  (kernels/shade/)
+from pyjulia4d.reference.shade import light_terms, reflect_color, reflect_rays, shade  # noqa: E402,F401  (kernels/shade/)

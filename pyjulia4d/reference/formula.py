@@ -54,13 +54,13 @@ class Formula:
 
     def julia_f(self, q, c):
         if self.theta != 0:
-            from .kind.rotate import rot_f
+            from pyjulia4d.reference.kind.rotate import rot_f
             return rot_f(q, c, self.theta, lambda x, cc: self.alg.julia_f(x, cc, self.fn))
         return self.alg.julia_f(q, c, self.fn)
 
     def julia_f_jvp(self, q, h):
         if self.theta != 0:
-            from .kind.rotate import rot_f_jvp
+            from pyjulia4d.reference.kind.rotate import rot_f_jvp
             return rot_f_jvp(q, h, self.theta, lambda x, hh: self.alg.julia_f_jvp(x, hh, self.fn))
         return self.alg.julia_f_jvp(q, h, self.fn)
 

@@ -3,12 +3,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..camera import Frame
-from ..codes import STATUS_HIT
-from ..plan import light_parameters
+from pyjulia4d.geometry.camera import Frame
+from pyjulia4d.pipeline.codes import STATUS_HIT
+from pyjulia4d.pipeline.plan import light_parameters
 # imported by the package at its end, once these are defined
-from . import _dot, _to_camera, julia_distance_formula, julia_inside
-from .formula import QUATERNION_SQR, Formula
+from pyjulia4d.reference import _dot, _to_camera, julia_distance_formula, julia_inside
+from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 
 
 def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,
@@ -66,7 +66,7 @@ def _orbit_start(p, c, F: Formula, mandelbrot: bool):
     """(q_start, step(q, live) -> f(q) + c on the live points, first index): the Julia orbit
     of p, or for a Mandelbrot set that of 0 with c = p from q_1 = c (shade/light.cl ORBIT_*)."""
     if mandelbrot:
-        from .kind.mandelbrot import mandel_f, mandel_start
+        from pyjulia4d.reference.kind.mandelbrot import mandel_f, mandel_start
         cp = F.ALG_IN(np.asarray(p, np.float64))
         return mandel_start(F, cp), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
     cc = F.ALG_C(np.asarray(c, np.float64))
@@ -174,7 +174,7 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
 
 def extra_visibility_of_scene(scene, point, normal, status, F: Formula):
     """extra_visibility with the scene's settings, or None without shadows or shading.lights."""
-    from ..camera import camera_frame, extra_lights, march_radius
+    from pyjulia4d.geometry.camera import camera_frame, extra_lights, march_radius
     sh = scene.shading
     if sh.shadow == "none" or not sh.lights:
         return None
@@ -189,7 +189,7 @@ def extra_visibility_of_scene(scene, point, normal, status, F: Formula):
 def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
     """light_terms with the scene's settings (render.light_parameters), or None when the
     scene uses none of them."""
-    from ..camera import camera_frame, light_position, march_radius
+    from pyjulia4d.geometry.camera import camera_frame, light_position, march_radius
     sh = scene.shading
     shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # kernel_config.light_defines
     if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":

@@ -3,8 +3,8 @@ i^2 = -1, j^2 = k^2 = +1, ij = ji = -k, ki = ik = -j, jk = kj = i; commutative, 
 The product is built from the basis table itself (the kernel writes it out)."""
 from __future__ import annotations
 
-from . import power
-from .table import ALG_C, ALG_DOT, ALG_IN, ALG_NORM2, product  # noqa: F401 (the algebra's interface)
+from pyjulia4d.reference.algebra import power
+from pyjulia4d.reference.algebra.table import ALG_C, ALG_DOT, ALG_IN, ALG_NORM2, product  # noqa: F401 (the algebra's interface)
 
 SIGN = [[1, 1, 1, 1], [1, -1, -1, -1], [1, -1, 1, 1], [1, -1, 1, 1]]
 alg_mul = product(SIGN)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .table import product
+from pyjulia4d.reference.algebra.table import product
 
 # seed 003's table: ij = ji = k, jk = kj = -i, ki = ik = -j, ii = jj = -1, kk = +1
 SIGN = [[1, 1, 1, 1], [1, -1, 1, -1], [1, 1, -1, -1], [1, -1, -1, 1]]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .level import kind_level
+from pyjulia4d.reference.kind.level import kind_level
 
 
 def _start(p, F):

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .level import kind_level
+from pyjulia4d.reference.kind.level import kind_level
 
 REAL_MIN = np.finfo(np.float64).tiny
 
@@ -14,7 +14,7 @@ REAL_MIN = np.finfo(np.float64).tiny
 def mandel_start(F, c):
     """q_1 = v + c, v f's critical or asymptotic value (scene.MANDELBROT_START; kind/mandelbrot.cl
     MANDEL_START), in the algebra's coordinates."""
-    from ...scene import MANDELBROT_START
+    from pyjulia4d.scene.model import MANDELBROT_START
     return c + F.ALG_IN(np.asarray(MANDELBROT_START[F.function], np.float64))
 
 

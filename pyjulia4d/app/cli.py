@@ -1,0 +1,357 @@
+"""Command line: ``pyjulia4d render|animate|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
+
+Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
+status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
+each after removing any temporary file."""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import signal
+import sys
+import threading
+import warnings
+from pathlib import Path
+from typing import Any, Iterator, NoReturn, Sequence
+
+from pyjulia4d.app.output import check_output_path, write_image
+from pyjulia4d.scene.model import Scene, SceneError, override_key
+
+PROG = "pyjulia4d"
+
+
+class UsageError(Exception):
+    """A command line argparse cannot parse; its message is argparse's."""
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP, raised in the main thread so that clean-up runs as for Ctrl-C
+    (a BaseException, like KeyboardInterrupt: ``except Exception`` must not catch it)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (no usage text) and status 2 from main()."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def _parser() -> argparse.ArgumentParser:
+    from pyjulia4d import __version__
+
+    ap = _Parser(prog=PROG, description="Ray trace 3D views of 4D Julia sets: quaternions, the hypercomplex "
+                                        "numbers with POV-Ray's 18 functions, CQuats and more.")
+    ap.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    r = sub.add_parser("render", help="render a scene to .png or .exr")
+    r.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
+                   help="scene file, or an image pyjulia4d rendered: its header holds the scene as "
+                        "rendered, which is rendered again (default: the built-in scene)")
+    r.add_argument("-o", "--output", metavar="OUT",
+                   help="OUT.png or OUT.exr (default: <scene stem>.png, <image stem>-rerender.png for an "
+                        "image, or julia.png)")
+    # kept as text so bad sizes get the same one-line scene error as --set
+    r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W; not both)")
+    r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H; not both)")
+    r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; README lists every key and its valid range)")
+    r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
+    r.add_argument("--channels", metavar="LIST",
+                   help="EXR channel groups to compute and write, comma-separated from RGBA, Z (depth and "
+                        "its bracket), N (normal), P (4D position); default all.  Z alone skips normals "
+                        "and shading and keeps 8 bytes per pixel: the way to render huge depth maps")
+    r.add_argument("--force", action="store_true",
+                   help="render settings refused for their work: predicted over 6 hours by a probe render, or hopeless per ray")
+    _cluster_options(r, "tiles of the image")
+
+    a = sub.add_parser("animate", help="render a keyframed scene to numbered frames and a video")
+    a.add_argument("scene", metavar="SCENE.toml", help="scene file with [[keyframe]] tables and [animation]")
+    a.add_argument("-o", "--output", metavar="PATTERN",
+                   help="frame files, one run of # for the frame number: frames/julia_####.png or .exr "
+                        "(default: <scene stem>_####.png)")
+    a.add_argument("--frames", metavar="A:B", help="render frames A to B (inclusive; default all)")
+    a.add_argument("--video", metavar="OUT", help="also encode the frames into OUT.mp4 or OUT.webm")
+    a.add_argument("--width", metavar="W", help="frame width (same as --set image.width=W; not both)")
+    a.add_argument("--height", metavar="H", help="frame height (same as --set image.height=H; not both)")
+    a.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene key (it is then no longer keyframed) or animation.frames, "
+                        "animation.fps, animation.interpolation")
+    a.add_argument("--device", metavar="SPEC", help="OpenCL device of every worker (as for render)")
+    a.add_argument("--channels", metavar="LIST", help="EXR channel groups (as for render)")
+    a.add_argument("--force", action="store_true", help="render frames whose work is refused as hopeless")
+    _cluster_options(a, "whole frames")
+
+    sub.add_parser("devices", help="list the OpenCL devices, which cannot compile, and the default")
+
+    k = sub.add_parser("keys", help="list every scene key with its default, valid range and meaning")
+    k.add_argument("section", nargs="?", metavar="SECTION",
+                   help="only this section's keys: fractal, camera, slice, march, normals, shading, "
+                        "image, clip or render")
+
+    i = sub.add_parser("import-pov", help="convert a POV-Ray julia_fractal scene to a scene file")
+    i.add_argument("pov", metavar="FILE.pov", help="POV-Ray 3.7 scene with one julia_fractal")
+    i.add_argument("-o", "--output", metavar="SCENE.toml",
+                   help="scene file to write (default: <FILE stem>.toml in the current directory)")
+    i.add_argument("--width", metavar="W", help="image width, also POV-Ray's image_width (default 640)")
+    i.add_argument("--height", metavar="H", help="image height, also POV-Ray's image_height (default 480)")
+    return ap
+
+
+def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
+    """--workers and --scheduler (pyjulia4d/distributed.py): Dask renders ``units``."""
+    p.add_argument("--workers", metavar="N",
+                   help=f"render {units} on a local Dask cluster of N worker processes (0: in this "
+                        f"process; animate's default: one per GPU, or 1 on a CPU)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help=f"render {units} on an existing Dask cluster, e.g. tcp://HOST:8786 "
+                        f"(dask scheduler; dask worker tcp://HOST:8786 on each node)")
+
+
+def select_device(spec: str | None) -> Any:
+    """devices.select_device, imported late: pyopencl is slow to import."""
+    from pyjulia4d.opencl.devices import select_device as select
+
+    return select(spec)
+
+
+def _size_overrides(args: argparse.Namespace) -> list[str]:
+    """--set overrides with --width and --height added (render and animate)."""
+    overrides = list(args.overrides)
+    for flag, dotted in (("--width", "image.width"), ("--height", "image.height")):
+        value = getattr(args, flag[2:])
+        if value is None:
+            continue
+        if any(override_key(o) == dotted for o in overrides):
+            raise SceneError(dotted, f"given twice, by {flag} and by --set {dotted}; use one")
+        overrides.append(f"{dotted}={value}")
+    return overrides
+
+
+IMAGE_SUFFIXES = (".png", ".exr")
+
+
+def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
+    """The scene an image was rendered from: the resolved scene write_image put in its header
+    (``pyjulia4d.scene``: the camera camera.fit chose included, so the same picture comes
+    back), with overrides applied.  One SceneError naming the file if there is none."""
+    from pyjulia4d.app.output import read_header
+    from pyjulia4d.scene.model import MAX_SCENE_BYTES, scene_table_from_text
+
+    shown = path if path.isprintable() else repr(path)
+    if not Path(path).is_file():
+        raise SceneError(shown, "cannot read: no such file")
+    header = read_header(Path(path))
+    if header is None:
+        raise SceneError(shown, f"cannot read it as a {Path(path).suffix.lower()[1:].upper()} image")
+    text = header.get("pyjulia4d.scene")
+    if text is None:
+        raise SceneError(shown, "holds no pyjulia4d scene (not rendered by pyjulia4d, or its metadata "
+                                "was stripped)")
+    if len(text.encode("utf-8", "replace")) > MAX_SCENE_BYTES:
+        raise SceneError(shown, "its scene is larger than 1 MiB")
+    return Scene.from_dict(scene_table_from_text(text, f"{shown} (its scene)"), overrides)
+
+
+def _render(args: argparse.Namespace) -> int:
+    overrides = _size_overrides(args)
+    if args.scene is None:   # the built-in scene; framed (camera.fit) unless a position is set
+        scene = Scene.from_dict({}, overrides)
+        default_out = "julia.png"
+    elif Path(args.scene).suffix.lower() in IMAGE_SUFFIXES:   # render it again
+        scene = scene_from_image(args.scene, overrides)
+        default_out = Path(args.scene).stem + "-rerender.png"
+    else:
+        scene = Scene.from_toml(args.scene, overrides)
+        default_out = Path(args.scene).stem + ".png"
+    out = check_output_path(default_out if args.output is None else args.output)
+    outputs = _outputs(args.channels, out)
+    if args.workers is not None or args.scheduler is not None:  # tiles on a Dask cluster
+        from pyjulia4d.app.cluster import check_workers, render_on_cluster
+
+        workers = None if args.workers is None else check_workers(args.workers)
+        result = render_on_cluster(scene, workers, args.scheduler, args.device, outputs, args.force,
+                                   progress=True)
+    else:
+        device = select_device(args.device)
+
+        from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
+
+        result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
+    from pyjulia4d.scene.quality import BOUND_MAX_ITER, stated_p99
+
+    # capped rays, the guards that fired and the certified depth bracket are part of the
+    # result: said in the header and the closing line, never hidden
+    q = scene.march.quality
+    stated = stated_p99(q, scene.fractal.max_iter)
+    report, tail = result.report(stated)
+    if q != "custom" and stated is None:  # never claim a bound that was not measured
+        tail += (f"; march.quality={q} states no depth-error bound beyond fractal.max_iter "
+                 f"{BOUND_MAX_ITER}: the bracket above is this render's own")
+        report["pyjulia4d.preset_bound_met"] = "no bound stated"
+    # the scene as rendered: with camera.fit, the camera the framing pass chose
+    rendered = getattr(result, "scene", None) or scene
+    header = {"pyjulia4d.scene": rendered.to_toml(), **report}
+    if scene.camera.fit and rendered is not scene:
+        pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
+        tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
+    write_image(out, result, header)
+    w, h = scene.image.width, scene.image.height
+    why = ""
+    if args.device is None and args.workers is None and args.scheduler is None and hasattr(device, "int_ptr"):
+        from pyjulia4d.opencl.devices import default_reason
+        why = f" ({default_reason(device)})"
+    print(
+        f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}{why}, "
+        f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
+    )
+    return 0
+
+
+def _import_pov(args: argparse.Namespace) -> int:
+    """import-pov: FILE.pov -> SCENE.toml (pyjulia4d/povray.py); warnings only on success."""
+    from pyjulia4d.interop.povray import check_toml_path, import_pov, write_toml
+
+    size = []
+    for key, value in (("image.width", args.width), ("image.height", args.height)):
+        if value is not None:
+            v = value.strip()
+            value = int(v) if v.isascii() and v.lstrip("+-").isdigit() and len(v) < 20 else value
+            Scene.from_dict({"image": {key.partition(".")[2]: value}})  # render's range errors
+        size.append(value)
+    imported = import_pov(args.pov, *size)
+    out = check_toml_path(args.output if args.output is not None else Path(args.pov).stem + ".toml", args.pov)
+    write_toml(out, imported.toml)
+    for w in imported.warnings:
+        _say(f"pyjulia4d: warning: {_one_line(Warning(w))}")
+    s = imported.scene
+    print(f"wrote {out}: {s.fractal.algebra} {s.fractal.function}, c = {list(s.fractal.c)}, "
+          f"max_iter {s.fractal.max_iter}, {s.image.width}x{s.image.height} "
+          f"(render: {PROG} render {out})")
+    return 0
+
+
+# --channels: EXR channel groups and the render outputs behind them (render.RenderResult)
+CHANNEL_GROUPS = {"RGBA": ("color", "alpha"), "Z": ("depth", "bracket"), "N": ("normal",),
+                  "P": ("position",)}
+
+
+def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
+    """The render outputs behind --channels (None: all the format holds)."""
+    if out.suffix.lower() == ".png":
+        if channels is not None and channels.strip().upper() != "RGBA":
+            raise SceneError("--channels", f"{channels!r}: a PNG holds RGBA only; write .exr for Z, N or P")
+        return ("color", "alpha")
+    if channels is None:
+        return None
+    groups = [g.strip().upper() for g in channels.split(",")]
+    if not all(groups):
+        raise SceneError("--channels", f"{channels!r}: empty name in the list; use names from "
+                                       f"{', '.join(CHANNEL_GROUPS)}")
+    for g in groups:
+        if g not in CHANNEL_GROUPS:
+            raise SceneError("--channels", f"unknown channel group {g!r}; use names from "
+                                           f"{', '.join(CHANNEL_GROUPS)}")
+    return tuple(o for g in groups for o in CHANNEL_GROUPS[g])
+
+
+def _show_arg(text: str) -> str:
+    return text if text.isprintable() and len(text) <= 80 else repr(text[:80])
+
+
+def _one_line(e: BaseException) -> str:
+    return " ".join(str(e).splitlines()) or type(e).__name__
+
+
+def _say(line: str) -> None:
+    """One line on stderr, whatever its encoding, even with the terminal gone."""
+    try:
+        try:
+            print(line, file=sys.stderr)
+        except UnicodeEncodeError:  # e.g. an argument's undecodable bytes on an ASCII stderr
+            print(line.encode("ascii", "backslashreplace").decode("ascii"), file=sys.stderr)
+    except OSError:  # the terminal is gone (SIGHUP): nothing left to tell
+        pass
+
+
+def _warn_one_line(message, category, filename, lineno, file=None, line=None) -> None:
+    _say(f"pyjulia4d: warning: {_one_line(Warning(message))}")
+
+
+_SIGNALS = tuple(getattr(signal, s) for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s))
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    # a second SIGTERM/SIGHUP during the clean-up the first one starts would cut it short
+    for s in _SIGNALS:
+        signal.signal(s, signal.SIG_IGN)
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _signals_raise() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise Terminated inside the block.  Only where their action
+    is the default one (``nohup`` sets SIGHUP to ignore: that stays), and only in the
+    main thread (the only one that can set handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {s: signal.getsignal(s) for s in _SIGNALS}
+    for s, h in old.items():
+        if h == signal.SIG_DFL:
+            signal.signal(s, _raise_terminated)
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit status (2 on bad input, 130 on Ctrl-C, 128 + the
+    signal number on SIGTERM or SIGHUP)."""
+    try:
+        args = _parser().parse_args(argv)
+    except UsageError as e:
+        _say(f"pyjulia4d: error: {_one_line(e)} (see --help)")
+        return 2
+    shown = warnings.showwarning
+    warnings.showwarning = _warn_one_line  # workload and precision warnings: one line each
+    try:
+        with _signals_raise():
+            if args.command == "devices":
+                from pyjulia4d.opencl.devices import describe_devices
+
+                print(describe_devices())
+                return 0
+            if args.command == "keys":
+                from pyjulia4d.scene.keys import describe_keys
+                from pyjulia4d.scene.model import SECTION_NAMES
+
+                if args.section is not None and args.section not in SECTION_NAMES:
+                    raise SceneError(_show_arg(args.section), f"unknown section; use one of "
+                                                              f"{', '.join(SECTION_NAMES)}")
+                print(describe_keys(args.section))
+                return 0
+            if args.command == "import-pov":
+                return _import_pov(args)
+            if args.command == "animate":
+                from pyjulia4d.app.animation import run_cli
+
+                return run_cli(args)
+            return _render(args)
+    except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
+        _say(f"pyjulia4d: error: {_one_line(e)}")
+        return 2
+    except KeyboardInterrupt:
+        _say("pyjulia4d: interrupted")
+        return 130
+    except Terminated as e:
+        _say(f"pyjulia4d: terminated by {signal.Signals(e.signum).name}")
+        return 128 + e.signum
+    finally:
+        warnings.showwarning = shown

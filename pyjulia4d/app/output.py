@@ -1,0 +1,273 @@
+"""Image writers (PNG, EXR).  Every writer is atomic: a temp file in the target
+directory is renamed over the output, so a failed or interrupted write leaves
+nothing at the output path.
+
+The temp file is ``.<stem>.<random><ext>`` beside the output, its stem shortened so
+that the name fits the file system's name limit; it is removed on any exception,
+KeyboardInterrupt and the CLI's SIGTERM/SIGHUP exception included."""
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import stat
+import tempfile
+import threading
+from pathlib import Path
+from typing import Any, Iterator, Mapping
+
+import numpy as np
+
+FORMATS = (".png", ".exr")
+
+# Room left for tempfile's random part of a name (8 characters in CPython today).
+_RANDOM_CHARS = 16
+# Where pathconf() cannot tell: the usual Linux limits.
+_NAME_MAX, _PATH_MAX = 255, 4096
+# Deferred while a temp file is created or removed, so that no signal's exception can
+# fall between creating a file and knowing its name (which would leave it behind).
+_HELD = tuple(getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s))
+
+
+class OutputError(ValueError):
+    """Unusable output path or format; the message starts with the path."""
+
+
+def _suffix(path: str | Path) -> str:
+    return Path(path).suffix.lower()
+
+
+def _shown(path: str) -> str:
+    """The path as a message shows it: itself when printable, else its repr."""
+    return path if path and path.isprintable() else repr(path)
+
+
+def _quoted(path: str | Path) -> str:
+    """The path in quotes: 'dir', or its repr when not printable."""
+    path = str(path)
+    return f"'{path}'" if path and path.isprintable() else repr(path)
+
+
+def _limit(directory: str | Path, name: str, fallback: int) -> int:
+    try:
+        value = os.pathconf(directory, name)
+    except (OSError, ValueError):
+        return fallback
+    return value if value > 0 else fallback  # -1: no limit, keep the usual one
+
+
+def _temp_affixes(p: Path, name_max: int) -> tuple[str, str]:
+    """(prefix, suffix) of the temp file for ``p``: ``.<stem>.`` and its extension, the
+    stem cut so that prefix + random part + suffix fits in ``name_max`` bytes."""
+    room = max(0, name_max - len(os.fsencode(p.suffix)) - 2 - _RANDOM_CHARS)
+    stem = p.stem[:room]
+    while len(os.fsencode(stem)) > room:  # multi-byte characters: cut by bytes
+        stem = stem[:-1]
+    return f".{stem}.", p.suffix
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Run the Python handlers of SIGINT, SIGTERM and SIGHUP (Ctrl-C's KeyboardInterrupt,
+    the CLI's exceptions) at the end of the block instead of inside it.
+
+    Python runs every handler in the main thread, whichever thread the signal was
+    delivered to (OpenCL's workers take some): blocking it with pthread_sigmask in this
+    thread would not defer it, swapping the handlers does."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread runs handlers (and may swap them)
+        return
+    caught: list[int] = []
+    old = {}
+    for s in _HELD:
+        if callable(signal.getsignal(s)):
+            old[s] = signal.signal(s, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+        if caught:
+            old[caught[0]](caught[0], None)  # the first one's exception, now
+
+
+def check_directory(shown: str, parent: Path) -> None:
+    """The one-line errors for an output whose directory ``parent`` is missing, unreadable or
+    not a directory (images, scene files, videos); ``shown`` names the output."""
+    try:
+        st = os.stat(parent)
+    except FileNotFoundError:
+        raise OutputError(f"{shown}: directory {_quoted(parent)} does not exist") from None
+    except (OSError, ValueError) as e:
+        raise OutputError(f"{shown}: directory {_quoted(parent)}: "
+                          f"{getattr(e, 'strerror', None) or e}") from None
+    if not stat.S_ISDIR(st.st_mode):
+        raise OutputError(f"{shown}: {_quoted(parent)} is not a directory")
+
+
+def check_output_path(path: str | Path) -> Path:
+    """Fail before rendering if ``path`` cannot take the image: its format, its
+    directory, the length of its name and path (the temp file's too), and a temp
+    file really created (and removed) beside it."""
+    raw = os.fspath(path)
+    shown = _shown(raw)
+    if not raw:
+        raise OutputError(f"{shown}: empty output path")
+    p = Path(raw)
+    ext = _suffix(p)
+    if ext not in FORMATS:
+        got = _quoted(ext) if ext else "'(none)'"
+        raise OutputError(f"{shown}: unsupported output format {got} (use .png or .exr)")
+    if raw.endswith(("/", os.sep)):
+        raise OutputError(f"{shown}: names a directory (trailing '/')")
+    parent = p.parent
+    check_directory(shown, parent)
+    name_max = _limit(parent, "PC_NAME_MAX", _NAME_MAX)
+    path_max = _limit(parent, "PC_PATH_MAX", _PATH_MAX)  # counts the terminating NUL
+    name = len(os.fsencode(p.name))
+    if name > name_max:
+        raise OutputError(f"{shown}: file name too long ({name} bytes; this file system "
+                          f"allows {name_max})")
+    prefix, suffix = _temp_affixes(p, name_max)
+    longest = max(len(os.fsencode(raw)),
+                  len(os.fsencode(os.path.join(parent, prefix + suffix))) + _RANDOM_CHARS)
+    if longest >= path_max:
+        raise OutputError(f"{shown}: path too long ({longest} bytes with the temporary "
+                          f"file's name; the limit is {path_max - 1})")
+    try:
+        is_dir = stat.S_ISDIR(os.stat(p).st_mode)
+    except FileNotFoundError:
+        is_dir = False
+    except (OSError, ValueError) as e:  # ValueError: a NUL in the name
+        raise OutputError(f"{shown}: {getattr(e, 'strerror', None) or e}") from None
+    if is_dir:
+        raise OutputError(f"{shown}: is a directory")
+    try:
+        # the only exact test of "can a file be made here" (permissions, read-only
+        # mounts, /proc, ACLs, root) is to make one
+        with _signals_held():
+            fd, tmp = tempfile.mkstemp(dir=parent, prefix=prefix, suffix=suffix)
+            os.close(fd)
+            os.unlink(tmp)
+    except OSError as e:
+        raise OutputError(f"{shown}: cannot create a file in {_quoted(parent)}: "
+                          f"{e.strerror or e}") from None
+    return p
+
+
+def _file_mode() -> int:
+    """0o666 less the umask: what a plain open() would have created."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+@contextlib.contextmanager
+def _atomic(path: str | Path) -> Iterator[Path]:
+    """Yield a temp path beside ``path``; move it onto ``path`` only on success."""
+    p = Path(path)
+    prefix, suffix = _temp_affixes(p, _limit(p.parent, "PC_NAME_MAX", _NAME_MAX))
+    tmp: Path | None = None
+    try:
+        with _signals_held():  # a signal arriving here is raised once tmp is known
+            fd, name = tempfile.mkstemp(dir=p.parent, prefix=prefix, suffix=suffix)
+            os.close(fd)
+            tmp = Path(name)
+        yield tmp
+        os.chmod(tmp, _file_mode())  # mkstemp creates 0600
+        os.replace(tmp, p)
+    except BaseException:  # KeyboardInterrupt and SIGTERM/SIGHUP too: never leave it behind
+        if tmp is not None:
+            with _signals_held():  # a second signal must not cut the clean-up short
+                tmp.unlink(missing_ok=True)
+        raise
+
+
+def _to_u8(x: np.ndarray) -> np.ndarray:
+    x = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0)
+    return np.rint(np.clip(x, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def write_png(
+    path: str | Path,
+    color: np.ndarray,
+    alpha: np.ndarray,
+    text: Mapping[str, str] | None = None,
+) -> None:
+    """8-bit RGBA PNG from ``color`` (H, W, 3), linear light, and ``alpha`` (H, W) in [0, 1].
+
+    The colour is clipped to [0, 1] and sRGB-encoded (the renderer shades in linear light;
+    an EXR keeps it linear), alpha is linear; both rounded.  ``text`` entries become PNG
+    iTXt chunks.
+    """
+    from PIL import Image, PngImagePlugin
+
+    from pyjulia4d.pipeline.colormap import linear_to_srgb
+
+    color = np.asarray(color)
+    alpha = np.asarray(alpha)
+    if color.ndim != 3 or color.shape[2] != 3 or alpha.shape != color.shape[:2]:
+        raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
+    rgb = linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0))
+    rgba = np.concatenate([_to_u8(rgb), _to_u8(alpha)[..., None]], axis=2)
+    info = PngImagePlugin.PngInfo()
+    for k, v in (text or {}).items():
+        info.add_itxt(k, str(v))  # iTXt: UTF-8, unlike tEXt's Latin-1
+    with _atomic(path) as tmp:
+        Image.fromarray(np.ascontiguousarray(rgba)).save(tmp, format="PNG", pnginfo=info)
+
+
+def write_exr(
+    path: str | Path,
+    channels: Mapping[str, np.ndarray],
+    header: Mapping[str, str] | None = None,
+) -> None:
+    """Single-part scanline EXR, ZIP-compressed, one float32 channel per entry.
+
+    ``header`` entries are written as string attributes.
+    """
+    import OpenEXR
+
+    if not channels:
+        raise ValueError("no channels to write")
+    # OpenEXR.File replaces the dict's arrays by Channel objects: hand it a fresh dict.
+    data = {name: np.ascontiguousarray(a, dtype=np.float32) for name, a in channels.items()}
+    shapes = {a.shape for a in data.values()}
+    if len(shapes) != 1 or len(next(iter(shapes))) != 2:
+        raise ValueError(f"EXR channels must be 2D and of one shape, got {sorted(shapes)}")
+    hdr: dict[str, Any] = {
+        "compression": OpenEXR.ZIP_COMPRESSION,
+        "type": OpenEXR.scanlineimage,
+    }
+    hdr.update({k: str(v) for k, v in (header or {}).items()})
+    with _atomic(path) as tmp:
+        OpenEXR.File(hdr, data).write(str(tmp))
+
+
+def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None) -> None:
+    """Write a RenderResult as .png (colour + alpha) or .exr (``result.exr_channels()``)."""
+    p = check_output_path(path)
+    try:
+        if _suffix(p) == ".png":
+            write_png(p, result.color, result.alpha, header)
+        else:
+            write_exr(p, result.exr_channels(), header)
+    except OSError as e:
+        raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
+
+
+def read_header(path: str | Path) -> dict[str, str] | None:
+    """An image's header entries (PNG text chunks, EXR string attributes), as write_image
+    wrote them; None if it cannot be read."""
+    path = Path(path)
+    try:
+        if path.suffix.lower() == ".exr":
+            import OpenEXR
+            hdr = OpenEXR.File(str(path), header_only=True).header()
+            return {k: v for k, v in hdr.items() if isinstance(v, str)}
+        from PIL import Image
+        with Image.open(path) as im:
+            im.load()  # text chunks after the image data too; a truncated file fails here
+            return dict(im.text)
+    except Exception:  # a damaged or foreign file
+        return None

@@ -1,0 +1,119 @@
+"""Video from a sequence of frames: MP4 (H.264) or WebM (VP9), through imageio-ffmpeg,
+whose wheel ships its own ffmpeg (no system ffmpeg).
+
+PNG frames are taken as written (sRGB, 8 bits); EXR frames hold linear light and are
+encoded like a PNG is (colour clipped to [0, 1], sRGB-encoded, rounded: output.write_png).
+Alpha is dropped: missed pixels already hold shading.background.  Odd sizes are padded
+to even ones by repeating the last row or column (4:2:0 chroma needs even sizes).  The
+video is written atomically (output.py: a temp file beside it, renamed).
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Iterable, Iterator
+
+import numpy as np
+
+from pyjulia4d.app.output import OutputError, _atomic, _quoted, _shown, check_directory
+
+CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
+# H.264's constant rate factor and VP9's constant quality (lower is better; both about
+# visually lossless for renders): smooth gradients of a render band at the defaults.
+QUALITY = {".mp4": ["-crf", "18", "-preset", "medium"], ".webm": ["-crf", "24", "-b:v", "0"]}
+
+
+def have_ffmpeg() -> bool:
+    """Whether imageio-ffmpeg (the ``video`` extra) is installed."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("imageio_ffmpeg") is not None
+    except ValueError:   # sys.modules["imageio_ffmpeg"] is None (blocked)
+        return False
+
+
+def check_video_path(path: str | os.PathLike) -> Path:
+    """Fail before rendering if ``path`` cannot take the video: .mp4 or .webm, in an
+    existing, writable directory."""
+    raw = os.fspath(path)
+    shown = _shown(raw)
+    p = Path(raw)
+    if not raw or raw.endswith(("/", os.sep)):
+        raise OutputError(f"{shown}: not a file name")
+    ext = p.suffix.lower()
+    if ext not in CODECS:
+        got = _quoted(ext) if ext else "'(none)'"
+        raise OutputError(f"{shown}: unsupported video format {got} (use .mp4 or .webm)")
+    check_directory(shown, p.parent)
+    if p.is_dir():
+        raise OutputError(f"{shown}: is a directory")
+    if not os.access(p.parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{shown}: cannot create a file in {_quoted(p.parent)}")
+    if not have_ffmpeg():
+        raise OutputError(f"{shown}: video needs imageio-ffmpeg, which is not installed: pip install "
+                          f"'pyjulia4d[video]'")
+    return p
+
+
+def read_frame(path: str | os.PathLike) -> np.ndarray:
+    """A frame file as (H, W, 3) uint8 sRGB: a PNG's RGB, an EXR's R, G, B encoded as
+    output.write_png encodes them."""
+    p = Path(path)
+    if p.suffix.lower() == ".exr":
+        import OpenEXR
+
+        from pyjulia4d.pipeline.colormap import linear_to_srgb
+        from pyjulia4d.app.output import _to_u8
+
+        ch = OpenEXR.File(str(p), separate_channels=True).channels()
+        if not all(k in ch for k in "RGB"):
+            raise OutputError(f"{_shown(str(p))}: no R, G, B channels to make a video of "
+                              f"(rendered with --channels without RGBA)")
+        rgb = np.stack([np.asarray(ch[k].pixels, np.float32) for k in "RGB"], axis=-1)
+        return _to_u8(linear_to_srgb(np.nan_to_num(rgb, nan=0.0)))
+    from PIL import Image
+
+    with Image.open(p) as im:
+        return np.asarray(im.convert("RGB"))
+
+
+def _even(frame: np.ndarray) -> np.ndarray:
+    h, w = frame.shape[:2]
+    return np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+
+
+def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: float) -> int:
+    """Encode ``frames`` ((H, W, 3) uint8, one size) at ``fps`` into ``path`` (.mp4 or
+    .webm), atomically; returns the number of frames written."""
+    import imageio_ffmpeg
+
+    p = Path(path)
+    ext = p.suffix.lower()
+    it: Iterator[np.ndarray] = iter(frames)
+    first = next(it, None)
+    if first is None:
+        raise OutputError(f"{_shown(str(p))}: no frames to encode")
+    first = _even(first)
+    h, w = first.shape[:2]
+    n = 0
+    with _atomic(p) as tmp:
+        writer = imageio_ffmpeg.write_frames(
+            str(tmp), (w, h), fps=fps, codec=CODECS[ext], pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
+            quality=None, macro_block_size=1, output_params=QUALITY[ext], ffmpeg_log_level="error")
+        writer.send(None)  # start ffmpeg
+        try:
+            for frame in (first, *(_even(f) for f in it)):
+                if frame.shape != first.shape:
+                    raise OutputError(f"{_shown(str(p))}: frame {n} is {frame.shape[1]}x{frame.shape[0]}, "
+                                      f"the first {w}x{h}: a video's frames share one size")
+                writer.send(np.ascontiguousarray(frame))
+                n += 1
+        finally:
+            writer.close()
+    return n
+
+
+def video_from_files(path: str | os.PathLike, files: Iterable[str | os.PathLike], fps: float) -> int:
+    """write_video of the frame files, read one at a time."""
+    return write_video(path, (read_frame(f) for f in files), fps)

@@ -1,0 +1,1 @@
+"""The 4D camera: its frame, the slice, rays and the bounding ball."""

@@ -1,0 +1,1 @@
+"""Other programs' scenes: POV-Ray's julia_fractal."""

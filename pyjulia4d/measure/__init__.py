@@ -1,0 +1,1 @@
+"""Ground truth and the catalogue of stiff and extreme cases, for tests and benchmarks."""

@@ -1,0 +1,68 @@
+"""Build the OpenCL program of a kernel configuration (kernel_config.py).
+
+Built programs are kept per (context, pieces, switches) for the process, and their
+binaries on disk across processes in ``<cache>/programs`` (resources.cache_dir), keyed by
+the source, the options and the device and driver (devices.device_key): not every driver
+caches its own (PoCL does; others may not).  A binary that no longer loads is rebuilt
+from source.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+
+import pyopencl as cl
+
+from pyjulia4d.opencl.devices import build, cannot_compile, compile_error, device_key
+from pyjulia4d.pipeline.kernel_config import KernelConfig, source
+from pyjulia4d.resources import cache_dir
+
+
+_programs: dict[tuple, cl.Program] = {}
+
+
+def _from_binary(ctx: cl.Context, dev: cl.Device, path, opts) -> cl.Program | None:
+    """The program from a cached binary, or None (none cached, or it no longer loads)."""
+    try:
+        binary = path.read_bytes()
+    except OSError:
+        return None
+    try:
+        return build(cl.Program(ctx, [dev], [binary]), opts)
+    except (cl.Error, RuntimeError, ValueError):
+        return None
+
+
+def _save_binary(prg: cl.Program, path) -> None:
+    """Write the program's binary atomically; a cache that cannot be written costs only time."""
+    try:
+        binary = prg.get_info(cl.program_info.BINARIES)[0]
+        if not binary:
+            return
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.{os.getpid()}")
+        tmp.write_bytes(bytes(binary))
+        os.replace(tmp, path)
+    except (cl.Error, OSError):
+        pass
+
+
+def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
+    """Build (once per context and configuration) and return the program."""
+    key = (ctx.int_ptr, config)
+    prg = _programs.get(key)
+    if prg is None:
+        opts = [f"-D{d}" for d in config.defines]
+        dev = ctx.devices[0]
+        if compile_error(dev):  # a compiler that fails on everything: one line, not a build log
+            raise cannot_compile(dev)
+        src = source(config)
+        digest = hashlib.sha256("\0".join([src, " ".join(opts), device_key(dev), cl.VERSION_TEXT])
+                                .encode()).hexdigest()
+        path = cache_dir() / "programs" / f"{digest}.bin"
+        prg = _from_binary(ctx, dev, path, opts)
+        if prg is None:
+            prg = build(cl.Program(ctx, src), opts)
+            _save_binary(prg, path)
+        _programs[key] = prg
+    return prg

@@ -1,0 +1,200 @@
+"""OpenCL device discovery and selection."""
+from __future__ import annotations
+
+import warnings
+
+import pyopencl as cl
+
+
+class DeviceError(ValueError):
+    """No OpenCL device, or none matching the request."""
+
+
+def _indexed() -> list[tuple[str, cl.Platform, cl.Device]]:
+    """(``"P:D"``, platform, device) for every device; [] without OpenCL."""
+    try:
+        platforms = cl.get_platforms()
+    except cl.Error:  # no ICD / no platform raises rather than returning []
+        return []
+    out = []
+    for pi, p in enumerate(platforms):
+        try:
+            devices = p.get_devices()
+        except cl.Error:  # a platform without devices raises DEVICE_NOT_FOUND
+            continue
+        out.extend((f"{pi}:{di}", p, d) for di, d in enumerate(devices))
+    return out
+
+
+def list_devices() -> list[tuple[cl.Platform, cl.Device]]:
+    """Every (platform, device) pair, in platform then device order; [] without OpenCL."""
+    return [(p, d) for _, p, d in _indexed()]
+
+
+def device_type(device: cl.Device) -> str:
+    """"GPU", "CPU", "ACCELERATOR" or "OTHER"."""
+    t = device.type
+    for name in ("GPU", "CPU", "ACCELERATOR"):
+        if t & getattr(cl.device_type, name):
+            return name
+    return "OTHER"
+
+
+def has_fp64(device: cl.Device) -> bool:
+    """Whether the device can run the double-precision kernels."""
+    try:
+        if "cl_khr_fp64" in device.extensions.split():
+            return True
+        return bool(device.double_fp_config)
+    except cl.Error:
+        return False
+
+
+def build(prg: cl.Program, options=()) -> cl.Program:
+    """``prg.build(options)`` without pyopencl's CompilerWarning: Intel's CPU runtime returns a
+    build log ("Compilation started ... Device build done") on every successful build,
+    which pyopencl would show as a warning; failures still raise with their log."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cl.CompilerWarning)
+        return prg.build(options=list(options))
+
+
+_PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *= 2.0f; }"
+_compiles: dict[int, str] = {}
+
+
+def compile_error(device: cl.Device) -> str:
+    """"" when ``device`` compiles OpenCL C, else the first line of its build error.
+
+    Checked once per device and process.  Seen: PyPI's PoCL 3.0 (LLVM 14) on a CPU its
+    LLVM does not know (AMD Zen 5) fails every build with "unknown target CPU
+    'generic'"; Debian's pocl-opencl-icd picks its kernel library by CPU features and
+    builds there."""
+    key = device.int_ptr
+    if key not in _compiles:
+        try:
+            ctx = cl.Context([device])
+            build(cl.Program(ctx, _PROBE_SOURCE))
+            _compiles[key] = ""
+        except (cl.Error, RuntimeError) as e:
+            lines = [ln.strip() for ln in str(e).splitlines() if "error" in ln.lower() and ln.strip()]
+            msg = next((ln for ln in lines if not ln.startswith("clBuildProgram")), "")
+            _compiles[key] = msg or (lines[0] if lines else type(e).__name__)
+    return _compiles[key]
+
+
+def cannot_compile(device: cl.Device) -> DeviceError:
+    """The one-line error for a device whose OpenCL compiler fails."""
+    return DeviceError(f"device '{device.name.strip()}' ({device.platform.name.strip()}) cannot "
+                       f"compile OpenCL C: {compile_error(device)}; pick another with --device "
+                       f"(a CPU unknown to PyPI's PoCL: install Debian's pocl-opencl-icd)")
+
+
+def device_key(device: cl.Device) -> str:
+    """Platform, platform version, device, device version and driver version: what a
+    cached answer about a device (a program binary, a probed width) is keyed by."""
+    p = device.platform
+    return " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version,
+                                           device.driver_version))
+
+
+def describe_devices() -> str:
+    """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``, and
+    whether it compiles (a device that cannot is never picked by default)."""
+    rows = _indexed()
+    if not rows:
+        raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
+    out = []
+    chosen = None
+    try:
+        chosen = select_device(None)
+    except DeviceError:
+        pass
+    for idx, p, d in rows:
+        err = compile_error(d)
+        mark = "  (default)" if chosen is not None and d.int_ptr == chosen.int_ptr else ""
+        out.append(f"{idx}  {p.name.strip()} {p.version.strip()} | {d.name.strip()} | {device_type(d)}, "
+                   f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}, "
+                   f"driver {d.driver_version.strip()}"
+                   + (f", cannot compile: {err}" if err else "") + mark)
+    from pyjulia4d.opencl import runtimes
+
+    if chosen is not None:
+        out.append(default_reason(chosen))
+    lib = runtimes.registered["library"]
+    out.append(f"Intel's CPU runtime from PyPI: registered ({lib})" if lib else
+               f"Intel's CPU runtime from PyPI: not registered ({runtimes.registered['why_not']})")
+    return "\n".join(out)
+
+
+# CPU runtimes by preference when more than one compiles, by platform name: Intel's CPU
+# runtime ran the kernels of every algebra x function pair faster than PoCL on the
+# development machine (AMD EPYC Zen 5; benchmarks/cpu_runtimes.py, results in
+# benchmarks/results/cpu_runtimes.md), and built them faster from cold caches.  Others
+# follow in platform order.
+CPU_PREFERENCE = ("Intel(R) OpenCL",)
+
+
+def runtime_rank(device: cl.Device) -> int:
+    """Where ``device``'s platform stands in CPU_PREFERENCE (len(CPU_PREFERENCE) if absent)."""
+    name = device.platform.name.strip()
+    return CPU_PREFERENCE.index(name) if name in CPU_PREFERENCE else len(CPU_PREFERENCE)
+
+
+def default_reason(dev: cl.Device) -> str:
+    """Why select_device(None) picked ``dev``, for the closing line: its index, and the
+    devices passed over before it (a device of the wanted type that cannot compile)."""
+    rows = _indexed()
+    at = next((k for k, (_, _, d) in enumerate(rows) if d.int_ptr == dev.int_ptr), len(rows))
+    idx = rows[at][0] if at < len(rows) else "?"
+    kind = device_type(dev)
+    skipped = [i for i, _, d in rows if device_type(d) == kind and compile_error(d)]
+    passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
+    if kind == "CPU" and passed:
+        why = f"{idx}, the default: no GPU; of the CPU runtimes that compile, {dev.platform.name.strip()} " \
+              f"is preferred (faster on every pair measured: benchmarks/cpu_runtimes.py) over {', '.join(passed)}"
+    else:
+        why = f"{idx}, the default: the first {kind} that compiles"
+        if kind != "GPU":
+            why += ", no GPU"
+    if skipped:
+        why += f"; {', '.join(skipped)} cannot compile"
+    return why
+
+
+def select_device(spec: str | None = None) -> cl.Device:
+    """Pick a device.
+
+    ``None``: the first GPU on any platform, else the first CPU device, skipping devices
+    that cannot compile (compile_error); DeviceError if none can.
+    ``"P:D"``: platform and device indices as ``describe_devices`` prints them.
+    ``"cpu"`` / ``"gpu"``: the first device of that type.
+    Anything else: the first device whose platform name, platform vendor or
+    device name contains it (case-insensitive).
+    """
+    rows = _indexed()
+    if not rows:
+        raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
+    hint = "(run 'pyjulia4d devices' to list them)"
+    if spec is None:
+        for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
+            found = [d for _, _, d in rows if device_type(d) == want and not compile_error(d)]
+            if found:
+                return min(found, key=runtime_rank) if want == "CPU" else found[0]
+        raise cannot_compile(rows[0][2])
+    s = spec.strip()
+    if s.lower() in ("cpu", "gpu"):
+        for _, _, d in rows:
+            if device_type(d) == s.upper():
+                return d
+        raise DeviceError(f"--device {spec!r}: no {s.upper()} device found {hint}")
+    for idx, _, d in rows:
+        if s == idx:
+            return d
+    if ":" in s and all(part.strip().isdigit() for part in s.split(":")):
+        raise DeviceError(f"--device {spec!r}: no device with that index {hint}")
+    needle = s.lower()
+    for _, p, d in rows:
+        if needle and any(needle in n.lower() for n in (p.name, p.vendor, d.name)):
+            return d
+    raise DeviceError(f"--device {spec!r}: no matching OpenCL device {hint}")

@@ -1,0 +1,574 @@
+"""Execute a render plan (plan.py): per tile, march -> normals -> shade, then assemble.
+
+Every per-pixel step is an OpenCL kernel (the march makes its own rays); Python only
+enqueues tiles and copies back the outputs the plan keeps.  Two tiles are in flight: the
+kernels of one run while the host files the other, with no finish() between them.
+``reference.render`` is the float64 numpy twin of this module's ``render``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import sys
+import time
+
+import numpy as np
+import pyopencl as cl
+import pyopencl.array as cla
+from tqdm import tqdm
+
+from pyjulia4d.pipeline import antialias, colormap
+from pyjulia4d.opencl import build
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.opencl.devices import has_fp64, select_device
+from pyjulia4d.opencl.lanes import lanes_for
+from pyjulia4d.geometry.camera import clip_planes, extra_lights
+from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, judge, predict, tile_side
+from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, fog_start, gradient_step, light_parameters, make_plan,  # noqa: F401
+                   make_tiles)  # (TILE, make_tiles: API)
+from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
+from pyjulia4d.pipeline.result import RenderResult, count_guards
+from pyjulia4d.scene.model import Scene, SceneError, march_method
+
+
+_queues: dict[int, tuple[cl.Context, cl.CommandQueue]] = {}
+
+
+def queue_for(device: cl.Device) -> tuple[cl.Context, cl.CommandQueue]:
+    """One context and queue per device, kept for the process."""
+    key = device.int_ptr
+    if key not in _queues:
+        ctx = cl.Context([device])
+        # profiling: the kernels' own time, summed from their events (render's kernel_seconds)
+        _queues[key] = (ctx, cl.CommandQueue(
+            ctx, properties=cl.command_queue_properties.PROFILING_ENABLE))
+    return _queues[key]
+
+
+class Precision:
+    """numpy types matching the kernels' real / real4 for one precision."""
+
+    def __init__(self, double: bool):
+        self.scalar = np.float64 if double else np.float32
+        self.vec_dtype = cl.cltypes.double4 if double else cl.cltypes.float4
+        self.vec = cl.cltypes.make_double4 if double else cl.cltypes.make_float4
+
+    def v4(self, v) -> np.ndarray:
+        return self.vec(*[float(x) for x in v])
+
+
+def _float4(v3, w=0.0):
+    return cl.cltypes.make_float4(*[float(x) for x in v3], float(w))
+
+
+# The floor of normals.step = "auto": a central difference of the estimate over a step h
+# carries its rounding error divided by h; at h = epsilon = 5e-7 (the final preset) float32
+# differences are noise (2.8 degrees median on the c = 0 ball, against 0.1 at 1e-5).
+# Every kernel is launched in work-groups of one fixed size over a range padded to a whole
+# number of them, the true item count passed as its first argument (kernels return past it):
+# PoCL compiles a work-group function per local size, and with the local size left to the
+# driver (None) it picked one per global size, so every new image size recompiled
+# (+0.27 s measured at 321x241 after 320x240).
+LOCAL_SIZE = 64
+_local: dict[tuple[int, int], int] = {}
+
+
+def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
+    """LOCAL_SIZE, or the largest power of two the device allows for this kernel."""
+    key = (kernel.int_ptr, device.int_ptr)
+    if key not in _local:
+        most = kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, device)
+        size = LOCAL_SIZE
+        while size > most and size > 1:
+            size //= 2
+        _local[key] = size
+    return _local[key]
+
+
+def march_items(n: int, tile_w: int, lanes: int) -> int:
+    """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
+    per block of pixels (kernels/march/march.cl)."""
+    if lanes == 1:
+        return n
+    bw, bh = kernel_config.packet_block(lanes)
+    return -(-tile_w // bw) * -(-(n // tile_w) // bh)
+
+
+def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
+           items: int | None = None) -> cl.Event | None:
+    """Enqueue ``kernel`` over n items, ``lanes`` per work-item (packets of rays) or
+    ``items`` work-items: n_items = n first, then ``args``.  Returns the launch's event."""
+    if n <= 0:
+        return None
+    loc = local_size(kernel, queue.device)
+    items = -(-n // lanes) if items is None else items
+    return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
+
+
+def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
+                   point, depth, status, normal, size: tuple[int, int] | None = None,
+                   lanes: int = 1) -> cl.Event | None:
+    """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
+    device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
+    image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
+    f = scene.fractal
+    w, h = size or (scene.image.width, scene.image.height)
+    n = w * h
+    c = pr.v4(f.c)
+    eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
+    kernel = cl.Kernel(prg, f"normals_{method}")
+    if method == "jacobian":
+        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
+                      pr.scalar(f.bailout), right, up, fwd, normal.data, lanes=lanes)
+    if method == "gradient":
+        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
+                      pr.scalar(f.bailout), pr.scalar(gradient_step(scene)), right, up, fwd, normal.data)
+    return launch(queue, kernel, n, point.data, depth.data, status.data, np.int32(w), np.int32(h), eye,
+                  right, up, fwd, normal.data)
+
+
+
+# The device buffers each output needs (march/march.cl, normals_*.cl, shade.cl); status, flags,
+# depth, bracket and the normals' guard word are read back always (one tile's worth): the
+# streamed counts, guards and bracket statistics come from them.
+_READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket": ("bracket",),
+         "normal": ("normal",), "position": ("point",), "status": ("status",),
+         "samples": ("samples",)}
+
+
+class TileRunner:
+    """The kernels of one plan on one device, with two slots of tile buffers (device and
+    host staging) so that one tile's kernels run while the previous one is filed."""
+
+    SLOTS = 2
+
+    def __init__(self, plan: Plan, dev: cl.Device):
+        self.plan = plan
+        self.ctx, self.queue = queue_for(dev)
+        self.prg = build.program(self.ctx, plan.program)
+        self.march_prg = (self.prg if plan.march_program == plan.program
+                          else build.program(self.ctx, plan.march_program))
+        self.pr = pr = Precision(plan.double)
+        sc, f, m, sh = plan.scene, plan.scene.fractal, plan.scene.march, plan.scene.shading
+        nmax = max(t.n for t in plan.tiles)
+        read = {"status", "flags", "depth", "bracket"} | {b for k in plan.outputs for b in _READ[k]}
+        if plan.normals:
+            read.add("normal")
+        self.read = read
+        self.slots = []
+        for _ in range(self.SLOTS):
+            bufs = {"depth": cla.empty(self.queue, nmax, pr.scalar),
+                    "bracket": cla.empty(self.queue, nmax, pr.scalar),
+                    "point": cla.empty(self.queue, nmax, pr.vec_dtype),
+                    "status": cla.empty(self.queue, nmax, np.int32),
+                    "samples": cla.empty(self.queue, nmax, np.int32),
+                    "flags": cla.empty(self.queue, nmax, np.int32)}
+            if plan.normals:
+                bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
+            if plan.shades:
+                bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            if plan.reflects:   # the reflected rays, their march, normals and colour
+                for k in ("origins", "dirs", "point2", "normal2"):
+                    bufs[k] = cla.empty(self.queue, nmax, pr.vec_dtype)
+                for k in ("depth2", "bracket2"):
+                    bufs[k] = cla.empty(self.queue, nmax, pr.scalar)
+                for k in ("status2", "samples2", "flags2"):
+                    bufs[k] = cla.empty(self.queue, nmax, np.int32)
+                bufs["refl"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            if plan.light_terms:
+                bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+                bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.program.defines
+                                              else 1, cl.cltypes.float4)
+            stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
+            self.slots.append((bufs, stage))
+        fr = plan.frame
+        self.eye, self.fwd, self.right, self.up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
+        self.camera = (self.eye, self.fwd, self.right, self.up, pr.scalar(fr.tan_half_fov),
+                       np.int32(sc.image.width), np.int32(sc.image.height))
+        self.march_const = (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(m.epsilon),
+                            pr.scalar(plan.radius), pr.scalar(plan.near), pr.scalar(plan.far),
+                            np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
+        self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(plan.light),
+                            _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
+                            _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
+                            np.float32(sh.shininess))
+        self.fog = (np.float32(sh.fog), np.float32(fog_start(plan.frame.position, plan.radius)))
+        self.march_k = cl.Kernel(self.march_prg, "march")
+        # [clip]: the half-spaces in world space, as march.cl and march/clip.cl take them
+        planes = clip_planes(sc)
+        self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
+        self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
+                          (pr.v4([planes[k][1] if k < len(planes) else 0.0 for k in range(4)]),)
+                          if planes else ())
+        self.clip_k = cl.Kernel(self.prg, "clip_normals") if planes and plan.normals else None
+        self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
+        # shade/light.cl: in the march's packets where the march has them (kernel_config.march_config)
+        self.light_k = (cl.Kernel(self.march_prg if plan.lanes > 1 else self.prg, "light_terms")
+                        if plan.light_terms else None)
+        self.light_const = light_arguments(plan, pr) if plan.light_terms else ()
+        lut = (colormap.table(sh.colormap) if sh.coloring != "flat" else np.zeros((2, 4), np.float32))
+        self.lut = cla.to_device(self.queue, lut.view(cl.cltypes.float4).ravel())
+        self.n_lut = np.int32(len(lut))
+        self.no_terms = cla.empty(self.queue, 1, cl.cltypes.float4)
+        # shading.lights (camera.extra_lights): positions or directions, colours; their
+        # visibility per pixel where shadows are traced (-D EXTRA_SHADOWS)
+        geo, rgb = extra_lights(sc)
+        self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in geo]))
+        self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in rgb]))
+        self.extra_shadows = "EXTRA_SHADOWS" in plan.program.defines
+        if plan.reflects:
+            self.refl_prg = build.program(self.ctx, plan.reflect_program)
+            self.refl_march_k = cl.Kernel(self.refl_prg, "march")
+            self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
+            self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
+            self.refl_bias = pr.scalar(light_parameters(sc, plan.radius)["bias"])
+
+    def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
+                ) -> tuple[list[cl.Event], list[cl.Event]]:
+        """Queue the tile's kernels - rays through sample ``sample`` of ``samples`` of each
+        pixel (rays.cl; one: the centre) - and the copies of what is read back into ``slot``:
+        (kernel events, copy events); nothing waits."""
+        plan, pr, q = self.plan, self.pr, self.queue
+        bufs, stage = self.slots[slot]
+        n = tile.n
+        kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
+                          np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const, bufs["depth"].data, bufs["point"].data,
+                          bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
+                          bufs["bracket"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
+        if plan.normals:
+            method = plan.scene.normals.method
+            packet = plan.normals_in_march_program
+            kernels.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, method,
+                                          plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
+                                          bufs["normal"], size=(tile.aw, tile.ah),
+                                          lanes=plan.lanes if packet else 1))
+            if self.clip_k is not None:
+                kernels.append(launch(q, self.clip_k, n, bufs["flags"].data, bufs["status"].data, self.right,
+                                      self.up, self.fwd, *self.clip_n, bufs["normal"].data))
+        if plan.reflects:
+            kernels += self.enqueue_reflection(tile, bufs)
+        if plan.light_terms:
+            kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
+                                  bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
+                                  self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
+                                  bufs["vis_extra"].data,
+                                  lanes=plan.lanes))
+        if plan.shades:
+            terms = bufs["terms"] if plan.light_terms else self.no_terms
+            vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
+            refl = bufs["refl"] if plan.reflects else self.no_terms
+            kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
+                                  bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
+                                  self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
+                                  vis_extra.data, refl.data, np.float32(plan.scene.shading.reflection),
+                                  bufs["rgba"].data))
+        copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
+        return kernels, copies
+
+    def enqueue_reflection(self, tile: Tile, bufs: dict) -> list:
+        """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
+        march reading given rays, in the same packets), its normals and its colour."""
+        plan, pr, q, n = self.plan, self.pr, self.queue, tile.n
+        sh = plan.scene.shading
+        ev = [launch(q, self.reflect_rays_k, n, bufs["point"].data, bufs["normal"].data, bufs["status"].data,
+                     self.eye, self.right, self.up, self.fwd, self.refl_bias, pr.scalar(plan.radius),
+                     bufs["origins"].data, bufs["dirs"].data)]
+        ev.append(launch(q, self.refl_march_k, n, np.int32(tile.aw), bufs["origins"].data, bufs["dirs"].data,
+                         *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
+                         bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data, *self.clip_args,
+                         items=march_items(n, tile.aw, plan.lanes)))
+        packet = plan.normals_in_march_program
+        ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
+                                 plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],
+                                 size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))
+        if self.clip_k is not None:
+            ev.append(launch(q, self.clip_k, n, bufs["flags2"].data, bufs["status2"].data, self.right, self.up,
+                             self.fwd, *self.clip_n, bufs["normal2"].data))
+        ev.append(launch(q, self.reflect_color_k, n, bufs["status2"].data, bufs["normal2"].data,
+                         bufs["point2"].data, bufs["dirs"].data, self.right, self.up, self.fwd,
+                         pr.v4(plan.light), _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
+                         _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), bufs["refl"].data))
+        return ev
+
+    def collect(self, tile: Tile, slot: int) -> dict[str, np.ndarray]:
+        """The slot's staged arrays of ``tile``, shaped (ah, aw[, 4]) over its box (valid once
+        the slot's copy events have completed)."""
+        _, stage = self.slots[slot]
+        n, shape = tile.n, (tile.ah, tile.aw)
+        out = {}
+        for k in self.read:
+            a = stage[k][:n]
+            if k in ("point", "normal"):
+                out[k] = a.view(self.pr.scalar).reshape(*shape, 4)
+            elif k == "rgba":
+                out[k] = a.view(np.float32).reshape(*shape, 4)
+            else:
+                out[k] = a.reshape(shape)
+        return out
+
+
+def light_arguments(plan: Plan, pr: Precision) -> tuple:
+    """The light_terms kernel's arguments after the buffers (kernels/shade/light.cl)."""
+    sc, fr = plan.scene, plan.frame
+    f = sc.fractal
+    lp = light_parameters(sc, plan.radius)
+    return (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(sc.march.epsilon),
+            pr.v4(fr.right), pr.v4(fr.up), pr.v4(fr.forward), pr.v4(plan.light), pr.scalar(plan.radius),
+            pr.scalar(lp["step"]), pr.scalar(lp["bias"]), pr.scalar(lp["softness"]), np.int32(lp["max_steps"]),
+            pr.scalar(lp["ao_distance"]), pr.scalar(lp["ao_strength"]), pr.v4(lp["trap"]))
+
+
+def _seconds(events) -> float:
+    """The device time of completed, profiled events."""
+    total = 0
+    for ev in events:
+        if ev is not None:
+            total += ev.profile.end - ev.profile.start
+    return total * 1e-9
+
+
+def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
+           force: bool = False, tile: int = TILE, lanes: int | None = None,
+           outputs=None, region=None, calibrate: bool = True) -> RenderResult:
+    """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
+    ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
+    ``lanes`` (rays per work-item of the march) overrides render.variant's choice
+    (lanes.lanes_for); the tests and the width probe use it.  ``outputs`` names the arrays
+    kept (workload.OUTPUTS; None: all): a depth-only render of any size keeps 8 bytes per
+    pixel on the host (depth and its bracket) and two tiles on the device.  ``region`` =
+    (x0, y0, w, h) renders those pixels of the image alone, bit for bit as the whole
+    render has them (the distributed renderer's unit of one frame).  ``calibrate``: a probe
+    render of the scene predicts the time first (calibrate.py: refuse, warn, size the tiles
+    so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``."""
+    t_start = time.perf_counter()
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
+    dev = device if isinstance(device, cl.Device) else select_device(device)
+    double = scene.render.float == "double"
+    if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
+        raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
+    if scene.camera.fit:   # framing.py: a quick first pass places the camera
+        import warnings
+
+        from pyjulia4d.pipeline.framing import fit_camera
+
+        def first_pass(s: Scene, outs) -> RenderResult:
+            with warnings.catch_warnings():   # the render proper says them, once
+                warnings.simplefilter("ignore")
+                return render(s, device=dev, force=True, lanes=lanes, outputs=outs)
+
+        with warnings.catch_warnings():   # refuse before any pass runs; warn after it
+            warnings.simplefilter("ignore")
+            make_plan(scene, dev, lanes or 1, outputs=outputs, force=force, tile=tile, region=region)
+        scene, _ = fit_camera(scene, first_pass)
+    if lanes is None:
+        lanes = lanes_for(dev, scene.render.variant, double)
+    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
+    prediction = None
+    if calibrate and plan.estimate.seconds > SKIP_BELOW_SECONDS:
+        def run_probe(tiles) -> float:
+            """The probe's kernel seconds, divided by the compute units a tile of the render
+            keeps busy: each probe block is one work-group, run by one of them."""
+            events: list = []
+            probe = TileRunner(dataclasses.replace(plan, tiles=tiles), dev)
+            _run_tiles(probe, tiles, lambda t, got: None, events, _NoProgress())
+            big = max(plan.tiles, key=lambda t: t.n)
+            groups = -(-march_items(big.n, big.aw, plan.lanes) // local_size(probe.march_k, dev))
+            return _seconds(events) / max(1, min(dev.max_compute_units, groups))
+
+        prediction = predict(plan, run_probe)
+        judge(plan, prediction, force)
+        side = tile_side(prediction, tile)
+        if side < tile:
+            plan = plan.retile(side)
+    runner = TileRunner(plan, dev)
+    rx, ry, W, H = plan.region
+    keep = plan.outputs
+    shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W),
+              "normal": (H, W, 3), "position": (H, W, 4), "status": (H, W), "samples": (H, W)}
+    img = {k: np.empty(shapes[k], np.int32 if k in ("status", "samples") else np.float32) for k in keep}
+    counts = {"miss": 0, "hit": 0, "capped": 0}
+    guards: dict[str, int] = {}
+    kernel_events: list = []
+
+    def at(t: Tile) -> tuple[slice, slice]:
+        """The tile's pixels in the arrays (which cover the region)."""
+        rows, cols = t.dst()
+        return slice(rows.start - ry, rows.stop - ry), slice(cols.start - rx, cols.stop - rx)
+
+    def file(t: Tile, got: dict[str, np.ndarray]) -> None:
+        own, dst = t.own(), at(t)
+        st = got["status"][own]
+        for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
+            counts[name] += int(np.count_nonzero(st == code))
+        guard = got["flags"][own]
+        if "normal" in got:  # guard flags (kernels/real.cl): the march's buffer and the normals' w
+            guard = guard | got["normal"][own][..., 3].astype(np.int32)
+        for k, v in count_guards(st, got["depth"][own], guard).items():
+            guards[k] = guards.get(k, 0) + v
+        if "color" in keep:
+            img["color"][dst] = got["rgba"][own][..., :3]
+        if "alpha" in keep:
+            img["alpha"][dst] = got["rgba"][own][..., 3] if "rgba" in got else (st == STATUS_HIT)
+        for k, src in (("depth", "depth"), ("bracket", "bracket"), ("status", "status"),
+                       ("samples", "samples")):
+            if k in keep:
+                img[k][dst] = got[src][own]
+        if "normal" in keep:
+            img["normal"][dst] = got["normal"][own][..., :3]
+        if "position" in keep:
+            img["position"][dst] = got["point"][own]
+
+    S = scene.image.samples
+    aa = S > 1 and bool({"color", "alpha"} & keep)
+    adaptive = aa and scene.image.adaptive
+    IW, IH = scene.image.width, scene.image.height
+    centre_file = file
+    if adaptive:
+        # antialias.py: the centre's colour and alpha over the region and the one-pixel ring
+        # around it (flags of border pixels look outside the region), as the flags take them
+        ex0, ey0 = max(0, rx - 1), max(0, ry - 1)
+        ex1, ey1 = min(IW, rx + W + 1), min(IH, ry + H + 1)
+        centre_c = np.zeros((ey1 - ey0, ex1 - ex0, 3), np.float32) if plan.shades else None
+        centre_a = np.zeros((ey1 - ey0, ex1 - ex0), np.float32)
+
+        def note(t: Tile, got: dict[str, np.ndarray]) -> None:
+            rows, cols = t.dst()
+            dst = slice(rows.start - ey0, rows.stop - ey0), slice(cols.start - ex0, cols.stop - ex0)
+            c, a = _centre_values(got, t.own(), plan.shades)
+            if centre_c is not None:
+                centre_c[dst] = c
+            centre_a[dst] = a
+
+        def centre_file(t: Tile, got: dict[str, np.ndarray]) -> None:
+            file(t, got)
+            note(t, got)
+
+    with _progress(W * H * (1 + S if aa else 1), progress) as bar:
+        # the centre of each pixel: every output (depth, normal, position come from it)
+        _run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
+        if aa:
+            # image.samples more passes of colour and alpha alone, each through its own
+            # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
+            cplan = dataclasses.replace(plan, outputs=frozenset({"color", "alpha", "bracket"}))
+            tiles, flags = cplan.tiles, None
+            if adaptive:
+                # image.adaptive: the samples run over the blocks holding a flagged pixel,
+                # and the flagged pixels alone take their mean (antialias.py)
+                ring = tuple(t for box in antialias.ring(plan.region, IW, IH)
+                             for t in make_tiles(IW, IH, max(box[2], box[3]), plan.halo, box))
+                if ring:
+                    _run_tiles(TileRunner(dataclasses.replace(cplan, tiles=ring), dev), ring, note,
+                               kernel_events, bar)
+                flags = antialias.flag_edges(centre_c, centre_a)[ry - ey0:ry - ey0 + H, rx - ex0:rx - ex0 + W]
+                tiles = antialias.block_tiles(flags, plan.region, IW, IH, plan.halo,
+                                              max(t.n for t in plan.tiles))
+                _set_total(bar, W * H + sum(t.w * t.h for t in ring) + S * sum(t.w * t.h for t in tiles))
+            crunner = TileRunner(dataclasses.replace(cplan, tiles=tiles), dev) if tiles else None
+            acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
+            acc_a = np.zeros((H, W), np.float32)
+
+            def add(t: Tile, got: dict[str, np.ndarray]) -> None:
+                own, dst = t.own(), at(t)
+                if acc_c is not None:
+                    acc_c[dst] += got["rgba"][own][..., :3]
+                acc_a[dst] += got["rgba"][own][..., 3]
+
+            for k in range(S if tiles else 0):
+                _run_tiles(crunner, tiles, add, kernel_events, bar, sample=k, samples=S)
+            if flags is None:
+                if acc_c is not None:
+                    img["color"] = acc_c / S
+                if "alpha" in keep:
+                    img["alpha"] = acc_a / S
+            else:
+                if acc_c is not None:
+                    img["color"] = np.where(flags[..., None], acc_c / S, img["color"])
+                if "alpha" in keep:
+                    img["alpha"] = np.where(flags, acc_a / S, img["alpha"])
+
+    result = RenderResult(
+        color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
+        normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
+        samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
+        device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
+        guards=guards, scene=scene, prediction=prediction)
+    result.seconds = time.perf_counter() - t_start
+    return result
+
+
+def _centre_values(got: dict[str, np.ndarray], own, shaded: bool):
+    """A tile's centre colour (None where the plan does not shade) and alpha over its own
+    pixels, as the render keeps them (``file``): what antialias.flag_edges compares."""
+    if shaded:
+        rgba = got["rgba"][own]
+        return rgba[..., :3], rgba[..., 3]
+    return None, (got["status"][own] == STATUS_HIT).astype(np.float32)
+
+
+def _set_total(bar, total: int) -> None:
+    """The progress bar's total, once the adaptive passes' work is known."""
+    bar.total = total
+    if hasattr(bar, "refresh"):
+        bar.refresh()
+
+
+class _LineProgress:
+    """Progress for a stderr that is not a terminal (a log file, a pipe): whole lines, the
+    first after ``first`` seconds (none for renders shorter than that), then at most one per
+    ``every`` seconds - no carriage returns."""
+
+    def __init__(self, total: int, every: float = 10.0, first: float = 3.0):
+        self.total, self.every, self.n = total, every, 0
+        self.t0 = time.perf_counter()
+        self.last = self.t0 - every + first
+
+    def update(self, k: int) -> None:
+        self.n += k
+        now = time.perf_counter()
+        if now - self.last >= self.every and self.n < self.total:
+            self.last = now
+            eta = (now - self.t0) * (self.total - self.n) / max(self.n, 1)
+            print(f"render: {100 * self.n / self.total:.0f}% of {self.total} pixels, "
+                  f"{now - self.t0:.0f} s, about {eta:.0f} s left", file=sys.stderr, flush=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+
+class _NoProgress:
+    def update(self, k: int) -> None:
+        pass
+
+
+def _progress(total: int, enabled: bool):
+    """A tqdm bar on a terminal, plain lines elsewhere (or nothing when not ``enabled``)."""
+    if enabled and not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
+        return _LineProgress(total)
+    return tqdm(total=total, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
+                disable=not enabled, desc="render")
+
+
+def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample: int = 0,
+               samples: int = 1) -> None:
+    """Every tile through ``runner``, two in flight: tile i + 1's kernels are queued before
+    tile i is filed (``file(tile, arrays)``)."""
+    pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
+    for i, t in enumerate(tiles):
+        slot = i % TileRunner.SLOTS
+        kernels, copies = runner.enqueue(t, slot, sample, samples)
+        if pending is not None:
+            _file_pending(runner, pending, file, kernel_events, bar)
+        pending = (t, slot, kernels, copies)
+    if pending is not None:
+        _file_pending(runner, pending, file, kernel_events, bar)
+
+
+def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -> None:
+    t, slot, kernels, copies = pending
+    cl.wait_for_events([e for e in copies])
+    kernel_events.extend(kernels)
+    file(t, runner.collect(t, slot))
+    bar.update(t.w * t.h)

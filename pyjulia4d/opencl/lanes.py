@@ -1,0 +1,107 @@
+"""How many rays a work-item of the march carries on a device (kernels/real.cl, "Lanes").
+
+CPUs run a packet of rays per work-item in their vector lanes (PoCL does not vectorise a
+data-dependent loop across work-items: the packet march of the default scene runs 5x
+(8 lanes) to 7x (16 lanes) faster than one ray per work-item on the 2-core AVX-512
+development machine); GPUs run one ray per work-item.  Which widths a CPU driver survives
+is found by a probe that cannot take a render down: a child process builds and runs the
+packet march at 16, then 8, then 4 lanes on a tiny scene and compares it with the one-ray
+kernel; the widest that passes is used.  PyPI's PoCL 3.0 killed the process with SIGSEGV on
+float16 kernels, which is why the probe runs apart.  The answer is cached per device and
+driver version in ``~/.cache/pyjulia4d/lanes.json`` (``PYJULIA4D_CACHE`` moves it).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pyopencl as cl
+
+from pyjulia4d.opencl.devices import device_key, device_type
+from pyjulia4d.resources import cache_dir
+
+WIDTHS = (16, 8, 4)
+
+_memo: dict[str, int] = {}
+
+_PROBE = r"""
+import sys, warnings
+warnings.simplefilter("ignore")
+import numpy as np
+from pyjulia4d import Scene
+from pyjulia4d.opencl.devices import select_device
+from pyjulia4d.opencl.executor import render
+spec, lanes = sys.argv[1], int(sys.argv[2])
+dev = select_device(spec)
+s = Scene.default().with_overrides(["image.width=37", "image.height=29", "march.post_steps=6"])
+one = render(s, device=dev, lanes=1)
+pk = render(s, device=dev, lanes=lanes)
+same = np.mean(one.status == pk.status) >= 0.99
+hit = (one.status == 1) & (pk.status == 1)
+close = np.mean(np.abs(one.depth[hit] - pk.depth[hit]) <= one.bracket[hit] + pk.bracket[hit] + 1e-5) >= 0.99
+print("ok" if same and close else "wrong")
+"""
+
+
+def cache_path() -> Path:
+    return cache_dir() / "lanes.json"
+
+
+def device_spec(device: cl.Device) -> str:
+    """The ``P:D`` index of ``device`` (devices.select_device understands it)."""
+    for pi, p in enumerate(cl.get_platforms()):
+        try:
+            for di, d in enumerate(p.get_devices()):
+                if d.int_ptr == device.int_ptr:
+                    return f"{pi}:{di}"
+        except cl.Error:
+            continue
+    raise ValueError("device not found among the platforms")
+
+
+def probe(device: cl.Device, timeout: float = 120.0) -> int:
+    """The widest of WIDTHS whose packet march builds, runs and agrees with one ray per
+    work-item in a child process; 1 if none does."""
+    spec = device_spec(device)
+    for lanes in WIDTHS:
+        try:
+            p = subprocess.run([sys.executable, "-c", _PROBE, spec, str(lanes)], capture_output=True,
+                               text=True, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            continue
+        if p.returncode == 0 and p.stdout.strip().endswith("ok"):
+            return lanes
+    return 1
+
+
+def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
+    """Rays per work-item of the march for ``render.variant`` on ``device``: 1 for
+    "scalar", for double precision (packets are float) and for GPUs under "auto"; for
+    "packet", or a CPU under "auto", the probed width (cached)."""
+    if variant == "scalar" or double:
+        return 1
+    if variant == "auto" and device_type(device) != "CPU":
+        return 1
+    key = device_key(device)
+    if key in _memo:
+        return _memo[key]
+    path = cache_path()
+    try:
+        known = json.loads(path.read_text())
+    except (OSError, ValueError):
+        known = {}
+    if not isinstance(known, dict) or not isinstance(known.get(key), int):
+        known = known if isinstance(known, dict) else {}
+        known[key] = probe(device)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}")
+            tmp.write_text(json.dumps(known, indent=1, sort_keys=True))
+            os.replace(tmp, path)
+        except OSError:
+            pass  # an unwritable cache only costs the probe next time
+    _memo[key] = int(known[key])
+    return _memo[key]

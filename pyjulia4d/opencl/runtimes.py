@@ -1,0 +1,119 @@
+"""OpenCL runtimes that come from PyPI: making Intel's CPU runtime visible to the ICD loader.
+
+pyopencl's wheel loads OpenCL drivers ("ICDs") through its own ocl-icd, which reads the
+``*.icd`` files in ``$OCL_ICD_VENDORS`` (default ``/etc/OpenCL/vendors``) and in its own
+``pyopencl/.libs`` (PyPI's PoCL, from ``pyopencl[pocl]``).  PyPI's PoCL 3.0 (LLVM 14)
+cannot compile for CPUs its LLVM does not know (AMD Zen 5: "unknown target CPU
+'generic'"); Intel's CPU runtime (the ``intel-opencl-rt`` wheel, with
+``intel-cmplr-lib-rt``) runs on any x86-64 CPU with SSE4.2, AMD's included.  Its wheel
+installs an ``.icd`` file naming a path from its build (``/opt/anaconda1anaconda2anaconda3/
+lib/libintelocl.so``) in a folder the loader never reads, so the loader never sees it.
+
+``register()`` (called when pyjulia4d is imported, before any OpenCL call: ocl-icd reads
+its vendors folder at the first one) writes a vendors folder of its own into pyjulia4d's
+cache folder: one ``.icd`` file naming the wheel's real ``libintelocl.so``, plus a copy of
+every system ``.icd`` file (``$OPENCL_VENDOR_PATH`` or ``/etc/OpenCL/vendors``), since
+``OCL_ICD_VENDORS`` replaces that folder; then points ``OCL_ICD_VENDORS`` at it.  Nothing is
+written outside the cache folder.  It does nothing when the user has set ``OCL_ICD_VENDORS``
+(their choice stands), when ``PYJULIA4D_NO_BUNDLED_OPENCL`` is set, when the wheel is not
+installed, or when a system ICD already is Intel's CPU runtime.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.metadata
+import os
+import tempfile
+from pathlib import Path
+
+from pyjulia4d.resources import cache_dir
+
+_SYSTEM_VENDORS = "/etc/OpenCL/vendors"   # ocl-icd's compiled-in default
+_INTEL_LIB = "libintelocl.so"
+
+# What register() did, for `devices` and the closing line: the library it registered
+# ("" if none) and why not, when it did not.
+registered: dict[str, str] = {"library": "", "why_not": "not yet run"}
+
+
+def intel_library() -> Path | None:
+    """The ``libintelocl.so`` of the installed intel-opencl-rt wheel, or None."""
+    try:
+        dist = importlib.metadata.distribution("intel-opencl-rt")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    for f in dist.files or ():
+        if f.name == _INTEL_LIB:
+            path = Path(os.path.normpath(dist.locate_file(f)))
+            if path.is_file():
+                return path
+    return None
+
+
+def system_icds() -> dict[str, str]:
+    """{file name: library line} of the ``.icd`` files the loader would read by default."""
+    folder = Path(os.environ.get("OPENCL_VENDOR_PATH") or _SYSTEM_VENDORS)
+    out = {}
+    try:
+        names = sorted(p.name for p in folder.iterdir() if p.suffix == ".icd")
+    except OSError:
+        return out
+    for name in names:
+        try:
+            line = (folder / name).read_text(errors="replace").strip()
+        except OSError:
+            continue
+        if line:
+            out[name] = line
+    return out
+
+
+def _write_vendors(icds: dict[str, str]) -> Path:
+    """A vendors folder holding ``icds`` under the cache folder, named by its content
+    (so processes share it and a changed system set gets a new one), made atomically."""
+    text = "\n".join(f"{k}\0{v}" for k, v in sorted(icds.items()))
+    folder = cache_dir() / "icd" / hashlib.sha256(text.encode()).hexdigest()[:16]
+    if folder.is_dir():
+        return folder
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=".icd-", dir=folder.parent))
+    try:
+        for name, line in icds.items():
+            (tmp / name).write_text(line + "\n")
+        os.rename(tmp, folder)
+    except OSError:
+        for p in tmp.iterdir():
+            p.unlink()
+        tmp.rmdir()
+        if not folder.is_dir():
+            raise
+    return folder
+
+
+def register() -> None:
+    """Point ocl-icd at a vendors folder that adds the intel-opencl-rt wheel's CPU runtime
+    to the system's drivers (module docstring).  Idempotent; never raises."""
+    if registered["why_not"] != "not yet run":
+        return
+    if os.environ.get("PYJULIA4D_NO_BUNDLED_OPENCL"):
+        registered["why_not"] = "PYJULIA4D_NO_BUNDLED_OPENCL is set"
+        return
+    if os.environ.get("OCL_ICD_VENDORS"):
+        registered["why_not"] = "OCL_ICD_VENDORS is set"
+        return
+    lib = intel_library()
+    if lib is None:
+        registered["why_not"] = "intel-opencl-rt is not installed"
+        return
+    icds = system_icds()
+    if any(Path(v).name.startswith(_INTEL_LIB) for v in icds.values()):
+        registered["why_not"] = "the system has Intel's CPU runtime"
+        return
+    icds["pyjulia4d-intel-cpu.icd"] = str(lib)
+    try:
+        folder = _write_vendors(icds)
+    except OSError as e:
+        registered["why_not"] = f"cannot write the vendors folder ({e.strerror or e})"
+        return
+    os.environ["OCL_ICD_VENDORS"] = str(folder)
+    registered.update(library=str(lib), why_not="")

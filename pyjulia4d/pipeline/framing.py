@@ -1,0 +1,83 @@
+"""camera.fit: frame the set from a quick low-resolution pass, keeping the view direction
+(seed 000 §4 finds near and far the same way: from what a first pass sees).
+
+The pass looks along the scene's view direction at the whole bounding ball (96 x 72 rays,
+depth and position only); the new target is the centroid of the 4D points it hit and the
+new distance the smallest at which every one of them lies within 90 % of the field of
+view, both turned back into the scene's (slice) coordinates.  A pass that hits nothing
+leaves the camera alone.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pyjulia4d.geometry.camera import camera_frame, march_radius, slice_rotation, unit
+from pyjulia4d.scene.model import COORD, Scene, SceneError
+
+PROBE = (96, 72)
+MARGIN = 0.9
+
+
+def to_scene(scene: Scene, x) -> np.ndarray:
+    """World point -> scene (slice) coordinates: the inverse of camera.to_world."""
+    r = slice_rotation(scene.slice.normal)
+    return r.T @ (np.asarray(x, float) - scene.slice.distance * unit(scene.slice.normal))
+
+
+def _within_reach(scene: Scene, eye: np.ndarray, radius: float, what: str) -> None:
+    """A camera at ``eye`` (world coordinates) must be a valid camera.position (every
+    component within +-COORD): else the set is too large to frame, which comes of its
+    bound - the bailout where the pair has no polynomial escape bound (camera.bounding_radius)
+    - not of a key the user set; refused with one line naming fractal.bailout."""
+    pos = to_scene(scene, eye)
+    if np.all(np.abs(pos) <= COORD):
+        return
+    f = scene.fractal
+    raise SceneError("fractal.bailout", f"camera.fit: {what} would need a camera {float(np.max(np.abs(pos))):.3g} "
+                     f"from the origin, beyond camera.position's range [-1e6, 1e6], to frame the "
+                     f"{f.algebra} {f.function} set within its bound of radius {radius:.3g} "
+                     f"(fractal.bailout={f.bailout!r}); lower fractal.bailout, or give camera.position")
+
+
+def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
+    """The scene with camera.position and camera.target refitted (camera.fit then false),
+    and a record of the pass.  ``render_fn(scene, outputs)`` renders (render.render)."""
+    fr = camera_frame(scene)
+    radius = march_radius(scene)
+    tan_v = fr.tan_half_fov
+    tan_h = tan_v * scene.image.width / scene.image.height
+    half = math.atan(min(tan_v, tan_h))
+    d0 = 1.2 * radius / math.sin(half)
+    # the bounding ball is about the world origin (camera.march_radius); the camera sees the
+    # 3D hyperplane through its eye spanned by right, up and forward (the slice, seed 000
+    # §4), so the pass looks at the point of that hyperplane nearest the ball's centre
+    rel = -np.asarray(fr.position, float)
+    centre = np.asarray(fr.position, float) + sum((rel @ v) * v for v in (fr.right, fr.up, fr.forward))
+    eye = centre - d0 * fr.forward
+    _within_reach(scene, eye, radius, "the first pass")
+    w, h = PROBE
+    probe = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, eye)],
+                             "camera.target": [float(v) for v in to_scene(scene, centre)],
+                             "camera.fit": False, "image.width": w, "image.height": h,
+                             "image.samples": 1})
+    res = render_fn(probe, ["position"])
+    pts = res.position[np.all(np.isfinite(res.position), axis=-1)].astype(np.float64)
+    record = {"probe_hits": int(len(pts)), "probe_size": f"{w}x{h}"}
+    if len(pts) == 0:
+        return scene.replace(**{"camera.fit": False}), record
+    c = pts.mean(axis=0)
+    # back onto the viewed hyperplane exactly (the hits are float32)
+    c = centre + sum(((c - centre) @ v) * v for v in (fr.right, fr.up, fr.forward))
+    rel = pts - c
+    x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
+    dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),
+               float(np.max(np.abs(y) / (MARGIN * tan_v) - z)), 1e-6)
+    pos = c - dist * fr.forward
+    _within_reach(scene, pos, radius, "the framed camera")
+    record.update(distance=dist, target=[float(v) for v in c])
+    fitted = scene.replace(**{"camera.position": [float(v) for v in to_scene(scene, pos)],
+                              "camera.target": [float(v) for v in to_scene(scene, c)],
+                              "camera.fit": False})
+    return fitted, record

@@ -1,0 +1,204 @@
+"""A render's plan: the scene resolved once into everything its kernels need.
+
+scene -> plan -> tiles -> image.  ``make_plan`` checks the work and the memory
+(workload.py), resolves the 4D camera frame, the bounding radius, the light, the
+kernel configurations (build.py) and the tile list, and fixes which outputs are kept.
+A plan holds plain values (numbers, numpy vectors, the scene), so it can be pickled
+and a tile of it executed anywhere the same kernels build; render.py executes it.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from pyjulia4d.pipeline import kernel_config, workload
+from pyjulia4d.pipeline.workload import resolve_outputs
+from pyjulia4d.geometry.camera import Frame, camera_frame, light_position, march_radius
+from pyjulia4d.scene.model import Scene, march_method
+
+# Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
+# which difference neighbours): device memory stays under ~20 MB single / ~36 MB double
+# per tile in flight (two are) at any image size, no launch runs for minutes, and the
+# progress bar moves per tile; 262,144 work-items per launch still fill a large GPU.
+TILE = 512
+
+
+@dataclass(frozen=True)
+class Tile:
+    """Pixels [x0, x0 + w) x [y0, y0 + h) of the image, computed over the box
+    (ax0, ay0, aw, ah): the tile with its halo, clipped to the image."""
+    x0: int
+    y0: int
+    w: int
+    h: int
+    ax0: int
+    ay0: int
+    aw: int
+    ah: int
+
+    @property
+    def n(self) -> int:
+        """Items the kernels run over (the box's pixels)."""
+        return self.aw * self.ah
+
+    def own(self) -> tuple[slice, slice]:
+        """The tile's own pixels within its box (rows, columns)."""
+        return (slice(self.y0 - self.ay0, self.y0 - self.ay0 + self.h),
+                slice(self.x0 - self.ax0, self.x0 - self.ax0 + self.w))
+
+    def dst(self) -> tuple[slice, slice]:
+        """The tile's pixels in the image (rows, columns)."""
+        return slice(self.y0, self.y0 + self.h), slice(self.x0, self.x0 + self.w)
+
+
+def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0,
+               region: tuple[int, int, int, int] | None = None) -> tuple[Tile, ...]:
+    """The tiles of the image (or of its ``region`` = (x0, y0, w, h)), row by row, each with
+    its halo box clipped to the image: a pixel's box holds the same neighbours however the
+    image is cut, so a region renders exactly as the same pixels of the whole image."""
+    rx, ry, rw, rh = region if region is not None else (0, 0, width, height)
+    out = []
+    for y0 in range(ry, ry + rh, tile):
+        for x0 in range(rx, rx + rw, tile):
+            w, h = min(tile, rx + rw - x0), min(tile, ry + rh - y0)
+            ax0, ay0 = max(0, x0 - halo), max(0, y0 - halo)
+            ax1, ay1 = min(width, x0 + w + halo), min(height, y0 + h + halo)
+            out.append(Tile(x0, y0, w, h, ax0, ay0, ax1 - ax0, ay1 - ay0))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A scene resolved into what its kernels need (see the module docstring)."""
+    scene: Scene
+    frame: Frame
+    radius: float                 # the march's bounding 4-ball (camera.march_radius)
+    light: np.ndarray             # positioned light in world space, or the eye
+    near: float                   # march.near, or -1 for "the ball's entry"
+    far: float                    # march.far, or -1 for "the ball's exit"
+    double: bool
+    lanes: int                    # rays per work-item of the march (lanes.lanes_for)
+    outputs: frozenset[str]
+    program: kernel_config.KernelConfig   # rays' tests, normals (other than packet Jacobian), shading
+    march_program: kernel_config.KernelConfig
+    tiles: tuple[Tile, ...]
+    estimate: workload.Estimate
+    region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
+
+    @property
+    def normals(self) -> bool:
+        """Whether the normals kernel runs: for the normal output or for shading."""
+        return bool({"normal", "color"} & self.outputs)
+
+    @property
+    def halo(self) -> int:
+        """Pixels around each tile computed for its Z-buffer normals (which difference neighbours)."""
+        return 1 if self.scene.normals.method == "zbuffer" and self.normals else 0
+
+    def retile(self, side: int) -> "Plan":
+        """The same plan in tiles of at most side x side pixels (calibrate.tile_side)."""
+        W, H = self.scene.image.width, self.scene.image.height
+        return dataclasses.replace(self, tiles=make_tiles(W, H, side, self.halo, self.region))
+
+    @property
+    def shades(self) -> bool:
+        return "color" in self.outputs
+
+    @property
+    def light_terms(self) -> bool:
+        """Whether shade/light.cl runs (shadows, ambient occlusion, a colour map): only for shading."""
+        return self.shades and "shade/light" in self.program.pieces
+
+    @property
+    def reflects(self) -> bool:
+        """Whether the mirror bounce runs (shading.reflection > 0; shade/reflect.cl): only for shading."""
+        return self.shades and "shade/reflect" in self.program.pieces
+
+    @property
+    def reflect_program(self) -> kernel_config.KernelConfig:
+        """The march of the reflected rays: this plan's march reading given rays."""
+        if self.lanes > 1:
+            return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
+        return kernel_config.scene_config(self.scene, ray_buffers=True)
+
+    @property
+    def normals_in_march_program(self) -> bool:
+        """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
+        return self.scene.normals.method == "jacobian"
+
+
+def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
+    """``region`` = (x0, y0, w, h) as ints, checked to lie in the image (None: the whole)."""
+    if region is None:
+        return None
+    from pyjulia4d.scene.model import SceneError
+    try:
+        x0, y0, w, h = (int(v) for v in region)
+    except (TypeError, ValueError):
+        raise SceneError("region", f"expected (x0, y0, width, height), got {region!r}") from None
+    W, H = scene.image.width, scene.image.height
+    if not (0 <= x0 and 0 <= y0 and w >= 1 and h >= 1 and x0 + w <= W and y0 + h <= H):
+        raise SceneError("region", f"{(x0, y0, w, h)} is not inside the {W}x{H} image")
+    return x0, y0, w, h
+
+
+def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
+              tile: int = TILE, region=None) -> Plan:
+    """Check and resolve ``scene`` for ``device`` (a pyopencl Device, "CPU" or "GPU") with
+    ``lanes`` rays per work-item of the march, keeping ``outputs`` (None: all), over the
+    image or its ``region`` (x0, y0, w, h) alone."""
+    region = check_region(scene, region)
+    kept = resolve_outputs(outputs)
+    est = workload.check(scene, device, force=force, outputs=kept)
+    m = scene.march
+    lp = light_position(scene)
+    frame = camera_frame(scene)
+    halo = 1 if scene.normals.method == "zbuffer" and {"normal", "color"} & kept else 0
+    return Plan(
+        scene=scene, frame=frame, radius=march_radius(scene),
+        light=lp if lp is not None else frame.position,
+        near=-1.0 if m.near == "auto" else float(m.near),
+        far=-1.0 if m.far == "auto" else float(m.far),
+        double=scene.render.float == "double", lanes=lanes, outputs=kept,
+        program=kernel_config.scene_config(scene),
+        march_program=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
+        tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
+        region=region or (0, 0, scene.image.width, scene.image.height),
+        estimate=est)
+
+
+# ---------------------------------------------------------------- numbers the kernels take
+# (resolved here, once, for both executors: render.py's OpenCL one and the float64 reference)
+
+GRADIENT_STEP_FLOOR = {"single": 1e-5, "double": 1e-8}
+
+
+def gradient_step(scene: Scene) -> float:
+    """The gradient normals' difference step: normals.step, or for "auto" march.epsilon
+    floored at GRADIENT_STEP_FLOOR[render.float]."""
+    if scene.normals.step != "auto":
+        return float(scene.normals.step)
+    return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.render.float])
+
+
+def fog_start(eye, radius: float) -> float:
+    """Where depth cueing starts: the eye's distance to the bounding ball (0 inside it)."""
+    return max(float(np.linalg.norm(eye)) - radius, 0.0)
+
+
+def light_parameters(sc: Scene, radius: float) -> dict:
+    """shade/light.cl's numbers: the shadow rays' step (the march's epsilon, or the fixed
+    scan's spacing across the bounding ball) and cap, the offset of their start off the
+    surface along the normal (two steps, at least 1e-3 of the ball's radius: the hit is
+    the outside end of its bracket, so this starts clear of the surface), the penumbra,
+    occlusion and trap settings."""
+    m, sh = sc.march, sc.shading
+    if march_method(sc) == "de":
+        step, cap = m.epsilon, m.max_steps
+    else:
+        step, cap = 2.0 * radius / m.z_resolution, m.z_resolution + 1
+    return dict(step=step, max_steps=cap, bias=max(2.0 * step, 1e-3 * radius),
+                softness=sh.shadow_softness, ao_distance=sh.ao_distance, ao_strength=sh.ao,
+                trap=tuple(sh.trap) + (0.0,) * (4 - len(sh.trap)))

@@ -1,0 +1,171 @@
+"""What a render returns (RenderResult): the image buffers, what the render cost, the
+guards that fired and the certified depth bracket; made by the OpenCL executor
+(render.render) and by the float64 reference (reference.render) alike, so it needs no
+OpenCL."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from pyjulia4d.pipeline.codes import GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, \
+    STATUS_HIT
+from pyjulia4d.scene.model import Scene
+
+if TYPE_CHECKING:
+    from pyjulia4d.pipeline.calibrate import Prediction
+
+
+@dataclass
+class RenderResult:
+    """Image buffers (row 0 at the top) and what the render cost."""
+    # each array is None where the render was not asked to keep it (render(outputs=...))
+    color: np.ndarray | None     # (H, W, 3) float32, background where missed
+    alpha: np.ndarray | None     # (H, W) float32, 1 on a hit
+    depth: np.ndarray | None     # (H, W) float32, distance along the unit 4D ray; +inf on a miss
+    normal: np.ndarray | None    # (H, W, 3) float32, unit, camera coordinates; 0 on a miss
+    position: np.ndarray | None  # (H, W, 4) float32, the 4D hit point; NaN on a miss
+    status: np.ndarray | None    # (H, W) int32, STATUS_* per pixel
+    samples: np.ndarray | None   # (H, W) int32, set tests (fixed) or estimates (de) before the hit
+    bracket: np.ndarray = None   # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
+    counts: dict = field(default_factory=dict)  # pixels by status: "miss", "hit", "capped" (all tiles)
+    device_name: str = ""
+    seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
+    kernel_seconds: float = 0.0  # the kernels alone
+    guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
+    lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
+    scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
+    prediction: Prediction | None = None   # calibrate.py's, where a probe ran
+
+    def __repr__(self) -> str:
+        h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
+        kept = [k for k in ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket")
+                if getattr(self, k) is not None]
+        return (f"RenderResult({w}x{h}, {100 * self.hit_fraction:.1f}% hit, {self.seconds:.3f} s on "
+                f"{self.device_name or '?'}, {self.lanes} rays per work-item, outputs {', '.join(kept)})")
+
+    def save(self, path, header: dict | None = None) -> None:
+        """Write the image: .png (colour and alpha) or .exr (every output kept), atomically;
+        the header gets this render's report (output.write_image)."""
+        from pyjulia4d.app.output import write_image
+        report, _ = self.report()
+        write_image(path, self, {**report, **(header or {})})
+
+    def _repr_png_(self) -> bytes | None:
+        """The picture, for notebooks (sRGB-encoded 8-bit RGBA)."""
+        if self.color is None:
+            return None
+        import io
+
+        from PIL import Image
+
+        from pyjulia4d.pipeline.colormap import linear_to_srgb
+        rgb = np.rint(linear_to_srgb(np.nan_to_num(self.color)) * 255).astype(np.uint8)
+        a = np.rint(np.clip(np.nan_to_num(self.alpha if self.alpha is not None else 1.0), 0, 1) * 255)
+        rgba = np.dstack([rgb, np.broadcast_to(a, rgb.shape[:2]).astype(np.uint8)])
+        buf = io.BytesIO()
+        Image.fromarray(rgba).save(buf, format="PNG")
+        return buf.getvalue()
+
+    @property
+    def hit_fraction(self) -> float:
+        total = sum(self.counts.values())
+        if total:
+            return self.counts.get("hit", 0) / total
+        return float(np.mean(self.status == STATUS_HIT))
+
+    def bracket_stats(self) -> dict[str, float]:
+        """p50 / p99 / max of the certified bracket width over the pixels hit (march/refine.cl):
+        each hit's surface crossing lies within its width behind its depth.  NaN when
+        nothing was hit."""
+        if self.bracket is None:
+            b = np.empty(0, np.float32)
+        else:  # finite exactly on hits (march/march.cl), so this needs no status array
+            b = self.bracket[np.isfinite(self.bracket)]
+        if b.size == 0:
+            return {"p50": math.nan, "p99": math.nan, "max": math.nan}
+        p50, p99 = np.percentile(b, [50, 99])
+        return {"p50": float(p50), "p99": float(p99), "max": float(b.max())}
+
+    def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
+        """What a render says about itself: (header entries for PNG/EXR, the tail of the
+        closing line).  Capped rays, the guards that fired and the certified depth bracket
+        (p50/p99/max) are never hidden; with ``stated_p99`` (the bound a quality preset
+        states) the line says whether this render's bracket p99 is within it."""
+        b = self.bracket_stats()
+        bracket = " ".join(f"{k}={v:.3g}" for k, v in b.items())
+        header = {
+            "pyjulia4d.device": self.device_name,
+            "pyjulia4d.rays_per_work_item": str(self.lanes),
+            "pyjulia4d.render_seconds": "%.6f" % self.seconds,
+            "pyjulia4d.capped_pixels": str(self.capped),
+            "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in self.guards.items()),
+            "pyjulia4d.depth_bracket": bracket,
+        }
+        fired = [f"{k} {v}" for k, v in self.guards.items() if v]
+        tail = f", {self.capped} capped" if self.capped else ""
+        tail += f"; guards fired: {', '.join(fired)}" if fired else ""
+        if not math.isnan(b["p99"]):
+            tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}"
+            if stated_p99 is not None:
+                ok = b["p99"] <= stated_p99
+                tail += (f" (within the preset's stated {stated_p99:.0e})" if ok else
+                         f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer "
+                         f"preset or more march.post_steps)")
+                header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
+        return header, tail
+
+    @property
+    def capped(self) -> int:
+        """Pixels whose march ran into the step cap (counted, never hidden)."""
+        if self.counts:
+            return int(self.counts.get("capped", 0))
+        return int(np.sum(self.status == STATUS_CAPPED))
+
+    def exr_channels(self) -> dict[str, np.ndarray]:
+        """The EXR channels of the outputs kept: RGBA, Z and Z.bracket, N.XYZ, P.XYZW."""
+        f = np.float32
+        ch = {}
+        if self.color is not None:
+            ch.update({"R": self.color[..., 0], "G": self.color[..., 1], "B": self.color[..., 2]})
+        if self.alpha is not None:
+            ch["A"] = self.alpha
+        if self.depth is not None:
+            ch["Z"] = self.depth
+            if self.bracket is not None:
+                ch["Z.bracket"] = self.bracket
+        if self.normal is not None:
+            for k, name in enumerate("XYZ"):
+                ch[f"N.{name}"] = self.normal[..., k]
+        if self.position is not None:
+            for k, name in enumerate("XYZW"):
+                ch[f"P.{name}"] = self.position[..., k]
+        return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
+
+
+def count_guards(status, depth, guard) -> dict[str, int]:
+    """Pixels each numerical guard fired on (nothing clamped without being counted).
+    ``guard`` holds the flags (kernels/codes.cl) of the march kernel's flags buffer ORed
+    with those the normals kernels write into the normal's w."""
+    status, guard = (np.asarray(a).ravel() for a in (status, guard))
+    hit = status == STATUS_HIT
+    guard = guard.astype(np.int32, copy=False)
+
+    def fired(flag, on=None):
+        m = (guard & flag) != 0
+        return int(np.count_nonzero(m if on is None else m & on))
+
+    return {
+        # de step below the spacing of t raised to one ulp (march/de.cl): effective epsilon = ulp(t)
+        "ulp_step": fired(GUARD_ULP_STEP),
+        # normal replaced by the view axis: degenerate or non-finite gradient (normals_*.cl)
+        "normal_fallback": fired(GUARD_NORMAL_FALLBACK, hit),
+        # Jacobian iteration stopped before q_n underflowed to 0 (normals/jacobian.cl)
+        "jacobian_tiny": fired(GUARD_JACOBIAN_TINY, hit),
+        # de: within epsilon of the set by the estimate, yet no point inside: a miss (march/de.cl)
+        "shell_miss": fired(GUARD_SHELL_MISS),
+        # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
+        "eye_hit": int(np.count_nonzero(hit & (np.asarray(depth).ravel() == 0))),
+    }

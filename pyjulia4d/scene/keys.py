@@ -1,0 +1,113 @@
+"""Every scene key with its default, valid range and a one-line meaning: ``pyjulia4d keys``
+(as Mandelbulber2's ``-L`` lists its parameters).  The defaults come from the scene
+dataclasses and the ranges from the checkers (scene._CHECKS via scene.valid_range), so the
+list cannot drift from what is accepted; docs/scene-keys.md holds the long form, and
+tests/test_scene.py holds both to the checkers."""
+from __future__ import annotations
+
+from pyjulia4d.scene.model import Scene, key_names, valid_range
+
+# One line per key: what it is, in the words of docs/scene-keys.md, shortened.
+MEANINGS = {
+    "fractal.algebra": "the 4D algebra: quaternions, hypercomplex numbers, CQuats or the naive commutative rules",
+    "fractal.function": "f in q <- f(q) + c (POV-Ray's names); all 18 for hypercomplex, sqr and cube elsewhere",
+    "fractal.c": "the Julia constant c",
+    "fractal.max_iter": "iterations: a point is inside when |q_n| <= bailout for n = 0..max_iter",
+    "fractal.bailout": "escape radius (POV-Ray's 4); single precision refuses above ~9.6e8",
+    "fractal.exponent": "pwr's complex exponent x + iy: f(q) = q^(x + iy)",
+    "fractal.kind": "julia, its mandelbrot set, a julia_stack of complex Julia sets, or the cubic_locus",
+    "fractal.theta": "quaternion maps: conjugate by the rotation e^(i theta) of the complex plane, degrees",
+    "fractal.c_from": "julia_stack: c (re, im) at the stack's end u = -1",
+    "fractal.c_to": "julia_stack: c (re, im) at the stack's end u = +1",
+    "fractal.component": "cubic_locus: C+ (orbit of +a bounded) or C- (orbit of -a)",
+    "fractal.locus_radius": "cubic_locus: radius of the 4-ball the unbounded locus is drawn in",
+    "camera.position": "the eye; 3 numbers get w = 0",
+    "camera.target": "the point looked at",
+    "camera.up": "up direction (made orthogonal to the view and limbo); any length",
+    "camera.limbo": "the 4th frame vector: the image plane is perpendicular to it",
+    "camera.fov": "full vertical field of view, degrees",
+    "camera.fit": "frame the set from a quick 96x72 first pass, keeping the view direction "
+                  "(default true when no camera.position is given)",
+    "slice.normal": "normal of the 3D hyperplane the camera looks into (POV-Ray's slice)",
+    "slice.distance": "the hyperplane's distance from the origin",
+    "march.quality": "draft, normal or final: measured march presets; custom: the march keys as given",
+    "march.method": "fixed (z-resolution scan), de (distance estimate) or auto (de where it exists)",
+    "march.z_resolution": "fixed: samples between near and far",
+    "march.post_steps": "refinement steps of the certified depth bracket after a hit",
+    "march.refine": "how post-steps refine the bracket: itp (interpolate-truncate-project) or bisect",
+    "march.epsilon": "de: the minimum step",
+    "march.max_steps": "de: cap on estimates per ray (capped rays are counted)",
+    "march.near": "start of the march along each ray; auto = entry into the bounding ball",
+    "march.far": "end of the march; auto = exit from the bounding ball",
+    "normals.method": "jacobian (analytic), gradient (6-point difference of the estimate) or zbuffer",
+    "normals.step": "gradient: difference step; auto = march.epsilon, at least 1e-5 (1e-8 double)",
+    "shading.color": "surface colour, linear light",
+    "shading.background": "colour where rays miss (alpha 0 there)",
+    "shading.ambient": "ambient weight",
+    "shading.diffuse": "Lambert weight",
+    "shading.specular": "Blinn-Phong weight; 0 compiles the term out",
+    "shading.shininess": "Blinn-Phong exponent",
+    "shading.light": "\"eye\" (a light at the camera) or the key light's position",
+    "shading.light_color": "key light colour",
+    "shading.shadow": "shadows of the set on itself: none, hard or soft",
+    "shading.shadow_softness": "penumbra k in min(k d / t): larger is sharper",
+    "shading.ao": "ambient occlusion strength; 0 compiles it out",
+    "shading.ao_distance": "how far along the normal occlusion is sampled",
+    "shading.coloring": "base colour: flat, or the colour map by iteration, orbit trap or the w coordinate",
+    "shading.colormap": "the matplotlib colour map for coloring other than flat",
+    "shading.trap": "the orbit trap's point (coloring = trap)",
+    "shading.fog": "depth cueing: fade toward the background by exp(-fog t); 0 compiles it out",
+    "shading.sky": "colour of the ambient light",
+    "shading.lights": "up to 3 more point or distant lights, each with its own shadows",
+    "shading.reflection": "share of one mirror bounce in the colour; 0 compiles it out",
+    "image.width": "pixels",
+    "image.height": "pixels",
+    "image.samples": "rays per pixel (stratified); colour and alpha are their mean",
+    "image.adaptive": "with samples > 1: supersample only pixels on an edge",
+    "clip.planes": "cut-away half-spaces n . p <= offset that cut the set open",
+    "render.float": "single, or double (float64 kernels, devices with cl_khr_fp64)",
+    "render.variant": "rays per work-item of the march: scalar (one), packet (16, 8 or 4) or auto",
+}
+
+
+def _value_text(v) -> str:
+    """A default as a scene file writes it: 0.15, "eye", [1.8, 1.6, -2.2, 0], [], false."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, float):
+        if v != 0 and not 1e-2 <= abs(v) < 1e3:
+            mantissa, exponent = f"{v:.14e}".split("e")
+            return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+        return f"{v:.1f}" if v == int(v) else f"{v:g}"
+    if isinstance(v, (tuple, list)):   # components as short as they go: [-0.2, 0.8, 0, 0]
+        return "[" + ", ".join(f"{x:g}" if isinstance(x, float) else _value_text(x) for x in v) + "]"
+    return str(v)
+
+
+def default_text(key: str) -> str:
+    """The default of ``key`` (section.name) as docs/scene-keys.md writes it;
+    camera.fit's depends on whether camera.position is given."""
+    if key == "camera.fit":
+        return "true when camera.position is not given, else false"
+    section, _, name = key.partition(".")
+    part = getattr(Scene.default(), section)
+    return _value_text(getattr(part, name))
+
+
+def rows() -> list[tuple[str, str, str, str]]:
+    """(key, default, valid range, meaning) for every key, in scene order."""
+    return [(k, default_text(k), valid_range(k), MEANINGS[k]) for k in key_names()]
+
+
+def describe_keys(section: str | None = None) -> str:
+    """The text ``pyjulia4d keys [SECTION]`` prints: one block per key, key and default on the
+    first line, the valid range and the meaning indented below."""
+    out = []
+    for key, default, valid, meaning in rows():
+        if section is not None and key.partition(".")[0] != section:
+            continue
+        out.append(f"{key} = {default}\n    range: {valid}\n    {meaning}")
+    return "\n".join(out)
+
