@@ -16,7 +16,8 @@ from pyjulia4d.opencl import runtimes
 runtimes.register()  # before any OpenCL call: Intel's CPU runtime from PyPI (opencl/runtimes.py)
 
 from pyjulia4d.pipeline.result import RenderResult  # noqa: E402
-from pyjulia4d.scene.model import Scene, SceneError  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
+from pyjulia4d.scene.checks import SceneError
 
 __version__ = "0.1.0"
 __all__ = ["Scene", "SceneError", "RenderResult", "render", "__version__"]

@@ -11,7 +11,9 @@ from pyjulia4d import reference as ref
 from pyjulia4d.reference.algebra import commutative as cm, cquat as cq, hypercomplex as hc, quaternion as qa
 from pyjulia4d.reference.formula import Formula, complex_value
 from pyjulia4d.opencl.executor import STATUS_HIT, render
-from pyjulia4d.scene.model import FUNCTIONS, FUNCTIONS_OF, Scene, SceneError
+from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 PAIRS = [(a, f) for a in FUNCTIONS_OF for f in FUNCTIONS_OF[a]]
 E = np.eye(4)

@@ -52,7 +52,7 @@ def test_supersampling_is_deterministic_and_keeps_the_centres():
 
 from pyjulia4d.pipeline import antialias  # noqa: E402
 from pyjulia4d.pipeline.colormap import srgb_to_linear  # noqa: E402
-from pyjulia4d.scene.model import SceneError  # noqa: E402
+from pyjulia4d.scene.checks import SceneError  # noqa: E402
 
 HYPER = ["fractal.algebra=hypercomplex", "fractal.c=-0.123,0,-0.745,0", "camera.position=1.7,5.7,-5.7",
          "camera.fov=15"]

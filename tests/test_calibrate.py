@@ -11,7 +11,8 @@ import pytest
 from harness import device
 from pyjulia4d.pipeline import calibrate, workload
 from pyjulia4d.opencl.executor import render
-from pyjulia4d.scene.model import Scene, SceneError
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 # one scene or two of each march method and of the costly options, 200-600 ms each here
 SCENES = {

@@ -26,11 +26,11 @@ import pytest
 
 import pyjulia4d
 from pyjulia4d.app import cli
-from pyjulia4d.scene.model import _CHECKS
+from pyjulia4d.scene.model import CHECKS
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 SEED = 20261125
-KEYS = [f"{s}.{k}" for s, table in _CHECKS.items() for k in table]
+KEYS = [f"{s}.{k}" for s, table in CHECKS.items() for k in table]
 OPTIONS = ["--output", "--width", "--height", "--set", "--device", "--force", "--help"]
 
 
@@ -44,7 +44,7 @@ class Case:
 
 def _check_of(key: str):
     section, _, name = key.partition(".")
-    return _CHECKS[section][name]
+    return CHECKS[section][name]
 
 
 # ------------------------------------------------------------------ value generators
@@ -70,7 +70,7 @@ def _fmt(x) -> str:
 
 
 def _out_of_range(rng: random.Random, valid, integer: bool) -> list:
-    """Numbers just and far outside the range ``valid`` (a scene._Range)."""
+    """Numbers just and far outside the range ``valid`` (a scene.checks.Range)."""
     lo, hi, lo_open = valid.lo, valid.hi, valid.lo_open
     if integer:
         return [lo - 1, lo - rng.randint(2, 10**6), hi + 1, hi + rng.randint(2, 10**12), 10**rng.randint(19, 60),
@@ -96,28 +96,28 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
     vals: list[str] = []
     garbage = [g for g in GARBAGE if g.strip() != word]
     vals += rng.sample(garbage, 3) + [_unicode(rng, rng.randint(1, 12))]
-    if kind == "_Choice":
+    if kind == "Choice":
         opts = check.options
         vals += [rng.choice(opts).upper(), rng.choice(opts)[:-1], rng.choice(opts) + "x", "1", "0"]
         return [v for v in vals if v.strip() not in opts]
-    if kind == "_Lights":   # "" and "[]" are valid (no lights)
+    if kind == "Lights":   # "" and "[]" are valid (no lights)
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["position", "position 1,2", "direction 0,0,0", "position 1,2,3 direction 1,0,0",
                        "color 1,1,1", "position 1,2,3 intensity -1", "position 1,2,3 intensity nan",
                        "position 1,2,3 color 1,1", "pos 1,2,3", ";".join(["position 1,2,3"] * 4),
                        "position 1,2,3;x"]
-    if kind == "_Planes":   # "" and "[]" are valid (no planes)
+    if kind == "Planes":   # "" and "[]" are valid (no planes)
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["1,0,0", "0,0,0,1", "1,0,0,nan", "1,0,0,2e6", ";".join(["1,0,0,0"] * 5), "1,0,0,0;x"]
     if word:
         vals += [word.upper(), word + "s", f"[{word}]"]
-    if inner_kind == "_Real":
+    if inner_kind == "Real":
         vals += [rng.choice(NONFINITE)] + [_fmt(v) for v in rng.sample(_out_of_range(rng, inner.range, False), 3)]
         vals += ["1,2", "[]"]
-    elif inner_kind == "_Integer":
+    elif inner_kind == "Integer":
         vals += [rng.choice(NONFINITE), "2.5", "1e3", "7.0", "true"]
         vals += [_fmt(v) for v in rng.sample(_out_of_range(rng, inner.range, True), 3)]
-    elif inner_kind == "_Vector":
+    elif inner_kind == "Vector":
         n = max(inner.lengths)
         ok = inner.element.range
         mid = _fmt((max(ok.lo, -1.0) + min(ok.hi, 1.0)) / 2 + 0.25)
@@ -175,23 +175,23 @@ def _toml_wrong_types(key: str) -> list[str]:
     kind = type(getattr(check, "inner", check)).__name__
     vals = ['"x"', "true", "1979-05-27T07:32:00Z", "1979-05-27", "07:32:00", "{ a = 1 }",
             "[[1, 2], [3]]", '"1.0"', "[]"]
-    if kind in ("_Real", "_Integer"):
+    if kind in ("Real", "Integer"):
         vals += ["nan", "+inf", "-inf", "[1.0]"]
-    if kind == "_Integer":
+    if kind == "Integer":
         vals += ["12.0", "1e3", str(2**63), "-" + str(2**63)]
-    if kind == "_Vector":
+    if kind == "Vector":
         vals += ["1.0", "[nan, 0, 0, 0]", "[0, inf, 0]", "[true, 1, 1]", '["0", 0, 0, 0]']
-    if kind == "_Choice":
+    if kind == "Choice":
         vals = [v for v in vals if v != "[]"] + ['"FIXED"', '""', '" de "']
-    if kind == "_Lights":   # [] is valid (no lights)
+    if kind == "Lights":   # [] is valid (no lights)
         vals = [v for v in vals if v != "[]"] + ["[{ color = [1, 1, 1] }]", "[[1, 2, 3]]",
                                                 "[{ position = [1, 2, 3], direction = [1, 0, 0] }]",
                                                 "[{ position = [1, 2, 3], x = 1 }]",
                                                 "[{ direction = [0, 0, 0] }]", "[{ position = [nan, 0, 0] }]"]
-    if kind == "_Planes":   # [] is valid (no planes)
+    if kind == "Planes":   # [] is valid (no planes)
         vals = [v for v in vals if v != "[]"] + ["[[0, 0, 0, 1]]", "[1, 2, 3, 4]", "[[1, 0, 0, nan]]",
                                                 "[[1, 0, 0, true]]"]
-    if kind == "_Bool":     # true is a boolean key's own type
+    if kind == "Bool":     # true is a boolean key's own type
         vals = [v for v in vals if v != "true"] + ["1", '"yes"']
     return vals
 
@@ -201,11 +201,11 @@ def _toml_out_of_range(rng: random.Random, key: str) -> list[str]:
     check = _check_of(key)
     inner = getattr(check, "inner", check)
     kind = type(inner).__name__
-    if kind == "_Real":
+    if kind == "Real":
         return [_toml_float(v) for v in rng.sample(_out_of_range(rng, inner.range, False), 2)]
-    if kind == "_Integer":
+    if kind == "Integer":
         return [str(v) for v in rng.sample(_out_of_range(rng, inner.range, True), 2)]
-    if kind == "_Vector":
+    if kind == "Vector":
         ok = inner.element.range
         n = max(inner.lengths)
         out = []

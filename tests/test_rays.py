@@ -5,8 +5,10 @@ import pytest
 from harness import Runner
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import camera_frame, cross4, slice_rotation
-from pyjulia4d.scene.model import Scene, SceneError
+from pyjulia4d.geometry.camera import camera_frame, slice_rotation
+from pyjulia4d.geometry.vec4 import cross4
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 
 @pytest.mark.parametrize("over", [[], ["camera.position=-2,1,5,8", "camera.fov=60"],

@@ -111,7 +111,7 @@ def test_tiles_give_the_same_image(normals):
 
 def test_image_too_large_for_memory_refused_before_rendering():
     from pyjulia4d.pipeline import workload
-    from pyjulia4d.scene.model import SceneError
+    from pyjulia4d.scene.checks import SceneError
 
     for w, h in [(1_000_000_000, 1), (100_000, 100_000), (46341, 46341), (65536, 65536)]:
         s = Scene.default().with_overrides([f"image.width={w}", f"image.height={h}"])
@@ -177,7 +177,7 @@ def test_cut_away_planes_match_reference(over):
 
 
 def test_clip_planes_refused():
-    from pyjulia4d.scene.model import SceneError
+    from pyjulia4d.scene.checks import SceneError
     for bad, msg in [("0,0,0,1", "plane 0: zero normal"), ("1,2,3", "plane 0: expected"),
                      ("1,0,0,0;0,1,0,0;0,0,1,0;1,1,0,0;1,0,1,0", "at most 4 planes"),
                      ("1,0,0,nan", "plane 0: element 3: not a finite number")]:

@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyjulia4d.scene.model import _CHECKS, _SECTIONS, Scene, SceneError, valid_range, march_method
+from pyjulia4d.scene.model import CHECKS, SECTIONS, Scene, valid_range
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.fractal.registry import march_method
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -35,8 +37,8 @@ def test_defaults() -> None:
 
 
 def test_checks_cover_every_field() -> None:
-    for name, cls in _SECTIONS.items():
-        assert [f.name for f in dataclasses.fields(cls)] == list(_CHECKS[name])
+    for name, cls in SECTIONS.items():
+        assert [f.name for f in dataclasses.fields(cls)] == list(CHECKS[name])
 
 
 def test_frozen() -> None:
@@ -291,7 +293,7 @@ def test_readme_valid_ranges_match_the_checkers() -> None:
     from pyjulia4d.scene.keys import default_text
 
     rows = _readme_key_rows()
-    keys = [f"{s}.{k}" for s, table in _CHECKS.items() for k in table]
+    keys = [f"{s}.{k}" for s, table in CHECKS.items() for k in table]
     assert sorted(rows) == sorted(keys)
     for key in keys:
         assert rows[key][1] == valid_range(key), key
@@ -303,7 +305,7 @@ def test_readme_valid_ranges_match_the_checkers() -> None:
 def _edges():
     """(dotted key, its lowest and highest valid value, a value just outside each) for
     every numeric key; vectors get every component at the edge."""
-    for section, table in _CHECKS.items():
+    for section, table in CHECKS.items():
         for key, check in table.items():
             inner = getattr(check, "inner", check)  # "auto" or a number
             element = getattr(inner, "element", None)  # a vector's components

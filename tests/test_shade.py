@@ -149,7 +149,7 @@ def test_shadows_compiled_only_where_they_show():
     (["shading.ao=2"], "shading.ao"),
 ])
 def test_light_settings_refused(over, key):
-    from pyjulia4d.scene.model import SceneError
+    from pyjulia4d.scene.checks import SceneError
     with pytest.raises(SceneError) as e:
         Scene.default().with_overrides(over)
     assert str(e.value).startswith(key + ": ")
@@ -228,7 +228,7 @@ def test_reflect_kernels_match_reference(light, fl):
 
 def test_reflection_shows_in_the_picture_and_zbuffer_is_refused():
     from pyjulia4d.opencl.executor import render
-    from pyjulia4d.scene.model import SceneError
+    from pyjulia4d.scene.checks import SceneError
     base = Scene.default().with_overrides(["image.width=48", "image.height=36", "shading.background=0,0,1"])
     plain, mirror = render(base), render(base.with_overrides(["shading.reflection=0.5"]))
     np.testing.assert_array_equal(plain.depth, mirror.depth)

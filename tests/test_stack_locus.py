@@ -13,7 +13,9 @@ from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import march_radius
 from pyjulia4d.opencl.executor import STATUS_HIT, render
-from pyjulia4d.scene.model import Scene, SceneError, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.fractal.registry import march_method
 
 C0, C1 = -1.0 + 0.0j, -0.1 + 0.75j      # the defaults of fractal.c_from, fractal.c_to
 
@@ -322,7 +324,7 @@ def test_locus_packets_give_the_same_pixels(lanes):
 def test_locus_escape_radius_is_one(radius):
     # beyond R every map of the ball grows |z| (the worst case |a| = |b| = radius, z, a^2 and b
     # lined up against z); below it one such map does not
-    from pyjulia4d.scene.model import locus_escape_radius
+    from pyjulia4d.fractal.registry import locus_escape_radius
     R = locus_escape_radius(radius)
     g = lambda r: r ** 3 - 3 * radius ** 2 * r - radius
     assert g(R * (1 + 1e-12)) > R * (1 + 1e-12) and g(R * 0.999) < R * 0.999

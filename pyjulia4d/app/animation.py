@@ -25,7 +25,7 @@ from typing import Any, Callable, Iterable, Sequence
 
 from pyjulia4d.scene.keyframes import Animation, parse_frames
 from pyjulia4d.app.output import _NAME_MAX, OutputError, _atomic, _limit, _shown, _temp_affixes, check_output_path, read_header
-from pyjulia4d.scene.model import SceneError
+from pyjulia4d.scene.checks import SceneError
 
 HEADER_SCENE = "pyjulia4d.scene"
 HEADER_FRAME = "pyjulia4d.frame"

@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import Any, Iterator, NoReturn, Sequence
 
 from pyjulia4d.app.output import check_output_path, write_image
-from pyjulia4d.scene.model import Scene, SceneError, override_key
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.text import override_key
 
 PROG = "pyjulia4d"
 
@@ -140,7 +142,7 @@ def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
     (``pyjulia4d.scene``: the camera camera.fit chose included, so the same picture comes
     back), with overrides applied.  One SceneError naming the file if there is none."""
     from pyjulia4d.app.output import read_header
-    from pyjulia4d.scene.model import MAX_SCENE_BYTES, scene_table_from_text
+    from pyjulia4d.scene.text import MAX_SCENE_BYTES, scene_table_from_text
 
     shown = path if path.isprintable() else repr(path)
     if not Path(path).is_file():

@@ -27,7 +27,8 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
-from pyjulia4d.scene.model import Scene, SceneError
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 
 class ClusterError(ValueError):

@@ -11,29 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyjulia4d.scene.model import MANDELBROT_START, Scene, SceneError, escape_degree, march_method
-
-
-def cross4(a, b, c) -> np.ndarray:
-    """The 4D cross product of seed 000_1dc675fe64448cc1.txt §4: a vector
-    perpendicular to a, b and c (the signed cofactors of the 3x4 matrix [a; b; c])."""
-    a1, a2, a3, a4 = a
-    b1, b2, b3, b4 = b
-    c1, c2, c3, c4 = c
-    return np.array([
-        a2 * (b4 * c3 - b3 * c4) + b2 * (a3 * c4 - a4 * c3) + c2 * (a4 * b3 - a3 * b4),
-        a1 * (b3 * c4 - b4 * c3) + b1 * (a4 * c3 - a3 * c4) + c1 * (a3 * b4 - a4 * b3),
-        a1 * (b4 * c2 - b2 * c4) + b1 * (a2 * c4 - a4 * c2) + c1 * (a4 * b2 - a2 * b4),
-        a1 * (b2 * c3 - b3 * c2) + b1 * (a3 * c2 - a2 * c3) + c1 * (a2 * b3 - a3 * b2),
-    ])
-
-
-def unit(v) -> np.ndarray:
-    """v / |v| for a finite, non-zero v, divided by its largest component first: |v|
-    neither overflows (1e300 components) nor underflows (1e-300 ones) on the way."""
-    v = np.asarray(v, float)
-    v = v / np.max(np.abs(v))
-    return v / np.linalg.norm(v)
+from pyjulia4d.geometry.vec4 import Degenerate, cross4, orthonormalise, unit
+from pyjulia4d.fractal.registry import MANDELBROT_START, escape_degree, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 
 def slice_rotation(normal) -> np.ndarray:
@@ -65,13 +46,6 @@ class Frame:
     tan_half_fov: float
 
 
-def _unit(v: np.ndarray, key: str, what: str) -> np.ndarray:
-    n = float(np.linalg.norm(v))
-    if not n > 1e-9 or not math.isfinite(n):
-        raise SceneError(key, what)
-    return unit(v)
-
-
 def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
     """Camera/light coordinates -> world: R p (+ distance n/|n| for positions)."""
     r = slice_rotation(scene.slice.normal)
@@ -88,13 +62,16 @@ def camera_frame(scene: Scene) -> Frame:
     fourth dimension; any other choice makes the rays travel in w."""
     cam = scene.camera
     pos = to_world(scene, cam.position)
-    fwd = _unit(to_world(scene, cam.target) - pos, "camera.target", "equals camera.position")
-    # directions are normalised before use: any non-zero length is valid (scene.py)
-    limbo = to_world(scene, unit(cam.limbo), direction=True)
-    limbo = _unit(limbo - (limbo @ fwd) * fwd, "camera.limbo", "parallel to the view direction")
-    up = to_world(scene, unit(cam.up), direction=True)
-    up = up - (up @ fwd) * fwd - (up @ limbo) * limbo
-    up = _unit(up, "camera.up", "parallel to the view direction or to camera.limbo")
+    # directions are normalised before use: any non-zero length is valid (scene/checks.py)
+    try:
+        fwd, limbo, up = orthonormalise(to_world(scene, cam.target) - pos,
+                                        to_world(scene, unit(cam.limbo), direction=True),
+                                        to_world(scene, unit(cam.up), direction=True))
+    except Degenerate as e:
+        key, what = {"forward": ("camera.target", "equals camera.position"),
+                     "limbo": ("camera.limbo", "parallel to the view direction"),
+                     "up": ("camera.up", "parallel to the view direction or to camera.limbo")}[e.which]
+        raise SceneError(key, what) from None
     right = cross4(fwd, up, limbo)
     right /= np.linalg.norm(right)
     return Frame(pos, fwd, right, up, math.tan(math.radians(cam.fov) / 2.0))
@@ -194,7 +171,7 @@ def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2, sta
 
 def stack_radius(scene: Scene) -> float:
     """Radius of a 4-ball about the origin that holds a Julia set stack (kernels/kind/
-    julia_stack.cl) in the hyperplane w = w0 the view keeps to (scene._check_stack): there
+    julia_stack.cl) in the hyperplane w = w0 the view keeps to (scene/rules.check_stack): there
     |z| <= bounding_radius(max |c(u)|) (|c(u)| <= the larger end point's: the segment is
     convex), |u| <= 1 and w = w0, widened by 2^-20 so that a scan starts outside."""
     f, cam, sl = scene.fractal, scene.camera, scene.slice

@@ -66,8 +66,10 @@ from typing import Any
 
 import numpy as np
 
-from pyjulia4d.scene.model import FUNCTIONS, Scene, SceneError
-from pyjulia4d.scene.model import _toml_value  # one TOML emitter for scenes and imports
+from pyjulia4d.fractal.registry import FUNCTIONS
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.text import toml_value  # one TOML emitter for scenes and imports
 
 MAX_POV_BYTES = 8 << 20       # larger files are refused unread
 POV_EPSILON = 1e-10           # POV-Ray's EPSILON (slice and camera checks)
@@ -1065,7 +1067,7 @@ def convert(r: _Reader, width: int, height: int) -> tuple[dict, dict, list[str],
     # which way pyjulia4d's right = cross4(forward, up, limbo) points, in world coordinates
     # (limbo +w in camera coordinates is R e_w = n there), against POV-Ray's right lifted
     # onto the slice: a negative slice normal's w, or a left-handed right vector, flips it
-    from pyjulia4d.geometry.camera import cross4
+    from pyjulia4d.geometry.vec4 import cross4
 
     f_w, u_w, r_w = (smap.lift(inv.direction(v), False) for v in (cam.direction, cam.up, cam.right))
     handed = float(cross4(f_w, u_w, smap.n) @ r_w)
@@ -1159,7 +1161,7 @@ def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
     for section, table in data.items():
         out.append(f"\n[{section}]")
         for k, v in table.items():
-            line = f"{k} = {_toml_value(v)}"
+            line = f"{k} = {toml_value(v)}"
             note = notes.get(f"{section}.{k}")
             out.append(f"{line}  # {note}" if note else line)
     return "\n".join(out) + "\n"

@@ -27,7 +27,8 @@ from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, fog_start, gradient_step,
                    make_tiles)  # (TILE, make_tiles: API)
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.pipeline.result import RenderResult, count_guards
-from pyjulia4d.scene.model import Scene, SceneError, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
 
 
 _queues: dict[int, tuple[cl.Context, cl.CommandQueue]] = {}

@@ -13,8 +13,10 @@ import math
 
 import numpy as np
 
-from pyjulia4d.geometry.camera import camera_frame, march_radius, slice_rotation, unit
-from pyjulia4d.scene.model import COORD, Scene, SceneError
+from pyjulia4d.geometry.camera import camera_frame, march_radius, slice_rotation
+from pyjulia4d.geometry.vec4 import unit
+from pyjulia4d.scene.checks import COORD, SceneError
+from pyjulia4d.scene.model import Scene
 
 PROBE = (96, 72)
 MARGIN = 0.9

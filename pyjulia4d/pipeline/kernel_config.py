@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import math
 
 from pyjulia4d.resources import kernel_dir
-from pyjulia4d.scene.model import MANDELBROT_START, Scene, march_method
+from pyjulia4d.fractal.registry import MANDELBROT_START, march_method
+from pyjulia4d.scene.model import Scene
 
 
 @dataclass(frozen=True)

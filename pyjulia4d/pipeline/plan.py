@@ -16,7 +16,8 @@ import numpy as np
 from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, light_position, march_radius
-from pyjulia4d.scene.model import Scene, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.fractal.registry import march_method
 
 # Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
 # which difference neighbours): device memory stays under ~20 MB single / ~36 MB double
@@ -133,7 +134,7 @@ def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
     """``region`` = (x0, y0, w, h) as ints, checked to lie in the image (None: the whole)."""
     if region is None:
         return None
-    from pyjulia4d.scene.model import SceneError
+    from pyjulia4d.scene.checks import SceneError
     try:
         x0, y0, w, h = (int(v) for v in region)
     except (TypeError, ValueError):

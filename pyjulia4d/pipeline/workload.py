@@ -25,7 +25,9 @@ import warnings
 from dataclasses import dataclass
 
 from pyjulia4d.geometry.camera import camera_frame, march_radius
-from pyjulia4d.scene.model import Scene, SceneError, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.fractal.registry import march_method
 
 # Set-test throughput, iterations of f per second, measured by benchmarks/throughput.py
 # (benchmarks/results/throughput.md, commit 19393ea) inside the march of the default scene on

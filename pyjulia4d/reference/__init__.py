@@ -19,7 +19,8 @@ from pyjulia4d.pipeline.codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK
                      STATUS_HIT, STATUS_MISS)
 from pyjulia4d.pipeline.plan import fog_start, gradient_step, light_parameters
 from pyjulia4d.pipeline.result import RenderResult, count_guards
-from pyjulia4d.scene.model import Scene, march_method
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.fractal.registry import march_method
 
 REAL_MIN = np.finfo(np.float64).tiny
 from pyjulia4d.pipeline.codes import FLAG_CUT_FACE  # noqa: E402  (kernels/codes.cl)

@@ -35,8 +35,10 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-from pyjulia4d.scene.model import (Scene, SceneError, _CHECKS, _Integer, _OrWord, _Real, _Vector, _show, _show_key,
-                    override_key, read_scene_table)
+from pyjulia4d.geometry.vec4 import Degenerate, orthonormalise, unit_or_none
+from pyjulia4d.scene.model import CHECKS, Scene
+from pyjulia4d.scene.checks import SceneError, Integer, OrWord, Real, Vector, show, show_key
+from pyjulia4d.scene.text import override_key, read_scene_table
 
 
 INTERPOLATIONS = ("linear", "smooth", "catmull-rom")
@@ -50,15 +52,15 @@ CAMERA_VECTORS = ("camera.position", "camera.target", "camera.up", "camera.limbo
 def _numeric(check: Any) -> Any:
     """The numeric checker behind a scene key's checker, or None for a non-numeric key
     (a choice, a boolean, the clip planes); "eye"/"auto" words are not interpolated."""
-    if isinstance(check, _OrWord):
+    if isinstance(check, OrWord):
         check = check.inner
-    return check if isinstance(check, (_Real, _Integer, _Vector)) else None
+    return check if isinstance(check, (Real, Integer, Vector)) else None
 
 
 def keyframable(dotted: str) -> bool:
     """Whether ``dotted`` is a scene key that keyframes may set."""
     section, _, key = dotted.partition(".")
-    check = _CHECKS.get(section, {}).get(key)
+    check = CHECKS.get(section, {}).get(key)
     return check is not None and _numeric(check) is not None and dotted not in FIXED_KEYS
 
 
@@ -110,28 +112,16 @@ def interpolate(frames, values, t: float, method: str) -> np.ndarray:
     return h00 * p0 + h10 * dt * tangent(i) + h01 * p1 + h11 * dt * tangent(i + 1)
 
 
-def _unit(v: np.ndarray) -> np.ndarray | None:
-    m = float(np.max(np.abs(v)))
-    if not m > 0 or not math.isfinite(m):
-        return None
-    v = v / m
-    n = float(np.linalg.norm(v))
-    return v / n if n > 1e-9 else None
-
-
 def orthonormal_camera(position, target, up, limbo) -> tuple[list[float], list[float]] | None:
     """(up', limbo') orthonormal to the view direction (module docstring), or None where
     the vectors are degenerate (the scene's own check then names the key)."""
-    f = _unit(np.subtract(target, position, dtype=np.float64))
-    lu = _unit(np.asarray(limbo, np.float64))
-    uu = _unit(np.asarray(up, np.float64))
-    if f is None or lu is None or uu is None:
+    lu = unit_or_none(np.asarray(limbo, np.float64))
+    uu = unit_or_none(np.asarray(up, np.float64))
+    if lu is None or uu is None:
         return None
-    limbo2 = _unit(lu - (lu @ f) * f)
-    if limbo2 is None:
-        return None
-    up2 = _unit(uu - (uu @ f) * f - (uu @ limbo2) * limbo2)
-    if up2 is None:
+    try:
+        _, limbo2, up2 = orthonormalise(np.subtract(target, position, dtype=np.float64), lu, uu)
+    except Degenerate:
         return None
     return [float(x) + 0.0 for x in up2], [float(x) + 0.0 for x in limbo2]
 
@@ -188,7 +178,7 @@ def _animation_settings(table: Any, overrides: list[tuple[str, str]]) -> dict[st
     if table is None:
         table = {}
     if not isinstance(table, Mapping):
-        raise SceneError("animation", f"expected a table, got {_show(table)}")
+        raise SceneError("animation", f"expected a table, got {show(table)}")
     raw = dict(table)
     for key, text in overrides:
         raw[key] = _parse_setting(key, text)
@@ -196,16 +186,16 @@ def _animation_settings(table: Any, overrides: list[tuple[str, str]]) -> dict[st
     for key, value in raw.items():
         dotted = f"animation.{key}"
         if key == "frames":
-            out[key] = _Integer(1, MAX_FRAMES)(dotted, value)
+            out[key] = Integer(1, MAX_FRAMES)(dotted, value)
         elif key == "fps":
-            out[key] = _Real(0.0, MAX_FPS, lo_open=True)(dotted, value)
+            out[key] = Real(0.0, MAX_FPS, lo_open=True)(dotted, value)
         elif key == "interpolation":
             if value not in INTERPOLATIONS:
                 raise SceneError(dotted, f"expected one of {', '.join(map(repr, INTERPOLATIONS))}, "
-                                         f"got {_show(value)}")
+                                         f"got {show(value)}")
             out[key] = value
         else:
-            raise SceneError(_show_key(dotted), "unknown key (animation takes frames, fps, interpolation)")
+            raise SceneError(show_key(dotted), "unknown key (animation takes frames, fps, interpolation)")
     return out
 
 
@@ -226,16 +216,16 @@ def _tracks(keyframes: Any, dropped: set[str]) -> tuple[list[Track], int]:
     if keyframes is None:
         return [], -1
     if not isinstance(keyframes, list):
-        raise SceneError("keyframe", f"expected [[keyframe]] tables, got {_show(keyframes)}")
+        raise SceneError("keyframe", f"expected [[keyframe]] tables, got {show(keyframes)}")
     by_key: dict[str, list[tuple[int, Any]]] = {}
     last = -1
     for i, kf in enumerate(keyframes, start=1):
         where = f"keyframe[{i}]"
         if not isinstance(kf, Mapping):
-            raise SceneError(where, f"expected a table, got {_show(kf)}")
+            raise SceneError(where, f"expected a table, got {show(kf)}")
         if "frame" not in kf:
             raise SceneError(f"{where}.frame", "missing: every keyframe needs frame = N")
-        frame = _Integer(0, MAX_FRAMES - 1)(f"{where}.frame", kf["frame"])
+        frame = Integer(0, MAX_FRAMES - 1)(f"{where}.frame", kf["frame"])
         if frame <= last:
             what = "duplicated" if frame == last else "out of order"
             raise SceneError(f"{where}.frame", f"{frame} is {what} (the previous keyframe is frame "
@@ -246,8 +236,8 @@ def _tracks(keyframes: Any, dropped: set[str]) -> tuple[list[Track], int]:
             raise SceneError(where, "sets no scene key")
         for dotted, value in keys:
             section, _, key = dotted.partition(".")
-            check = _CHECKS.get(section, {}).get(key)
-            name = f"{where}.{_show_key(dotted)}"
+            check = CHECKS.get(section, {}).get(key)
+            name = f"{where}.{show_key(dotted)}"
             if check is None:
                 raise SceneError(name, "unknown key")
             if dotted in FIXED_KEYS:
@@ -263,7 +253,7 @@ def _tracks(keyframes: Any, dropped: set[str]) -> tuple[list[Track], int]:
     for dotted, pts in by_key.items():
         if dotted in dropped:
             continue
-        integer = isinstance(_numeric(_CHECKS[dotted.split(".")[0]][dotted.split(".")[1]]), _Integer)
+        integer = isinstance(_numeric(CHECKS[dotted.split(".")[0]][dotted.split(".")[1]]), Integer)
         tracks.append(Track(dotted, tuple(f for f, _ in pts),
                             tuple(np.asarray(v, np.float64) for _, v in pts), integer))
     return tracks, last
@@ -339,7 +329,7 @@ def parse_frames(text: str | None, total: int) -> range:
         else:
             lo = hi = int(s)
     except ValueError:
-        raise SceneError("--frames", f"expected A:B (first and last frame), got {_show(text)}") from None
+        raise SceneError("--frames", f"expected A:B (first and last frame), got {show(text)}") from None
     if not 0 <= lo <= hi < total:
         raise SceneError("--frames", f"{lo}:{hi} is not within 0:{total - 1} (the animation's frames, "
                                      f"first not after last)")

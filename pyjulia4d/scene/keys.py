@@ -1,6 +1,6 @@
 """Every scene key with its default, valid range and a one-line meaning: ``pyjulia4d keys``
 (as Mandelbulber2's ``-L`` lists its parameters).  The defaults come from the scene
-dataclasses and the ranges from the checkers (scene._CHECKS via scene.valid_range), so the
+dataclasses and the ranges from the checkers (scene/model.CHECKS via valid_range), so the
 list cannot drift from what is accepted; docs/scene-keys.md holds the long form, and
 tests/test_scene.py holds both to the checkers."""
 from __future__ import annotations

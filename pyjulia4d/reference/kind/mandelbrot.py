@@ -14,7 +14,7 @@ REAL_MIN = np.finfo(np.float64).tiny
 def mandel_start(F, c):
     """q_1 = v + c, v f's critical or asymptotic value (scene.MANDELBROT_START; kind/mandelbrot.cl
     MANDEL_START), in the algebra's coordinates."""
-    from pyjulia4d.scene.model import MANDELBROT_START
+    from pyjulia4d.fractal.registry import MANDELBROT_START
     return c + F.ALG_IN(np.asarray(MANDELBROT_START[F.function], np.float64))
 
 

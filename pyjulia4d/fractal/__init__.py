@@ -1,0 +1,1 @@
+"""The registry of algebras, functions and kinds of set (registry.py)."""

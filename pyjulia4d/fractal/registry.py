@@ -1,0 +1,162 @@
+"""The registry of algebras, functions and kinds of set: one entry each, naming its OpenCL
+piece and its float64 twin and stating its facts.  Adding a function is one FUNCTIONS_TABLE
+entry plus kernels/function/<name>.cl and pyjulia4d/reference/function/<name>.py; the
+scene's choices, the kernel configuration (pipeline/kernel_config.py), the bounding ball
+(geometry/camera.py) and the reference all read it here.
+
+The algebras and functions are POV-Ray's julia_fractal's (seed 003_8ca5f9108f52d3d6.txt), in
+its order, with Gintz's CQuats and the naive commutative rules (seed 000_1dc675fe64448cc1.txt
+eqs. 14, 15); the kinds are seed 001_01b4b6353b5280e3.txt's (§2, §5).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+Vec4 = tuple[float, float, float, float]
+_ZERO = (0.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Function:
+    """f in q -> f(q) + c.  ``degree``: the polynomial maps' degree - they escape to infinity
+    like |q|^degree, which gives the bounding ball and the distance estimate (camera.
+    bounding_radius, iterate.cl); None for the others.  ``critical``: f's one critical (or
+    asymptotic) value v, in the point's own coordinates, where the Mandelbrot set's orbit
+    starts (q_1 = v + c, kernels/kind/mandelbrot.cl); None where f has several singular
+    values (tan, tanh) or none (ln, the inverse functions): no one Mandelbrot set."""
+
+    name: str
+    degree: int | None = None
+    critical: Vec4 | None = None
+
+    @property
+    def piece(self) -> str:
+        return f"function/{self.name}"
+
+    @property
+    def twin(self) -> str:
+        return f"pyjulia4d.reference.function.{self.name}"
+
+
+@dataclass(frozen=True)
+class Algebra:
+    """A 4D algebra.  ``functions``: the f it takes (quaternions sqr and cube only, as in
+    POV-Ray).  ``norm_bounded``: |q^D| >= |q|^D, so the escape bound holds - quaternions (the
+    norm is multiplicative) and the hypercomplex numbers (the power mean of their two complex
+    components); CQuats and the commutative rules have zero divisors with |q^2| < |q|^2.
+    ``estimate``: the polynomial maps have a distance estimate (seed 001 §3.1 eq. 8 for
+    quaternions; the product of two complex Julia sets for the hypercomplex numbers).
+    ``table``: a multiplication-table algebra whose powers come from algebra/power.cl."""
+
+    name: str
+    functions: tuple[str, ...]
+    norm_bounded: bool = False
+    estimate: bool = False
+    table: bool = False
+
+    @property
+    def piece(self) -> str:
+        return f"algebra/{self.name}"
+
+    @property
+    def twin(self) -> str:
+        return f"pyjulia4d.reference.algebra.{self.name}"
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A kind of set a [fractal] table describes.  ``piece``: its set test after iterate.cl
+    (kernels/kind/<name>.cl, with kind/level.cl), None for the Julia set itself.
+    ``estimate``: whether a proven distance estimate exists for it (the stack's "de" is an
+    empirical one)."""
+
+    name: str
+    piece: str | None = None
+    estimate: bool = True
+
+
+FUNCTIONS_TABLE: dict[str, Function] = {f.name: f for f in (
+    Function("sqr", degree=2, critical=_ZERO),
+    Function("cube", degree=3, critical=_ZERO),
+    Function("exp", critical=_ZERO),          # asymptotic value 0
+    Function("reciprocal", critical=_ZERO),   # asymptotic value 0: the orbit of c
+    Function("sin", critical=(1.0, 0.0, 0.0, 0.0)),    # sin(pi/2)
+    Function("asin"),
+    Function("sinh", critical=(0.0, 1.0, 0.0, 0.0)),   # sinh(i pi/2) = i, per hypercomplex component
+    Function("asinh"),
+    Function("cos", critical=(1.0, 0.0, 0.0, 0.0)),    # cos(0)
+    Function("acos"),
+    Function("cosh", critical=(1.0, 0.0, 0.0, 0.0)),   # cosh(0)
+    Function("acosh"),
+    Function("tan"),
+    Function("atan"),
+    Function("tanh"),
+    Function("atanh"),
+    Function("ln"),
+    Function("pwr", critical=_ZERO),          # critical point 0 for Re(exponent) > 1 (scene rules)
+)}
+
+FUNCTIONS = tuple(FUNCTIONS_TABLE)
+
+ALGEBRAS_TABLE: dict[str, Algebra] = {a.name: a for a in (
+    Algebra("quaternion", ("sqr", "cube"), norm_bounded=True, estimate=True),
+    Algebra("hypercomplex", FUNCTIONS, norm_bounded=True, estimate=True),
+    Algebra("cquat", ("sqr", "cube"), table=True),
+    Algebra("commutative", ("sqr", "cube"), table=True),
+)}
+
+ALGEBRAS = tuple(ALGEBRAS_TABLE)
+
+KINDS_TABLE: dict[str, Kind] = {k.name: k for k in (
+    Kind("julia"),
+    Kind("mandelbrot", piece="kind/mandelbrot"),
+    Kind("julia_stack", piece="kind/julia_stack", estimate=False),
+    Kind("cubic_locus", piece="kind/cubic_locus", estimate=False),
+)}
+
+KINDS = tuple(KINDS_TABLE)
+
+# Derived views, in the registry's order.
+FUNCTIONS_OF = {a.name: a.functions for a in ALGEBRAS_TABLE.values()}
+POLYNOMIAL_DEGREE = {f.name: f.degree for f in FUNCTIONS_TABLE.values() if f.degree is not None}
+MANDELBROT_START = {f.name: f.critical for f in FUNCTIONS_TABLE.values() if f.critical is not None}
+NORM_BOUNDED = tuple(a.name for a in ALGEBRAS_TABLE.values() if a.norm_bounded)
+
+
+def escape_degree(f: Any) -> int | None:
+    """D where |f(q)| >= |q|^D - |c| (camera.bounding_radius), else None; ``f`` a [fractal]."""
+    return POLYNOMIAL_DEGREE.get(f.function) if ALGEBRAS_TABLE[f.algebra].norm_bounded else None
+
+
+def has_distance_estimate(f: Any) -> bool:
+    """Whether the march may step by a distance estimate: a kind with a proven one, an
+    algebra with estimates, a polynomial function.  The other pairs are marched by the fixed
+    scan (march.method = "auto")."""
+    return (KINDS_TABLE[f.kind].estimate and ALGEBRAS_TABLE[f.algebra].estimate
+            and FUNCTIONS_TABLE[f.function].degree is not None)
+
+
+def march_method(scene: Any) -> str:
+    """march.method with "auto" resolved: "de" where the pair has a distance estimate,
+    else "fixed"."""
+    m = scene.march.method
+    if m != "auto":
+        return m
+    return "de" if has_distance_estimate(scene.fractal) else "fixed"
+
+
+def locus_escape_radius(radius: float) -> float:
+    """The escape radius of every f_{a,b}(z) = z^3 - 3 a^2 z + b with |a|, |b| <= radius: the
+    root R of R^3 - (3 radius^2 + 1) R - radius = 0, beyond which |f(z)| >= |z|^3 - 3 |a|^2 |z|
+    - |b| > |z| and the orbit grows without bound (kernels/kind/cubic_locus.cl)."""
+    k = 3.0 * radius * radius + 1.0
+    lo, hi = math.sqrt(k), math.sqrt(k) + radius + 1.0   # g(lo) = -radius < 0 < g(hi)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid * mid * mid - k * mid - radius > 0:
+            hi = mid
+        else:
+            lo = mid
+    return hi
