@@ -37,7 +37,8 @@ from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 from pyjulia4d.measure import truth  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.scene.quality import PRESETS  # noqa: E402
-from pyjulia4d.scene.model import Scene, has_distance_estimate  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
+from pyjulia4d.fractal.registry import has_distance_estimate
 
 HC = ["fractal.algebra=hypercomplex"]
 SCENES = {

@@ -32,12 +32,12 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 def _frames_run(client, anim, frames, out: Path):
     """(wall seconds, worker seconds summed) of rendering and writing ``frames``."""
     from pyjulia4d.app.cluster import render_many
-    from pyjulia4d.app.output import _atomic
+    from pyjulia4d.app.output import atomic_write
 
     worker = []
 
     def write(n, encoded, info):
-        with _atomic(out / f"f_{n:04d}.png") as tmp:
+        with atomic_write(out / f"f_{n:04d}.png") as tmp:
             tmp.write_bytes(encoded.data)
         worker.append(info.seconds)
 

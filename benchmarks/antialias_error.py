@@ -38,7 +38,7 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 from pyjulia4d import Scene, render  # noqa: E402
 from pyjulia4d.pipeline import antialias
 from pyjulia4d.pipeline.colormap import linear_to_srgb  # noqa: E402
-from pyjulia4d.scene.model import march_method  # noqa: E402
+from pyjulia4d.fractal.registry import march_method  # noqa: E402
 
 SCENES = {
     "default": [],

@@ -53,7 +53,7 @@ print(json.dumps({"first": first_s, "kernel": statistics.median(r.kernel_seconds
 
 def pairs() -> dict[str, list[str]]:
     """Scene name -> overrides: the gallery's pairs and the CQuat and commutative cubes."""
-    from pyjulia4d.scene.model import FUNCTIONS_OF
+    from pyjulia4d.fractal.registry import FUNCTIONS_OF
 
     out = {name: COMMON + keys for name, keys in SCENES.items()}
     for algebra, functions in FUNCTIONS_OF.items():

@@ -39,7 +39,8 @@ from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 from pyjulia4d.measure import truth  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.opencl.executor import render  # noqa: E402
-from pyjulia4d.scene.model import Scene, has_distance_estimate  # noqa: E402
+from pyjulia4d.scene.model import Scene  # noqa: E402
+from pyjulia4d.fractal.registry import has_distance_estimate
 
 MANDEL = ["fractal.kind=mandelbrot"]
 # camera looking at the Mandelbrot sets' centre (-0.5, 0, 0, 0) from above and in front

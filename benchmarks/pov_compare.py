@@ -154,7 +154,7 @@ def grad_n_cos(scene, position, mask) -> np.ndarray:
     with np.errstate(all="ignore"):
         g = ref.normal_jacobian(position[mask], scene.fractal.c, scene.fractal.max_iter + 1, 1e30,
                                 formula=formula_of(scene.fractal))
-        n = ref._to_camera(g, f)
+        n = ref.to_camera(g, f)
         full[mask] = n / np.linalg.norm(n, axis=-1, keepdims=True)
     return view_cos(scene, np.nan_to_num(full))
 

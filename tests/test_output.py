@@ -146,11 +146,11 @@ def test_too_long_name_refused(tmp_path, name: str) -> None:
 
 def test_temp_name_fits(tmp_path) -> None:
     p = tmp_path / ("x" * 251 + ".exr")
-    prefix, suffix = output._temp_affixes(p, 255)
-    assert len(os.fsencode(prefix + suffix)) + output._RANDOM_CHARS <= 255
+    prefix, suffix = output.temp_affixes(p, 255)
+    assert len(os.fsencode(prefix + suffix)) + output.RANDOM_CHARS <= 255
     assert prefix.startswith(".xxx") and suffix == ".exr"
-    prefix, _ = output._temp_affixes(tmp_path / ("é" * 125 + ".png"), 255)
-    assert prefix.startswith(".é") and len(os.fsencode(prefix)) + 4 + output._RANDOM_CHARS <= 255
+    prefix, _ = output.temp_affixes(tmp_path / ("é" * 125 + ".png"), 255)
+    assert prefix.startswith(".é") and len(os.fsencode(prefix)) + 4 + output.RANDOM_CHARS <= 255
 
 
 def test_too_long_path_refused(tmp_path, monkeypatch) -> None:

@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
-from pyjulia4d.scene.keyframes import Animation, parse_frames
-from pyjulia4d.app.output import _NAME_MAX, OutputError, _atomic, _limit, _shown, _temp_affixes, check_output_path, read_header
+from pyjulia4d.app.output import (NAME_MAX, OutputError, atomic_write, check_output_path, path_limit, read_header,
+                                  shown_path, temp_affixes)
 from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.keyframes import Animation
 
 HEADER_SCENE = "pyjulia4d.scene"
 HEADER_FRAME = "pyjulia4d.frame"
@@ -41,10 +42,10 @@ def check_pattern(pattern: str | os.PathLike) -> str:
     runs = _HASHES.findall(name)
     if len(runs) != 1:
         got = "none" if not runs else f"{len(runs)}"
-        raise OutputError(f"{_shown(raw)}: the file name needs one run of '#' for the frame number "
+        raise OutputError(f"{shown_path(raw)}: the file name needs one run of '#' for the frame number "
                           f"(e.g. frames/julia_####.png), found {got}")
     if "#" in os.path.dirname(raw):
-        raise OutputError(f"{_shown(raw)}: '#' belongs in the file name, not the directory")
+        raise OutputError(f"{shown_path(raw)}: '#' belongs in the file name, not the directory")
     return raw
 
 
@@ -69,11 +70,11 @@ _TEMP = re.compile(r"[A-Za-z0-9_]{8}")
 
 
 def remove_stale_temps(paths: Iterable[Path]) -> list[Path]:
-    """Remove the temporary files (``.<stem>.<8 random characters><ext>``, output._atomic)
+    """Remove the temporary files (``.<stem>.<8 random characters><ext>``, output.atomic_write)
     that a killed run left beside these frames; returns them."""
     by_dir: dict[Path, dict[str, str]] = {}
     for p in paths:
-        prefix, suffix = _temp_affixes(p, _limit(p.parent, "PC_NAME_MAX", _NAME_MAX))
+        prefix, suffix = temp_affixes(p, path_limit(p.parent, "PC_NAME_MAX", NAME_MAX))
         by_dir.setdefault(p.parent, {})[prefix] = suffix
     removed = []
     for d, affixes in by_dir.items():
@@ -133,16 +134,6 @@ def _check_scenes(anim: Animation, frames: range, device: Any, force: bool, outp
         warnings.warn(msg + more, RuntimeWarning, stacklevel=3)
 
 
-def check_device(device: str | None, scheduler: str | None) -> Any:
-    """The device workload.check estimates for before any frame renders: this machine's
-    (it renders here, on its local cluster), or "GPU" for an existing cluster, whose workers
-    check again on their own devices (render.render does, before any kernel runs)."""
-    if scheduler is not None:
-        return "GPU"
-    from pyjulia4d.opencl.devices import select_device
-    return select_device(device)
-
-
 class _Progress:
     """Frames done with an ETA: a tqdm bar on a terminal, a line at most every 10 s elsewhere."""
 
@@ -192,7 +183,7 @@ def animate(anim: Animation, pattern: str, frames: Sequence[int] | None = None, 
         workers = distributed.check_workers(workers)
     distributed.check_where(workers, scheduler)
     distributed.require_cluster(workers, scheduler)
-    _check_scenes(anim, frames, check_device(device, scheduler), force, outputs)
+    _check_scenes(anim, frames, distributed.check_device(device, scheduler), force, outputs)
     if video is not None:
         video = check_video_path(video)
     paths = {n: frame_path(pattern, n) for n in frames}
@@ -226,7 +217,7 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
     def write(n: int, result: Any, info: Any) -> None:
         """File a frame that came back: its bytes, encoded by the worker (distributed.EncodedImage)."""
         try:
-            with _atomic(paths[n]) as tmp:
+            with atomic_write(paths[n]) as tmp:
                 tmp.write_bytes(result.data)
         except OSError as e:
             raise OutputError(f"{paths[n]}: cannot write: {e.strerror or e}") from e
@@ -293,7 +284,7 @@ def _make_dirs(dirs: Iterable[Path]) -> list[Path]:
                         x.rmdir()
                     except OSError:
                         pass
-                raise OutputError(f"{_shown(str(d))}: cannot create the frame directory: "
+                raise OutputError(f"{shown_path(str(d))}: cannot create the frame directory: "
                                   f"{e.strerror or e}") from None
             made.append(m)
     return made
@@ -320,32 +311,12 @@ def closing_line(summary: Summary, pattern: str, video: str | None, fps: float) 
     return line
 
 
-def run_cli(args: Any) -> int:
-    """``python -m pyjulia4d animate`` (cli.py parses; errors are raised as ValueError)."""
-    from pyjulia4d.scene import keyframes
-    from pyjulia4d.app.cli import _outputs, _size_overrides
-
-    overrides = _size_overrides(args)
-    anim = keyframes.load(args.scene, overrides)
-    frames = parse_frames(args.frames, anim.frames)
-    pattern = args.output if args.output is not None else Path(args.scene).stem + "_####.png"
-    check_pattern(pattern)
-    outputs = _outputs(args.channels, Path(pattern.replace("#", "0")))
-    from pyjulia4d.app.cluster import check_workers
-
-    workers = None if args.workers is None else check_workers(args.workers)
-    summary = animate(anim, pattern, frames, video=args.video, workers=workers, scheduler=args.scheduler,
-                      device=args.device, force=args.force, outputs=outputs, progress=True)
-    print(closing_line(summary, pattern, args.video, anim.fps))
-    return 0
-
-
 def strip(files: Sequence[str | os.PathLike], out: str | os.PathLike, columns: int | None = None) -> None:
     """A contact sheet of frame files (one row, or ``columns`` wide), written atomically as PNG."""
     import numpy as np
     from PIL import Image
 
-    from pyjulia4d.app.output import _atomic
+    from pyjulia4d.app.output import atomic_write
     from pyjulia4d.app.video import read_frame
 
     imgs = [read_frame(f) for f in files]
@@ -356,5 +327,5 @@ def strip(files: Sequence[str | os.PathLike], out: str | os.PathLike, columns: i
     for i, im in enumerate(imgs):
         r, c = divmod(i, cols)
         sheet[r * h:(r + 1) * h, c * w:(c + 1) * w] = im
-    with _atomic(out) as tmp:
+    with atomic_write(out) as tmp:
         Image.fromarray(sheet).save(tmp, format="PNG")

@@ -214,6 +214,27 @@ def _render(args: argparse.Namespace) -> int:
     return 0
 
 
+def _animate(args: argparse.Namespace) -> int:
+    """animate: keyframed scene -> frames (and a video): app/animation.py renders them."""
+    from pyjulia4d.app.animation import animate, check_pattern, closing_line
+    from pyjulia4d.scene import keyframes
+    from pyjulia4d.scene.keyframes import parse_frames
+
+    overrides = _size_overrides(args)
+    anim = keyframes.load(args.scene, overrides)
+    frames = parse_frames(args.frames, anim.frames)
+    pattern = args.output if args.output is not None else Path(args.scene).stem + "_####.png"
+    check_pattern(pattern)
+    outputs = _outputs(args.channels, Path(pattern.replace("#", "0")))
+    from pyjulia4d.app.cluster import check_workers
+
+    workers = None if args.workers is None else check_workers(args.workers)
+    summary = animate(anim, pattern, frames, video=args.video, workers=workers, scheduler=args.scheduler,
+                      device=args.device, force=args.force, outputs=outputs, progress=True)
+    print(closing_line(summary, pattern, args.video, anim.fps))
+    return 0
+
+
 def _import_pov(args: argparse.Namespace) -> int:
     """import-pov: FILE.pov -> SCENE.toml (pyjulia4d/povray.py); warnings only on success."""
     from pyjulia4d.interop.povray import check_toml_path, import_pov, write_toml
@@ -342,9 +363,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.command == "import-pov":
                 return _import_pov(args)
             if args.command == "animate":
-                from pyjulia4d.app.animation import run_cli
-
-                return run_cli(args)
+                return _animate(args)
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
         _say(f"pyjulia4d: error: {_one_line(e)}")

@@ -169,6 +169,16 @@ def default_workers(device: str | None = None) -> int:
     return 1
 
 
+def check_device(device: str | None, scheduler: str | None) -> Any:
+    """The device workload.check estimates for before any frame renders: this machine's
+    (it renders here, on its local cluster), or "GPU" for an existing cluster, whose workers
+    check again on their own devices (render.render does, before any kernel runs)."""
+    if scheduler is not None:
+        return "GPU"
+    from pyjulia4d.opencl.devices import select_device
+    return select_device(device)
+
+
 def check_workers(text: Any) -> int:
     """--workers N: an integer 0 <= N <= 1024 (0: in this process, no cluster)."""
     try:
@@ -348,7 +358,6 @@ def render_on_cluster(scene: Scene, workers: int | None = None, scheduler: str |
     """``render --workers/--scheduler``: check the scene's work here (workload.check: on this
     machine's device, or as on a GPU for an existing cluster, whose workers check again),
     then render_tiled on the cluster.  Returns the RenderResult."""
-    from pyjulia4d.app.animation import check_device
     from pyjulia4d.pipeline.workload import check
 
     check_where(workers, scheduler)

@@ -21,9 +21,9 @@ import numpy as np
 FORMATS = (".png", ".exr")
 
 # Room left for tempfile's random part of a name (8 characters in CPython today).
-_RANDOM_CHARS = 16
+RANDOM_CHARS = 16
 # Where pathconf() cannot tell: the usual Linux limits.
-_NAME_MAX, _PATH_MAX = 255, 4096
+NAME_MAX, PATH_MAX = 255, 4096
 # Deferred while a temp file is created or removed, so that no signal's exception can
 # fall between creating a file and knowing its name (which would leave it behind).
 _HELD = tuple(getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s))
@@ -37,18 +37,18 @@ def _suffix(path: str | Path) -> str:
     return Path(path).suffix.lower()
 
 
-def _shown(path: str) -> str:
+def shown_path(path: str) -> str:
     """The path as a message shows it: itself when printable, else its repr."""
     return path if path and path.isprintable() else repr(path)
 
 
-def _quoted(path: str | Path) -> str:
+def quoted_path(path: str | Path) -> str:
     """The path in quotes: 'dir', or its repr when not printable."""
     path = str(path)
     return f"'{path}'" if path and path.isprintable() else repr(path)
 
 
-def _limit(directory: str | Path, name: str, fallback: int) -> int:
+def path_limit(directory: str | Path, name: str, fallback: int) -> int:
     try:
         value = os.pathconf(directory, name)
     except (OSError, ValueError):
@@ -56,10 +56,10 @@ def _limit(directory: str | Path, name: str, fallback: int) -> int:
     return value if value > 0 else fallback  # -1: no limit, keep the usual one
 
 
-def _temp_affixes(p: Path, name_max: int) -> tuple[str, str]:
+def temp_affixes(p: Path, name_max: int) -> tuple[str, str]:
     """(prefix, suffix) of the temp file for ``p``: ``.<stem>.`` and its extension, the
     stem cut so that prefix + random part + suffix fits in ``name_max`` bytes."""
-    room = max(0, name_max - len(os.fsencode(p.suffix)) - 2 - _RANDOM_CHARS)
+    room = max(0, name_max - len(os.fsencode(p.suffix)) - 2 - RANDOM_CHARS)
     stem = p.stem[:room]
     while len(os.fsencode(stem)) > room:  # multi-byte characters: cut by bytes
         stem = stem[:-1]
@@ -97,12 +97,12 @@ def check_directory(shown: str, parent: Path) -> None:
     try:
         st = os.stat(parent)
     except FileNotFoundError:
-        raise OutputError(f"{shown}: directory {_quoted(parent)} does not exist") from None
+        raise OutputError(f"{shown}: directory {quoted_path(parent)} does not exist") from None
     except (OSError, ValueError) as e:
-        raise OutputError(f"{shown}: directory {_quoted(parent)}: "
+        raise OutputError(f"{shown}: directory {quoted_path(parent)}: "
                           f"{getattr(e, 'strerror', None) or e}") from None
     if not stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: {_quoted(parent)} is not a directory")
+        raise OutputError(f"{shown}: {quoted_path(parent)} is not a directory")
 
 
 def check_output_path(path: str | Path) -> Path:
@@ -110,27 +110,27 @@ def check_output_path(path: str | Path) -> Path:
     directory, the length of its name and path (the temp file's too), and a temp
     file really created (and removed) beside it."""
     raw = os.fspath(path)
-    shown = _shown(raw)
+    shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")
     p = Path(raw)
     ext = _suffix(p)
     if ext not in FORMATS:
-        got = _quoted(ext) if ext else "'(none)'"
+        got = quoted_path(ext) if ext else "'(none)'"
         raise OutputError(f"{shown}: unsupported output format {got} (use .png or .exr)")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent
     check_directory(shown, parent)
-    name_max = _limit(parent, "PC_NAME_MAX", _NAME_MAX)
-    path_max = _limit(parent, "PC_PATH_MAX", _PATH_MAX)  # counts the terminating NUL
+    name_max = path_limit(parent, "PC_NAME_MAX", NAME_MAX)
+    path_max = path_limit(parent, "PC_PATH_MAX", PATH_MAX)  # counts the terminating NUL
     name = len(os.fsencode(p.name))
     if name > name_max:
         raise OutputError(f"{shown}: file name too long ({name} bytes; this file system "
                           f"allows {name_max})")
-    prefix, suffix = _temp_affixes(p, name_max)
+    prefix, suffix = temp_affixes(p, name_max)
     longest = max(len(os.fsencode(raw)),
-                  len(os.fsencode(os.path.join(parent, prefix + suffix))) + _RANDOM_CHARS)
+                  len(os.fsencode(os.path.join(parent, prefix + suffix))) + RANDOM_CHARS)
     if longest >= path_max:
         raise OutputError(f"{shown}: path too long ({longest} bytes with the temporary "
                           f"file's name; the limit is {path_max - 1})")
@@ -150,7 +150,7 @@ def check_output_path(path: str | Path) -> Path:
             os.close(fd)
             os.unlink(tmp)
     except OSError as e:
-        raise OutputError(f"{shown}: cannot create a file in {_quoted(parent)}: "
+        raise OutputError(f"{shown}: cannot create a file in {quoted_path(parent)}: "
                           f"{e.strerror or e}") from None
     return p
 
@@ -163,10 +163,10 @@ def _file_mode() -> int:
 
 
 @contextlib.contextmanager
-def _atomic(path: str | Path) -> Iterator[Path]:
+def atomic_write(path: str | Path) -> Iterator[Path]:
     """Yield a temp path beside ``path``; move it onto ``path`` only on success."""
     p = Path(path)
-    prefix, suffix = _temp_affixes(p, _limit(p.parent, "PC_NAME_MAX", _NAME_MAX))
+    prefix, suffix = temp_affixes(p, path_limit(p.parent, "PC_NAME_MAX", NAME_MAX))
     tmp: Path | None = None
     try:
         with _signals_held():  # a signal arriving here is raised once tmp is known
@@ -183,7 +183,7 @@ def _atomic(path: str | Path) -> Iterator[Path]:
         raise
 
 
-def _to_u8(x: np.ndarray) -> np.ndarray:
+def to_u8(x: np.ndarray) -> np.ndarray:
     x = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0)
     return np.rint(np.clip(x, 0.0, 1.0) * 255.0).astype(np.uint8)
 
@@ -209,11 +209,11 @@ def write_png(
     if color.ndim != 3 or color.shape[2] != 3 or alpha.shape != color.shape[:2]:
         raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
     rgb = linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0))
-    rgba = np.concatenate([_to_u8(rgb), _to_u8(alpha)[..., None]], axis=2)
+    rgba = np.concatenate([to_u8(rgb), to_u8(alpha)[..., None]], axis=2)
     info = PngImagePlugin.PngInfo()
     for k, v in (text or {}).items():
         info.add_itxt(k, str(v))  # iTXt: UTF-8, unlike tEXt's Latin-1
-    with _atomic(path) as tmp:
+    with atomic_write(path) as tmp:
         Image.fromarray(np.ascontiguousarray(rgba)).save(tmp, format="PNG", pnginfo=info)
 
 
@@ -240,7 +240,7 @@ def write_exr(
         "type": OpenEXR.scanlineimage,
     }
     hdr.update({k: str(v) for k, v in (header or {}).items()})
-    with _atomic(path) as tmp:
+    with atomic_write(path) as tmp:
         OpenEXR.File(hdr, data).write(str(tmp))
 
 

@@ -15,7 +15,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from pyjulia4d.app.output import OutputError, _atomic, _quoted, _shown, check_directory
+from pyjulia4d.app.output import OutputError, atomic_write, quoted_path, shown_path, check_directory
 
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 # H.264's constant rate factor and VP9's constant quality (lower is better; both about
@@ -37,19 +37,19 @@ def check_video_path(path: str | os.PathLike) -> Path:
     """Fail before rendering if ``path`` cannot take the video: .mp4 or .webm, in an
     existing, writable directory."""
     raw = os.fspath(path)
-    shown = _shown(raw)
+    shown = shown_path(raw)
     p = Path(raw)
     if not raw or raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: not a file name")
     ext = p.suffix.lower()
     if ext not in CODECS:
-        got = _quoted(ext) if ext else "'(none)'"
+        got = quoted_path(ext) if ext else "'(none)'"
         raise OutputError(f"{shown}: unsupported video format {got} (use .mp4 or .webm)")
     check_directory(shown, p.parent)
     if p.is_dir():
         raise OutputError(f"{shown}: is a directory")
     if not os.access(p.parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{shown}: cannot create a file in {_quoted(p.parent)}")
+        raise OutputError(f"{shown}: cannot create a file in {quoted_path(p.parent)}")
     if not have_ffmpeg():
         raise OutputError(f"{shown}: video needs imageio-ffmpeg, which is not installed: pip install "
                           f"'pyjulia4d[video]'")
@@ -64,14 +64,14 @@ def read_frame(path: str | os.PathLike) -> np.ndarray:
         import OpenEXR
 
         from pyjulia4d.pipeline.colormap import linear_to_srgb
-        from pyjulia4d.app.output import _to_u8
+        from pyjulia4d.app.output import to_u8
 
         ch = OpenEXR.File(str(p), separate_channels=True).channels()
         if not all(k in ch for k in "RGB"):
-            raise OutputError(f"{_shown(str(p))}: no R, G, B channels to make a video of "
+            raise OutputError(f"{shown_path(str(p))}: no R, G, B channels to make a video of "
                               f"(rendered with --channels without RGBA)")
         rgb = np.stack([np.asarray(ch[k].pixels, np.float32) for k in "RGB"], axis=-1)
-        return _to_u8(linear_to_srgb(np.nan_to_num(rgb, nan=0.0)))
+        return to_u8(linear_to_srgb(np.nan_to_num(rgb, nan=0.0)))
     from PIL import Image
 
     with Image.open(p) as im:
@@ -93,11 +93,11 @@ def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: floa
     it: Iterator[np.ndarray] = iter(frames)
     first = next(it, None)
     if first is None:
-        raise OutputError(f"{_shown(str(p))}: no frames to encode")
+        raise OutputError(f"{shown_path(str(p))}: no frames to encode")
     first = _even(first)
     h, w = first.shape[:2]
     n = 0
-    with _atomic(p) as tmp:
+    with atomic_write(p) as tmp:
         writer = imageio_ffmpeg.write_frames(
             str(tmp), (w, h), fps=fps, codec=CODECS[ext], pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
             quality=None, macro_block_size=1, output_params=QUALITY[ext], ffmpeg_log_level="error")
@@ -105,7 +105,7 @@ def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: floa
         try:
             for frame in (first, *(_even(f) for f in it)):
                 if frame.shape != first.shape:
-                    raise OutputError(f"{_shown(str(p))}: frame {n} is {frame.shape[1]}x{frame.shape[0]}, "
+                    raise OutputError(f"{shown_path(str(p))}: frame {n} is {frame.shape[1]}x{frame.shape[0]}, "
                                       f"the first {w}x{h}: a video's frames share one size")
                 writer.send(np.ascontiguousarray(frame))
                 n += 1

@@ -1168,9 +1168,9 @@ def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
 
 
 def read_pov(path: str | Path) -> str:
-    from pyjulia4d.app.output import _shown
+    from pyjulia4d.app.output import shown_path
 
-    where = _shown(os.fspath(path))
+    where = shown_path(os.fspath(path))
     try:
         with open(path, "rb") as f:
             raw = f.read(MAX_POV_BYTES + 1)
@@ -1187,14 +1187,14 @@ def read_pov(path: str | Path) -> str:
 
 def import_pov(path: str | Path, width: int | None = None, height: int | None = None) -> Imported:
     """Read ``path`` and map its julia_fractal, camera and light to a pyjulia4d scene."""
-    from pyjulia4d.app.output import _shown
+    from pyjulia4d.app.output import shown_path
 
     w, h = DEFAULT_SIZE if width is None and height is None else (width, height)
     if w is None or h is None:  # one given: the other keeps pyjulia4d's aspect ratio
         w = w if w is not None else max(1, round(h * DEFAULT_SIZE[0] / DEFAULT_SIZE[1]))
         h = h if h is not None else max(1, round(w * DEFAULT_SIZE[1] / DEFAULT_SIZE[0]))
     Scene.from_dict({"image": {"width": w, "height": h}})  # the same range errors as render's
-    where = _shown(os.fspath(path))
+    where = shown_path(os.fspath(path))
     text = read_pov(path)
     try:
         with np.errstate(all="ignore"):  # an overflow becomes a non-finite value the scene refuses
@@ -1212,15 +1212,15 @@ def import_pov(path: str | Path, width: int | None = None, height: int | None = 
 def check_toml_path(path: str | Path, source: str | Path) -> Path:
     """Fail before writing if ``path`` cannot take the scene file (output.check_output_path's
     checks, for .toml)."""
-    from pyjulia4d.app.output import _NAME_MAX, OutputError, _limit, _quoted, _shown, check_directory
+    from pyjulia4d.app.output import NAME_MAX, OutputError, path_limit, quoted_path, shown_path, check_directory
 
     raw = os.fspath(path)
-    shown = _shown(raw)
+    shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")
     p = Path(raw)
     if p.suffix.lower() != ".toml":
-        got = _quoted(p.suffix) if p.suffix else "'(none)'"
+        got = quoted_path(p.suffix) if p.suffix else "'(none)'"
         raise OutputError(f"{shown}: unsupported output format {got} (use .toml)")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
@@ -1239,7 +1239,7 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
         same = False
     if same:
         raise OutputError(f"{shown}: is the POV-Ray file itself")
-    name_max = _limit(p.parent, "PC_NAME_MAX", _NAME_MAX)
+    name_max = path_limit(p.parent, "PC_NAME_MAX", NAME_MAX)
     if len(os.fsencode(p.name)) > name_max:
         raise OutputError(f"{shown}: file name too long ({len(os.fsencode(p.name))} bytes; this file "
                           f"system allows {name_max})")
@@ -1248,10 +1248,10 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
 
 def write_toml(path: Path, text: str) -> None:
     """Atomically (output.py's temp file beside it, renamed)."""
-    from pyjulia4d.app.output import OutputError, _atomic
+    from pyjulia4d.app.output import OutputError, atomic_write
 
     try:
-        with _atomic(path) as tmp:
+        with atomic_write(path) as tmp:
             tmp.write_text(text, encoding="utf-8")
     except OSError as e:
         raise OutputError(f"{path}: cannot write: {e.strerror or e}") from None

@@ -74,7 +74,7 @@ def sphere_depth(origins, dirs, radius):
 
 def sphere_normals(points, frame):
     """c = 0: the radial unit normal p/|p| in camera coordinates (x right, y up, z to the eye)."""
-    return ref._unit_or_zero(ref._to_camera(np.asarray(points, np.float64), frame))
+    return ref.unit_or_zero(ref.to_camera(np.asarray(points, np.float64), frame))
 
 
 # --------------------------------------------------------------- real c
@@ -394,7 +394,7 @@ def jacobian_normals(points, scene: Scene):
     ok = np.all(np.isfinite(p), -1)
     if ok.any():
         g = ref.normal_jacobian(p[ok], f.c, f.max_iter, f.bailout, formula=ref.formula_of(f))
-        out[ok] = ref._unit_or_zero(ref._to_camera(g, fr))
+        out[ok] = ref.unit_or_zero(ref.to_camera(g, fr))
     return out
 
 

@@ -7,7 +7,8 @@ from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.pipeline.plan import light_parameters
 # imported by the package at its end, once these are defined
-from pyjulia4d.reference import _dot, _to_camera, julia_distance_formula, julia_inside
+from pyjulia4d.reference.iterate import dot4, julia_distance_formula, julia_inside
+from pyjulia4d.reference.normals import to_camera
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 
 
@@ -17,9 +18,9 @@ def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_ste
     by the estimate where F has one (soft: min(k 2d / t)), else samples every step; 0 at the
     first inside point; the ray clipped to the bounding ball and to tmax."""
     n = len(o)
-    b = _dot(o, l)
+    b = dot4(o, l)
     perp = o - b[:, None] * l
-    disc = radius * radius - _dot(perp, perp)
+    disc = radius * radius - dot4(perp, perp)
     s = np.sqrt(np.maximum(disc, 0.0))
     t = np.maximum(-b - s, step)
     t1 = np.minimum(-b + s, tmax)
@@ -219,7 +220,7 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     rgba[:, :3] = background
     if not hit.any():
         return rgba
-    p = _to_camera(point[hit] - frame.position, frame)
+    p = to_camera(point[hit] - frame.position, frame)
     lp = np.linalg.norm(p, axis=-1, keepdims=True)
     # the hit is the eye itself (depth 0, camera inside the set): the view axis (shade.cl)
     p = np.where(lp > 0, p / np.where(lp > 0, lp, 1), np.array([0.0, 0.0, -1.0]))
@@ -227,10 +228,10 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     if light_pos is None:
         l = v
     else:
-        l = _to_camera(np.asarray(light_pos) - point[hit], frame)
+        l = to_camera(np.asarray(light_pos) - point[hit], frame)
         l /= np.linalg.norm(l, axis=-1, keepdims=True)
     n = normal[hit]
-    lam = np.maximum(_dot(n, l), 0.0)
+    lam = np.maximum(dot4(n, l), 0.0)
     vis = terms[hit, 0] if terms is not None else np.ones(len(lam))
     ao = terms[hit, 1] if terms is not None else np.ones(len(lam))
     if lut is not None:
@@ -241,21 +242,21 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     else:
         base = np.asarray(color)[None, :]
     def lit(l, vis):
-        lam = np.maximum(_dot(n, l), 0.0)
+        lam = np.maximum(dot4(n, l), 0.0)
         out = base * (diffuse * vis * lam)[:, None]
         if specular > 0:
             hv = l + v
             hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
-            spec = np.where(lam > 0, np.maximum(_dot(n, hv), 0.0) ** shininess, 0.0)
+            spec = np.where(lam > 0, np.maximum(dot4(n, hv), 0.0) ** shininess, 0.0)
             out = out + (vis * specular * spec)[:, None]
         return out
 
     rgb = base * (ambient * ao)[:, None] * np.asarray(sky)[None, :] + lit(l, vis) * np.asarray(light_color)[None, :]
     for j in range(0 if lights_geo is None else len(lights_geo)):
         if lights_rgb[j, 3] != 0:
-            lj = np.broadcast_to(_to_camera(np.asarray(lights_geo[j])[None, :], frame), p.shape)
+            lj = np.broadcast_to(to_camera(np.asarray(lights_geo[j])[None, :], frame), p.shape)
         else:
-            lj = _to_camera(np.asarray(lights_geo[j]) - point[hit], frame)
+            lj = to_camera(np.asarray(lights_geo[j]) - point[hit], frame)
         ln = np.linalg.norm(lj, axis=-1, keepdims=True)
         lj = np.where(ln > 0, lj / np.where(ln > 0, ln, 1), v)
         vj = vis_extra[hit, j] if vis_extra is not None else np.ones(len(lam))
@@ -285,7 +286,7 @@ def reflect_rays(point, normal, status, frame: Frame, bias, radius):
     d = point[k] - frame.position
     dl = np.linalg.norm(d, axis=-1, keepdims=True)
     d = np.where(dl > 0, d / np.where(dl > 0, dl, 1), frame.forward)
-    r = d - 2 * _dot(d, nw)[:, None] * nw
+    r = d - 2 * dot4(d, nw)[:, None] * nw
     rl = np.linalg.norm(r, axis=-1, keepdims=True)
     dirs[k] = np.where(rl > 0, r / np.where(rl > 0, rl, 1), -d)
     origins[k] = point[k] + bias * nw
@@ -310,7 +311,7 @@ def reflect_color(status, normal, point, dirs, frame: Frame, light_pos, color, b
         l = np.asarray(light_pos, np.float64) - point[k]
         ll = np.linalg.norm(l, axis=-1, keepdims=True)
         l = np.where(ll > 0, l / np.where(ll > 0, ll, 1), -dirs[k])
-    lam = np.maximum(_dot(nw, l), 0.0)
+    lam = np.maximum(dot4(nw, l), 0.0)
     out[k, :3] = np.asarray(color) * (ambient * np.asarray(sky) + diffuse * lam[:, None] * np.asarray(light_color))
     out[k, 3] = 1.0
     return out

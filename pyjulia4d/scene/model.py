@@ -363,7 +363,7 @@ def check_light(light: "Light") -> None:
                 object.__setattr__(light, name, checked)
 
 
-def apply_quality(march: dict[str, Any], keep: set[str]) -> None:
+def fill_preset(march: dict[str, Any], keep: set[str]) -> None:
     """Set the preset's march values for ``march["quality"]``, except the keys in ``keep``."""
     if "quality" not in march:
         return
@@ -433,14 +433,14 @@ class Scene:
                 raw[section][key] = value
         # A quality preset fills the march keys the same source does not set itself;
         # a later source (an override) wins over an earlier one.
-        apply_quality(raw["march"], keep=set(raw["march"]))
+        fill_preset(raw["march"], keep=set(raw["march"]))
         if isinstance(overrides, str):  # a lone string would be iterated per character
             overrides = [overrides]
         for text in overrides:
             section, key, value = parse_override(text, CHECKS)
             raw[section][key] = value
             if (section, key) == ("march", "quality"):
-                apply_quality(raw["march"], keep=set())
+                fill_preset(raw["march"], keep=set())
         # No camera position given: nothing says where the set is, so frame it (a default
         # camera cuts off or shrinks to a speck many sets); a given position is kept as is.
         if "position" not in raw["camera"] and "fit" not in raw["camera"]:

@@ -71,10 +71,7 @@ A scene with fewer than ~100 hit pixels has its p99 set by one or two pixels.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # scene.py imports this module for the presets
-    from pyjulia4d.scene.model import Scene
+from typing import Any
 
 QUALITIES = ("custom", "draft", "normal", "final")
 
@@ -118,8 +115,8 @@ def preset_overrides(quality: str) -> list[str]:
     return [f"march.{k}={v}" for k, v in preset_values(quality).items()]
 
 
-def apply_quality(scene: Scene, quality: str) -> Scene:
-    """``scene`` with ``march.quality`` set to ``quality``: the preset's method,
+def apply_quality(scene: Any, quality: str) -> Any:
+    """``scene`` (a scene.model.Scene, which imports this module for the presets) with ``march.quality`` set to ``quality``: the preset's method,
     z_resolution, post_steps, epsilon and refine replace the scene's ("custom" changes nothing)."""
     if quality == "custom":
         return scene

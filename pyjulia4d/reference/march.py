@@ -1,0 +1,211 @@
+"""Twin of kernels/march/: refine.cl (the certified bracket), fixed.cl and de.cl (the
+marches along one ray) and march.cl (every ray of an image, with clip planes)."""
+from __future__ import annotations
+
+import numpy as np
+
+from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, STATUS_HIT, STATUS_MISS
+from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
+from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula, julia_inside, julia_level
+
+def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None,
+                   formula: Formula = QUATERNION_SQR):
+    """Narrow certified brackets [a (outside), b (inside)] on rays o + t d with ``steps``
+    set tests: ITP on the level function julia_level (``itp``) or bisection (seed 000
+    §7.1 eq. 11-12, every point classified); both stop where the bracket cannot be split.
+    Both guarantee width <= (b - a) / 2^steps, ITP with at most one more set test.
+    Returns (a, b - a): the outside end is the depth, the crossing lies within the width
+    behind it (march/refine.cl).  ``tests`` (int array, optional) gets the set tests each ray took
+    (ITP's two end-point level evaluations not counted)."""
+    a = np.array(a, np.float64)
+    b = np.array(b, np.float64)
+    pt = lambda k, t: o[k] + t[:, None] * d[k]
+    if itp:
+        k = np.arange(len(a))
+        fa, _ = julia_level(pt(k, a), c, max_iter, bailout, formula)
+        fb, _ = julia_level(pt(k, b), c, max_iter, bailout, formula)
+        ya, yb = -np.maximum(fa, REAL_MIN), -np.minimum(fb, 0.0)
+        w0 = b - a
+        eps = np.ldexp(w0, -(steps + 1))
+        k1 = 0.2 / np.where(w0 > 0, w0, 1.0)
+    live = np.ones(len(a), bool)
+    for j in range(steps + 1 if itp else steps):
+        if itp:
+            live &= b - a > 2 * eps
+        xh = 0.5 * (a + b)
+        live &= (xh > a) & (xh < b)
+        k = np.nonzero(live)[0]
+        if k.size == 0:
+            break
+        if tests is not None:
+            tests[k] += 1
+        if itp:
+            ak, bk, yak, ybk, xhk = a[k], b[k], ya[k], yb[k], xh[k]
+            r = np.ldexp(eps[k], steps + 1 - j) - 0.5 * (bk - ak)
+            delta = k1[k] * (bk - ak) ** 2
+            with np.errstate(invalid="ignore", divide="ignore"):
+                xf = np.where(ybk != yak, (ybk * ak - yak * bk) / (ybk - yak), xhk)
+            sigma = np.where(xhk >= xf, 1.0, -1.0)
+            xt = np.where(delta <= np.abs(xhk - xf), xf + sigma * delta, xhk)
+            x = np.where(np.abs(xt - xhk) <= r, xt, xhk - sigma * r)
+            x = np.where((x > ak) & (x < bk), x, xhk)
+            f, ins = julia_level(pt(k, x), c, max_iter, bailout, formula)
+            y = -f
+            b[k] = np.where(ins, x, bk)
+            yb[k] = np.where(ins, np.maximum(y, 0.0), ybk)
+            a[k] = np.where(ins, ak, x)
+            ya[k] = np.where(ins, yak, np.minimum(y, -REAL_MIN))
+        else:
+            x = xh[k]
+            ins = julia_inside(pt(k, x), c, max_iter, bailout, formula)
+            b[k] = np.where(ins, x, b[k])
+            a[k] = np.where(ins, a[k], x)
+    return a, b - a
+
+
+# ---------------------------------------------------- march/fixed.cl / march/de.cl
+
+def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
+                itp=True, formula: Formula = QUATERNION_SQR):
+    """Fixed z-resolution scan (seed 000 §3): the first inside sample and the one before it
+    are the certified bracket, refined by refine_bracket; a hit at the first sample is near
+    itself, width 0.  Returns (t, status, samples, flags, width)."""
+    n = len(o)
+    h = (far - near) / z_resolution
+    t = np.full(n, np.inf)
+    width = np.full(n, np.inf)
+    status = np.full(n, STATUS_MISS, np.int32)
+    samples = np.full(n, z_resolution + 1, np.int32)
+    first = np.zeros(n, bool)
+    active = np.ones(n, bool)
+    for i in range(z_resolution + 1):
+        idx = np.nonzero(active)[0]
+        if idx.size == 0:
+            break
+        ti = near[idx] + i * h[idx]
+        inside = julia_inside(o[idx] + ti[:, None] * d[idx], c, max_iter, bailout, formula)
+        got = idx[inside]
+        t[got] = ti[inside]
+        status[got] = STATUS_HIT
+        samples[got] = i + 1
+        first[got] = i == 0
+        active[got] = False
+    width[first] = 0.0
+    k = np.nonzero((status == STATUS_HIT) & ~first)[0]
+    if k.size:
+        # the kernel's t_prev is near + (i - 1) h, computed as such (not t - h)
+        t_prev = near[k] + (samples[k] - 2) * h[k]
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev, t[k], post_steps, c, max_iter, bailout, itp,
+                                        formula=formula)
+    return t, status, samples, np.zeros(n, np.int32), width
+
+
+def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
+             itp=True, formula: Formula = QUATERNION_SQR):
+    """r_{n+1} = r_n + max(d(r_n), eps) (seed 001 §3.2 eq. 9) until a point is inside (its
+    orbit never escaped); with the previous point, the certified bracket refined by
+    refine_bracket.  A step that rounds away (t + step == t) becomes one ulp of t
+    (GUARD_ULP_STEP); a ray that came within epsilon by the estimate and never got inside
+    is a miss flagged GUARD_SHELL_MISS (march/de.cl).  Returns (t, status, samples, flags, width)."""
+    n = len(o)
+    t = near.copy()
+    t_prev = near.copy()
+    width = np.full(n, np.inf)
+    status = np.full(n, STATUS_CAPPED, np.int32)
+    samples = np.full(n, max_steps, np.int32)
+    flags = np.zeros(n, np.int32)
+    shell = np.zeros(n, bool)
+    active = np.ones(n, bool)
+    bracketed = np.zeros(n, bool)
+    for i in range(max_steps):
+        idx = np.nonzero(active)[0]
+        if idx.size == 0:
+            break
+        out = t[idx] > far[idx]
+        gone = idx[out]
+        status[gone] = STATUS_MISS
+        samples[gone] = i
+        flags[gone[shell[gone]]] |= GUARD_SHELL_MISS
+        active[gone] = False
+        idx = idx[~out]
+        dist, escaped = julia_distance_formula(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout, formula)
+        hit = ~escaped
+        got = idx[hit]
+        status[got] = STATUS_HIT
+        samples[got] = i + 1
+        active[got] = False
+        if i == 0:
+            width[got] = 0.0
+        else:
+            bracketed[got] = True
+        k = idx[~hit]
+        shell[k] |= dist[~hit] < epsilon
+        t_prev[k] = t[k]
+        t[k] = t[k] + np.maximum(dist[~hit], epsilon)
+        stall = k[t[k] == t_prev[k]]
+        t[stall] = np.nextafter(t_prev[stall], np.inf)
+        flags[stall] |= GUARD_ULP_STEP
+    k = np.nonzero(bracketed)[0]
+    if k.size:
+        t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp,
+                                        formula=formula)
+    t[status != STATUS_HIT] = np.inf
+    return t, status, samples, flags, width
+
+
+# --------------------------------------------------------------------- march/march.cl
+
+def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
+          z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
+          formula: Formula = QUATERNION_SQR, clip=None):
+    """Clip each ray to the bounding 4-ball (and the ``clip`` half-spaces m . x <= e, world
+    space: camera.clip_planes), then march; returns (depth, point, status, samples).  A hit
+    at the first point of an interval a plane started is on its cut face: flags get
+    FLAG_CUT_FACE | k << 5.
+    ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
+    ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere)."""
+    o = np.asarray(origins, np.float64)
+    d = np.asarray(dirs, np.float64)
+    b = dot4(o, d)
+    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye (march/march.cl)
+    perp = o - b[:, None] * d
+    disc = radius * radius - dot4(perp, perp)
+    s = np.sqrt(np.maximum(disc, 0.0))
+    near = np.maximum(-b - s, 0.0)
+    far = -b + s
+    if near_set >= 0:
+        near = np.full_like(near, near_set)
+    if far_set >= 0:
+        far = np.full_like(far, far_set)
+    live = disc >= 0
+    cut = np.zeros(len(o), np.int64)      # 1 + the plane that set near (march.cl, -D CLIP)
+    for k, (m, off) in enumerate(clip or ()):
+        dn, on = d @ m, o @ m - off
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tp = -on / dn
+        far = np.where(dn > 0, np.minimum(far, tp), far)
+        raise_ = (dn < 0) & (tp > near)
+        near = np.where(raise_, tp, near)
+        cut = np.where(raise_, k + 1, cut)
+        live &= ~((dn == 0) & (on > 0))
+    live &= far >= near
+    n = len(o)
+    depth = np.full(n, np.inf)
+    status = np.full(n, STATUS_MISS, np.int32)
+    samples = np.zeros(n, np.int32)
+    k = np.nonzero(live)[0]
+    if k.size:
+        fn = march_fixed if method == "fixed" else march_de
+        depth[k], status[k], samples[k], fl, wd = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
+                                                     epsilon, z_resolution, post_steps, max_steps,
+                                                     refine == "itp", formula)
+        if flags is not None:
+            flags[k] |= fl
+            face = (status[k] == STATUS_HIT) & (wd == 0) & (cut[k] > 0)
+            flags[k[face]] |= FLAG_CUT_FACE | ((cut[k[face]] - 1) << 5)
+        if bracket is not None:
+            bracket[:] = np.inf
+            bracket[k] = np.where(status[k] == STATUS_HIT, wd, np.inf)
+    depth[status != STATUS_HIT] = np.inf
+    point = np.where((status == STATUS_HIT)[:, None], o + np.where(np.isfinite(depth), depth, 0)[:, None] * d, np.nan)
+    return depth, point, status, samples
