@@ -175,13 +175,16 @@ def test_progress_total_is_the_adaptive_work(monkeypatch):
 
     bars = []
 
-    class Bar:   # the progress bar render() drives: its total and what it was told was done
-        def __init__(self, total, enabled):
+    class Bar:   # the progress render() drives (pipeline/progress.Progress): its total and what was done
+        def __init__(self, total, *args, **kwargs):
             self.total, self.n = total, 0
             bars.append(self)
 
-        def update(self, k):
+        def update(self, k, note=""):
             self.n += k
+
+        def set_total(self, total):
+            self.total = total
 
         def __enter__(self):
             return self
@@ -189,7 +192,7 @@ def test_progress_total_is_the_adaptive_work(monkeypatch):
         def __exit__(self, *exc):
             return None
 
-    monkeypatch.setattr(rmod, "_progress", Bar)
+    monkeypatch.setattr(rmod, "Progress", Bar)
     monkeypatch.setattr(antialias, "BLOCK", 8)   # blocks of background in a small image
     s = Scene.default().with_overrides(SMALL + ["image.samples=4", "image.adaptive=true"])
     render(s, calibrate=False)

@@ -250,8 +250,8 @@ def test_object_transform_is_the_inverse_camera_transform(tmp_path, capsys, mods
     rc, out, err = _import(tmp_path, CAMERA + DOC_JULIA.replace("precision 15", f"precision 15 {mods}"), capsys)
     assert rc == 0, err
     s = Scene.from_toml(out)
-    from pyjulia4d.interop.povray import _Reader
-    r = _Reader(tokenize(f"julia_fractal {{ <0,0,0,0> {mods} }}", "t"), "t", 640, 480)
+    from pyjulia4d.interop.povray import SceneReader
+    r = SceneReader(tokenize(f"julia_fractal {{ <0,0,0,0> {mods} }}", "t"), "t", 640, 480)
     r.run()
     tr = r.julias[0].transform
     rng = np.random.default_rng(5)

@@ -16,7 +16,6 @@ import contextlib
 import math
 import os
 import re
-import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -25,6 +24,8 @@ from typing import Any, Callable, Iterable, Sequence
 
 from pyjulia4d.app.output import (NAME_MAX, OutputError, atomic_write, check_output_path, path_limit, read_header,
                                   shown_path, temp_affixes)
+from pyjulia4d.pipeline.progress import Progress
+from pyjulia4d.pipeline.result import add_counts
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.keyframes import Animation
 
@@ -134,33 +135,8 @@ def _check_scenes(anim: Animation, frames: range, device: Any, force: bool, outp
         warnings.warn(msg + more, RuntimeWarning, stacklevel=3)
 
 
-class _Progress:
-    """Frames done with an ETA: a tqdm bar on a terminal, a line at most every 10 s elsewhere."""
-
-    def __init__(self, total: int, enabled: bool):
-        self.total, self.n, self.enabled = total, 0, enabled
-        self.tty = hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
-        self.t0 = self.last = time.perf_counter()
-        self.bar = None
-        if enabled and self.tty:
-            from tqdm import tqdm
-            self.bar = tqdm(total=total, unit="frame", desc="animate", file=sys.stderr, leave=False)
-
-    def update(self, n: int) -> None:
-        self.n += 1
-        if self.bar is not None:
-            self.bar.update(1)
-            return
-        now = time.perf_counter()
-        if self.enabled and now - self.last >= 10.0 and self.n < self.total:
-            self.last = now
-            eta = (now - self.t0) * (self.total - self.n) / self.n
-            print(f"animate: frame {n} written, {self.n} of {self.total}, {now - self.t0:.0f} s, "
-                  f"about {eta:.0f} s left", file=sys.stderr, flush=True)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
+def _frame_line(n: int, total: int, spent: float, left: float, note: str) -> str:
+    return f"animate: frame {note} written, {n} of {total}, {spent:.0f} s, about {left:.0f} s left"
 
 
 def animate(anim: Animation, pattern: str, frames: Sequence[int] | None = None, video: str | None = None,
@@ -226,9 +202,8 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
         summary.devices.add(info.device)
         summary.programs_built += info.programs_built
         summary.capped += result.capped
-        for k, v in result.guards.items():
-            summary.guards[k] = summary.guards.get(k, 0) + v
-        bar.update(n)
+        add_counts(summary.guards, result.guards)
+        bar.update(1, note=str(n))
         if on_written is not None:
             on_written(n, paths[n])
 
@@ -255,7 +230,7 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
             f = distributed.fitted(client, anim.scene(0), device, force)
             anim = anim.with_camera(f.camera.position, f.camera.target)
             todo = todo_list(anim)
-        bar = _Progress(len(todo), progress)
+        bar = Progress(len(todo), "animate", "frame", enabled=progress, line=_frame_line, first=10.0, delay=0.0)
         try:
             distributed.render_many(client, todo, write, device=device, force=force)
         finally:

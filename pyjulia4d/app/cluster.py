@@ -27,6 +27,8 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
+from pyjulia4d.pipeline.progress import Progress
+from pyjulia4d.pipeline.result import RenderResult, add_counts
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 
@@ -95,11 +97,11 @@ def render_unit(scene: Scene, device: str | None = None, outputs=None, region=No
 
     t0 = time.perf_counter()
     dev = worker_device(device)
-    before = len(build._programs)
+    before = build.programs_built()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the client checked the scene and said its warnings
         result = render(scene, device=dev, force=force, outputs=outputs, region=region)
-    built = len(build._programs) - before
+    built = build.programs_built() - before
     if encode is not None:
         result = _encode(result, *encode)
     info = UnitInfo(worker=str(_worker_name()), pid=os.getpid(), device=dev.name.strip(),
@@ -299,18 +301,14 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
     spread over the cluster, assembled into one RenderResult equal bit for bit to
     render.render(scene) (each tile is a ``region`` render).  camera.fit is resolved once
     first, so that every tile sees the same camera."""
-    from tqdm import tqdm
-
     from pyjulia4d.pipeline.plan import TILE, make_tiles
-    from pyjulia4d.opencl.executor import RenderResult
     t0 = time.perf_counter()
     scene = fitted(client, scene, device, force)
     W, H = scene.image.width, scene.image.height
     regions = [(t.x0, t.y0, t.w, t.h) for t in make_tiles(W, H, tile or TILE)]
     parts: dict[tuple, Any] = {}
     infos: list[UnitInfo] = []
-    bar = tqdm(total=len(regions), unit="tile", desc="render", disable=not progress, leave=False,
-               delay=1.0)
+    bar = Progress(len(regions), "render", "tile", enabled=progress)   # lines, not a bar, in a log
 
     def got(region, result, info):
         parts[region] = result
@@ -336,10 +334,8 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
     counts: dict[str, int] = {}
     guards: dict[str, int] = {}
     for r in parts.values():
-        for k, v in r.counts.items():
-            counts[k] = counts.get(k, 0) + v
-        for k, v in r.guards.items():
-            guards[k] = guards.get(k, 0) + v
+        add_counts(counts, r.counts)
+        add_counts(guards, r.guards)
     names = sorted({r.device_name for r in parts.values()})
     nworkers = len({(i.worker, i.pid) for i in infos})
     where = (f" ({len(regions)} tile{'s' if len(regions) != 1 else ''} on {nworkers} "

@@ -21,6 +21,12 @@ from pyjulia4d.resources import cache_dir
 _programs: dict[tuple, cl.Program] = {}
 
 
+def programs_built() -> int:
+    """How many programs this process has built or loaded (a cluster worker reports how many
+    a unit added: none, once it has them)."""
+    return len(_programs)
+
+
 def _from_binary(ctx: cl.Context, dev: cl.Device, path, opts) -> cl.Program | None:
     """The program from a cached binary, or None (none cached, or it no longer loads)."""
     try:

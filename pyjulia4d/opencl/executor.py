@@ -8,13 +8,11 @@ kernels of one run while the host files the other, with no finish() between them
 from __future__ import annotations
 
 import dataclasses
-import sys
 import time
 
 import numpy as np
 import pyopencl as cl
 import pyopencl.array as cla
-from tqdm import tqdm
 
 from pyjulia4d.pipeline import antialias, colormap
 from pyjulia4d.opencl import build
@@ -25,8 +23,9 @@ from pyjulia4d.geometry.camera import clip_planes, extra_lights
 from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, judge, predict, tile_side
 from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, fog_start, gradient_step, light_parameters, make_plan,  # noqa: F401
                    make_tiles)  # (TILE, make_tiles: API)
+from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
-from pyjulia4d.pipeline.result import RenderResult, count_guards
+from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 
@@ -371,7 +370,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             keeps busy: each probe block is one work-group, run by one of them."""
             events: list = []
             probe = TileRunner(dataclasses.replace(plan, tiles=tiles), dev)
-            _run_tiles(probe, tiles, lambda t, got: None, events, _NoProgress())
+            _run_tiles(probe, tiles, lambda t, got: None, events, silent())
             big = max(plan.tiles, key=lambda t: t.n)
             groups = -(-march_items(big.n, big.aw, plan.lanes) // local_size(probe.march_k, dev))
             return _seconds(events) / max(1, min(dev.max_compute_units, groups))
@@ -402,10 +401,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
             counts[name] += int(np.count_nonzero(st == code))
         guard = got["flags"][own]
-        if "normal" in got:  # guard flags (kernels/real.cl): the march's buffer and the normals' w
+        if "normal" in got:  # guard flags (kernels/codes.cl): the march's buffer and the normals' w
             guard = guard | got["normal"][own][..., 3].astype(np.int32)
-        for k, v in count_guards(st, got["depth"][own], guard).items():
-            guards[k] = guards.get(k, 0) + v
+        add_counts(guards, count_guards(st, got["depth"][own], guard))
         if "color" in keep:
             img["color"][dst] = got["rgba"][own][..., :3]
         if "alpha" in keep:
@@ -444,7 +442,8 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
             file(t, got)
             note(t, got)
 
-    with _progress(W * H * (1 + S if aa else 1), progress) as bar:
+    with Progress(W * H * (1 + S if aa else 1), "render", "px", enabled=progress, line=_render_line,
+                  unit_scale=True) as bar:
         # the centre of each pixel: every output (depth, normal, position come from it)
         _run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
         if aa:
@@ -463,7 +462,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
                 flags = antialias.flag_edges(centre_c, centre_a)[ry - ey0:ry - ey0 + H, rx - ex0:rx - ex0 + W]
                 tiles = antialias.block_tiles(flags, plan.region, IW, IH, plan.halo,
                                               max(t.n for t in plan.tiles))
-                _set_total(bar, W * H + sum(t.w * t.h for t in ring) + S * sum(t.w * t.h for t in tiles))
+                bar.set_total(W * H + sum(t.w * t.h for t in ring) + S * sum(t.w * t.h for t in tiles))
             crunner = TileRunner(dataclasses.replace(cplan, tiles=tiles), dev) if tiles else None
             acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
             acc_a = np.zeros((H, W), np.float32)
@@ -506,50 +505,8 @@ def _centre_values(got: dict[str, np.ndarray], own, shaded: bool):
     return None, (got["status"][own] == STATUS_HIT).astype(np.float32)
 
 
-def _set_total(bar, total: int) -> None:
-    """The progress bar's total, once the adaptive passes' work is known."""
-    bar.total = total
-    if hasattr(bar, "refresh"):
-        bar.refresh()
-
-
-class _LineProgress:
-    """Progress for a stderr that is not a terminal (a log file, a pipe): whole lines, the
-    first after ``first`` seconds (none for renders shorter than that), then at most one per
-    ``every`` seconds - no carriage returns."""
-
-    def __init__(self, total: int, every: float = 10.0, first: float = 3.0):
-        self.total, self.every, self.n = total, every, 0
-        self.t0 = time.perf_counter()
-        self.last = self.t0 - every + first
-
-    def update(self, k: int) -> None:
-        self.n += k
-        now = time.perf_counter()
-        if now - self.last >= self.every and self.n < self.total:
-            self.last = now
-            eta = (now - self.t0) * (self.total - self.n) / max(self.n, 1)
-            print(f"render: {100 * self.n / self.total:.0f}% of {self.total} pixels, "
-                  f"{now - self.t0:.0f} s, about {eta:.0f} s left", file=sys.stderr, flush=True)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
-
-
-class _NoProgress:
-    def update(self, k: int) -> None:
-        pass
-
-
-def _progress(total: int, enabled: bool):
-    """A tqdm bar on a terminal, plain lines elsewhere (or nothing when not ``enabled``)."""
-    if enabled and not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
-        return _LineProgress(total)
-    return tqdm(total=total, unit="px", unit_scale=True, file=sys.stderr, delay=1.0, leave=False,
-                disable=not enabled, desc="render")
+def _render_line(n: int, total: int, spent: float, left: float, note: str) -> str:
+    return f"render: {100 * n / total:.0f}% of {total} pixels, {spent:.0f} s, about {left:.0f} s left"
 
 
 def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample: int = 0,

@@ -145,6 +145,14 @@ class RenderResult:
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
 
 
+def add_counts(total: dict[str, int], more: dict[str, int]) -> dict[str, int]:
+    """Add ``more``'s pixel counts (by status, or by guard) into ``total``; returns it.  One
+    render's tiles, one frame's cluster tiles and an animation's frames are summed by it."""
+    for k, v in more.items():
+        total[k] = total.get(k, 0) + v
+    return total
+
+
 def count_guards(status, depth, guard) -> dict[str, int]:
     """Pixels each numerical guard fired on (nothing clamped without being counted).
     ``guard`` holds the flags (kernels/codes.cl) of the march kernel's flags buffer ORed

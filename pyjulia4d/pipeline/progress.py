@@ -1,0 +1,62 @@
+"""Progress on stderr, written once for renders, animations and the cluster's tiles: a tqdm
+bar on a terminal; on a file or a pipe (a log) whole lines instead - the first after
+``first`` seconds (none for work shorter than that), then at most one per ``every`` seconds,
+never a carriage return; nothing when not enabled."""
+from __future__ import annotations
+
+import sys
+import time
+from typing import Callable
+
+from tqdm import tqdm
+
+# line(n done, total, seconds so far, seconds left, note) -> the text of one progress line
+LineText = Callable[[int, int, float, float, str], str]
+
+
+class Progress:
+    def __init__(self, total: int, desc: str, unit: str, enabled: bool = True, line: LineText | None = None,
+                 first: float = 3.0, every: float = 10.0, unit_scale: bool = False, delay: float = 1.0) -> None:
+        self.total, self.n, self.enabled, self.every = total, 0, enabled, every
+        self.t0 = time.perf_counter()
+        self.last = self.t0 - every + first
+        self.line = line or (lambda n, total, spent, left, note:
+                             f"{desc}: {n} of {total} {unit}s, {spent:.0f} s, about {left:.0f} s left")
+        tty = hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
+        self.bar = (tqdm(total=total, unit=unit, unit_scale=unit_scale, file=sys.stderr, delay=delay,
+                         leave=False, desc=desc) if enabled and tty else None)
+
+    def update(self, k: int = 1, note: str = "") -> None:
+        self.n += k
+        if self.bar is not None:
+            self.bar.update(k)
+            return
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if now - self.last >= self.every and self.n < self.total:
+            self.last = now
+            left = (now - self.t0) * (self.total - self.n) / max(self.n, 1)
+            print(self.line(self.n, self.total, now - self.t0, left, note), file=sys.stderr, flush=True)
+
+    def set_total(self, total: int) -> None:
+        """A new total, once the work is known (antialiasing's adaptive passes)."""
+        self.total = total
+        if self.bar is not None:
+            self.bar.total = total
+            self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+    def __enter__(self) -> "Progress":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def silent() -> Progress:
+    """A Progress that shows nothing (the time probe's passes)."""
+    return Progress(0, "", "", enabled=False)
