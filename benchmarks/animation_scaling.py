@@ -32,7 +32,7 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 def _frames_run(client, anim, frames, out: Path):
     """(wall seconds, worker seconds summed) of rendering and writing ``frames``."""
     from pyjulia4d.app.cluster import render_many
-    from pyjulia4d.app.output import atomic_write
+    from pyjulia4d.files import atomic_write
 
     worker = []
 

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
-from pyjulia4d.app.output import (NAME_MAX, OutputError, atomic_write, check_output_path, path_limit, read_header,
-                                  shown_path, temp_affixes)
+from pyjulia4d.app.output import OutputError, check_output_path, read_header
+from pyjulia4d.files import NAME_MAX, atomic_write, path_limit, shown_path, temp_affixes
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import add_counts
 from pyjulia4d.scene.checks import SceneError
@@ -291,7 +291,7 @@ def strip(files: Sequence[str | os.PathLike], out: str | os.PathLike, columns: i
     import numpy as np
     from PIL import Image
 
-    from pyjulia4d.app.output import atomic_write
+    from pyjulia4d.files import atomic_write
     from pyjulia4d.app.video import read_frame
 
     imgs = [read_frame(f) for f in files]

@@ -15,7 +15,8 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from pyjulia4d.app.output import OutputError, atomic_write, quoted_path, shown_path, check_directory
+from pyjulia4d.app.output import OutputError, check_directory
+from pyjulia4d.files import atomic_write, quoted_path, shown_path
 
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 # H.264's constant rate factor and VP9's constant quality (lower is better; both about

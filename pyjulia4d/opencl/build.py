@@ -9,12 +9,12 @@ from source.
 from __future__ import annotations
 
 import hashlib
-import os
 
 import pyopencl as cl
 
 from pyjulia4d.opencl.devices import build, cannot_compile, compile_error, device_key
 from pyjulia4d.pipeline.kernel_config import KernelConfig, source
+from pyjulia4d.files import atomic_write
 from pyjulia4d.resources import cache_dir
 
 
@@ -46,9 +46,8 @@ def _save_binary(prg: cl.Program, path) -> None:
         if not binary:
             return
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.{os.getpid()}")
-        tmp.write_bytes(bytes(binary))
-        os.replace(tmp, path)
+        with atomic_write(path) as tmp:
+            tmp.write_bytes(bytes(binary))
     except (cl.Error, OSError):
         pass
 

@@ -13,7 +13,6 @@ driver version in ``~/.cache/pyjulia4d/lanes.json`` (``PYJULIA4D_CACHE`` moves i
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -21,6 +20,7 @@ from pathlib import Path
 import pyopencl as cl
 
 from pyjulia4d.opencl.devices import device_key, device_type
+from pyjulia4d.files import atomic_write
 from pyjulia4d.resources import cache_dir
 
 WIDTHS = (16, 8, 4)
@@ -98,9 +98,8 @@ def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
         known[key] = probe(device)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f".{path.name}.{os.getpid()}")
-            tmp.write_text(json.dumps(known, indent=1, sort_keys=True))
-            os.replace(tmp, path)
+            with atomic_write(path) as tmp:
+                tmp.write_text(json.dumps(known, indent=1, sort_keys=True))
         except OSError:
             pass  # an unwritable cache only costs the probe next time
     _memo[key] = int(known[key])

@@ -41,7 +41,7 @@ def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
 
 
 def read_pov(path: str | Path) -> str:
-    from pyjulia4d.app.output import shown_path
+    from pyjulia4d.files import shown_path
 
     where = shown_path(os.fspath(path))
     try:
@@ -60,7 +60,7 @@ def read_pov(path: str | Path) -> str:
 
 def import_pov(path: str | Path, width: int | None = None, height: int | None = None) -> Imported:
     """Read ``path`` and map its julia_fractal, camera and light to a pyjulia4d scene."""
-    from pyjulia4d.app.output import shown_path
+    from pyjulia4d.files import shown_path
 
     w, h = DEFAULT_SIZE if width is None and height is None else (width, height)
     if w is None or h is None:  # one given: the other keeps pyjulia4d's aspect ratio
@@ -85,7 +85,8 @@ def import_pov(path: str | Path, width: int | None = None, height: int | None = 
 def check_toml_path(path: str | Path, source: str | Path) -> Path:
     """Fail before writing if ``path`` cannot take the scene file (output.check_output_path's
     checks, for .toml)."""
-    from pyjulia4d.app.output import NAME_MAX, OutputError, path_limit, quoted_path, shown_path, check_directory
+    from pyjulia4d.app.output import OutputError, check_directory
+    from pyjulia4d.files import NAME_MAX, path_limit, quoted_path, shown_path
 
     raw = os.fspath(path)
     shown = shown_path(raw)
@@ -121,7 +122,8 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
 
 def write_toml(path: Path, text: str) -> None:
     """Atomically (output.py's temp file beside it, renamed)."""
-    from pyjulia4d.app.output import OutputError, atomic_write
+    from pyjulia4d.app.output import OutputError
+    from pyjulia4d.files import atomic_write
 
     try:
         with atomic_write(path) as tmp:
