@@ -44,7 +44,7 @@ typedef struct {
 #define COUNTER_INIT(i)
 #endif
 
-/* Pixel status codes and guard flags: codes.cl (read by pyjulia4d/codes.py too). */
+/* Pixel status codes and guard flags: codes.cl (read by pyjulia4d/pipeline/codes.py too). */
 
 /* Lanes: the per-ray code is written once on these types.  LANES = 1 (the default) is one
  * ray per work-item, quat = real4 (GPUs, and the normals and shading everywhere); LANES = N

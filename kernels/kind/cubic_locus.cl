@@ -6,7 +6,7 @@
  * like the Julia sets.  p is inside when |p|^2 <= LOCUS_R2 (fractal.locus_radius^2: C+ is
  * unbounded - it holds every (a, a + 2 a^3), where +a is a fixed point - so it is drawn within
  * that 4-ball, cut by its sphere) and |z_n| <= bailout for n = 0 .. max_iter, z_0 = LOCUS_SIGN a
- * (+1: C+, -1: C-; fractal.component).  scene.py refuses a bailout below the escape radius of
+ * (+1: C+, -1: C-; fractal.component).  scene/rules.py refuses a bailout below the escape radius of
  * the maps in the ball (|z| > bailout then escapes), so the truncated set tends to C+.
  * No distance estimate is known (seed 001 §5.2): the fixed scan only; ALG_HAS_DE is undefined
  * (shadows and ambient occlusion test inside points).

@@ -105,7 +105,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
-    """--workers and --scheduler (pyjulia4d/distributed.py): Dask renders ``units``."""
+    """--workers and --scheduler (app/cluster.py): Dask renders ``units``."""
     p.add_argument("--workers", metavar="N",
                    help=f"render {units} on a local Dask cluster of N worker processes (0: in this "
                         f"process; animate's default: one per GPU, or 1 on a CPU)")

@@ -6,7 +6,7 @@ out which pixels are its own; seed 000_1dc675fe64448cc1.txt §10.1 calls ray tra
 "easily parallelized" and its work-pool over network clients unfinished.  Here the pool
 is Dask's: the scheduler hands out units, re-runs on another worker the units of a worker
 that dies, and returns every result to the client, which alone writes files.  A unit is a
-pure function of its scene (render.render, ``region`` for a tile): rendered twice it gives
+pure function of its scene (executor.render, ``region`` for a tile): rendered twice it gives
 the same bits, so a re-run unit changes nothing.  Each worker is a long-lived process that
 keeps its OpenCL context and built programs (render.queue_for, build.program) across the
 units it gets: a program is built once per worker, not once per frame (units report the
@@ -88,7 +88,7 @@ def worker_device(spec: str | None) -> Any:
 
 def render_unit(scene: Scene, device: str | None = None, outputs=None, region=None,
                 force: bool = False, encode: tuple[str, dict] | None = None) -> tuple[Any, UnitInfo]:
-    """One work unit: render.render of ``scene`` (its ``region`` alone for a tile) on the
+    """One work unit: executor.render of ``scene`` (its ``region`` alone for a tile) on the
     worker's device.  Returns the RenderResult - or, with ``encode`` = (".png" or ".exr",
     header), an EncodedImage of it, the header followed by the render's report - and a
     UnitInfo."""
@@ -174,7 +174,7 @@ def default_workers(device: str | None = None) -> int:
 def check_device(device: str | None, scheduler: str | None) -> Any:
     """The device workload.check estimates for before any frame renders: this machine's
     (it renders here, on its local cluster), or "GPU" for an existing cluster, whose workers
-    check again on their own devices (render.render does, before any kernel runs)."""
+    check again on their own devices (executor.render does, before any kernel runs)."""
     if scheduler is not None:
         return "GPU"
     from pyjulia4d.opencl.devices import select_device
@@ -299,7 +299,7 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
                  force: bool = False, tile: int | None = None, progress: bool = False):
     """One frame in tiles (plan.make_tiles: ``tile`` x ``tile`` pixels, default plan.TILE)
     spread over the cluster, assembled into one RenderResult equal bit for bit to
-    render.render(scene) (each tile is a ``region`` render).  camera.fit is resolved once
+    executor.render(scene) (each tile is a ``region`` render).  camera.fit is resolved once
     first, so that every tile sees the same camera."""
     from pyjulia4d.pipeline.plan import TILE, make_tiles
     t0 = time.perf_counter()

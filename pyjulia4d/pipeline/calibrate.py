@@ -68,13 +68,13 @@ def probe_tiles(plan: Plan) -> tuple:
 
 
 def passes(plan: Plan) -> int:
-    """Passes over every pixel: the centre, and image.samples colour passes (render.py)."""
+    """Passes over every pixel: the centre, and image.samples colour passes (opencl/executor.py)."""
     s = plan.scene.image.samples
     return 1 + s if s > 1 and {"color", "alpha"} & plan.outputs else 1
 
 
 def predict(plan: Plan, run_tiles) -> Prediction:
-    """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (render.py) and
+    """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (opencl/executor.py) and
     returns their kernel seconds; scaled to the region's pixels and the passes."""
     tiles = probe_tiles(plan)
     pixels = sum(t.w * t.h for t in tiles)

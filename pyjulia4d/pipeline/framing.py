@@ -45,7 +45,7 @@ def _within_reach(scene: Scene, eye: np.ndarray, radius: float, what: str) -> No
 
 def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     """The scene with camera.position and camera.target refitted (camera.fit then false),
-    and a record of the pass.  ``render_fn(scene, outputs)`` renders (render.render)."""
+    and a record of the pass.  ``render_fn(scene, outputs)`` renders (executor.render)."""
     fr = camera_frame(scene)
     radius = march_radius(scene)
     tan_v = fr.tan_half_fov

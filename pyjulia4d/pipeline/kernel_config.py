@@ -8,12 +8,11 @@ configurations, and build.py turns one into an OpenCL program.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-import math
-
+from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, KINDS_TABLE, MANDELBROT_START, march_method
 from pyjulia4d.resources import kernel_dir
-from pyjulia4d.fractal.registry import MANDELBROT_START, march_method
 from pyjulia4d.scene.model import Scene
 
 
@@ -25,17 +24,20 @@ class KernelConfig:
 
 
 def iteration_pieces(scene: Scene) -> tuple[str, ...]:
-    """codes.cl (status and guard codes), real.cl, complex arithmetic, the scene's one function (function/<name>.cl: a complex
-    function and its derivative) and one algebra (algebra/<name>.cl: the map q -> f(q) + c
-    built from them), the iteration."""
+    """codes.cl (status and guard codes), real.cl, complex arithmetic, the scene's one
+    function (function/<name>.cl: a complex function and its derivative) and one algebra
+    (algebra/<name>.cl: the map q -> f(q) + c built from them; a table algebra's powers from
+    algebra/power.cl), the iteration: the pieces the registry (fractal/registry.py) names."""
     f = scene.fractal
-    power = ("algebra/power",) if f.algebra in ("cquat", "commutative") else ()
+    algebra = ALGEBRAS_TABLE[f.algebra]
+    power = ("algebra/power",) if algebra.table else ()
     # fractal.theta != 0: the rotated map (kind/rotate.cl); fractal.kind other than "julia":
     # its set test after iterate.cl (kind/<kind>.cl, with kind/level.cl).  The default compiles
     # neither.
     rotate = ("kind/rotate",) if f.theta != 0 else ()
-    kind = ("kind/level", f"kind/{f.kind}") if f.kind != "julia" else ()
-    return (("codes", "real", "algebra/complex", f"function/{f.function}", f"algebra/{f.algebra}") + power
+    kind_piece = KINDS_TABLE[f.kind].piece
+    kind = ("kind/level", kind_piece) if kind_piece else ()
+    return (("codes", "real", "algebra/complex", FUNCTIONS_TABLE[f.function].piece, algebra.piece) + power
             + rotate + ("iterate",) + kind)
 
 

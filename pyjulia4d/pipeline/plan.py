@@ -4,7 +4,7 @@ scene -> plan -> tiles -> image.  ``make_plan`` checks the work and the memory
 (workload.py), resolves the 4D camera frame, the bounding radius, the light, the
 kernel configurations (build.py) and the tile list, and fixes which outputs are kept.
 A plan holds plain values (numbers, numpy vectors, the scene), so it can be pickled
-and a tile of it executed anywhere the same kernels build; render.py executes it.
+and a tile of it executed anywhere the same kernels build; opencl/executor.py executes it, and reference/executor.py in float64.
 """
 from __future__ import annotations
 
@@ -171,7 +171,7 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
 
 
 # ---------------------------------------------------------------- numbers the kernels take
-# (resolved here, once, for both executors: render.py's OpenCL one and the float64 reference)
+# (resolved here, once, for both executors: opencl/executor.py, the OpenCL one, and the float64 reference)
 
 GRADIENT_STEP_FLOOR = {"single": 1e-5, "double": 1e-8}
 

@@ -1,6 +1,6 @@
 """What a render returns (RenderResult): the image buffers, what the render cost, the
 guards that fired and the certified depth bracket; made by the OpenCL executor
-(render.render) and by the float64 reference (reference.render) alike, so it needs no
+(executor.render) and by the float64 reference (reference.render) alike, so it needs no
 OpenCL."""
 from __future__ import annotations
 

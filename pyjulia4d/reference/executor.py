@@ -27,7 +27,7 @@ def render(scene: Scene) -> RenderResult:
     > 1 the colour and alpha are the mean of S more passes through stratified samples of
     each pixel (rays.cl sample_offset); everything else comes from the pixel centres.  With
     image.adaptive, only the pixels flag_edges flags in the centre pass take that mean.
-    camera.fit frames the set as render.render does (framing.py), from a float64 first
+    camera.fit frames the set as executor.render does (framing.py), from a float64 first
     pass: the camera may differ from the kernels' in its last bits (their pass is float32),
     so compare with ``reference.render(result.scene)`` for the kernels' own camera."""
     t0 = time.perf_counter()

@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE
+
 
 @dataclass(frozen=True)
 class Formula:
@@ -29,13 +31,15 @@ class Formula:
     fn: Any = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        alg = importlib.import_module(f"{__package__}.algebra.{self.algebra}")
-        mod = importlib.import_module(f"{__package__}.function.{self.function}")
+        # the twins the registry names (fractal/registry.py), and the function's degree from it
+        alg = importlib.import_module(ALGEBRAS_TABLE[self.algebra].twin)
+        entry = FUNCTIONS_TABLE[self.function]
+        mod = importlib.import_module(entry.twin)
         if self.function == "pwr":
             p = complex(*self.exponent)
             fn = _Bound(functools.partial(mod.cfun, p=p), functools.partial(mod.cfun_d, p=p), None)
         else:
-            fn = _Bound(mod.cfun, mod.cfun_d, getattr(mod, "FUNC_POWER", None))
+            fn = _Bound(mod.cfun, mod.cfun_d, entry.degree)
         object.__setattr__(self, "alg", alg)
         object.__setattr__(self, "fn", fn)
 

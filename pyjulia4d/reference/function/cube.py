@@ -2,7 +2,7 @@
 "cube"), numpy's complex function (its branch cuts)."""
 import numpy as np  # noqa: F401
 
-FUNC_POWER = 3
+# its degree, FUNC_POWER in kernels/function/cube.cl: the registry's (fractal/registry.py)
 
 
 def cfun(z):

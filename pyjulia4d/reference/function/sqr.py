@@ -2,7 +2,7 @@
 "sqr"), numpy's complex function (its branch cuts)."""
 import numpy as np  # noqa: F401
 
-FUNC_POWER = 2
+# its degree, FUNC_POWER in kernels/function/sqr.cl: the registry's (fractal/registry.py)
 
 
 def cfun(z):

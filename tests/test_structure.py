@@ -1,0 +1,152 @@
+"""The package's shape holds: no import circles (late imports included), no private name
+imported across modules, no module far past 500 lines, the float64 reference importable
+without OpenCL, and a registry whose every entry names a kernel piece and a twin that
+exist (and every piece and twin has an entry)."""
+from __future__ import annotations
+
+import ast
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import pyjulia4d
+from pyjulia4d.fractal import registry
+from pyjulia4d.resources import kernel_dir
+
+PKG = Path(pyjulia4d.__file__).resolve().parent
+MOST_LINES = 600   # aim ~500; a module past this is doing more than one thing
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for p in PKG.rglob("*.py"):
+        parts = list(p.relative_to(PKG.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = p
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(name: str, path: Path) -> list[tuple[str, str]]:
+    """(imported module, imported name or "") for every import in the file, late ones too."""
+    tree = ast.parse(path.read_text())
+    pkg = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            for a in node.names:
+                out.append((target, a.name))
+        elif isinstance(node, ast.Import):
+            out.extend((a.name, "") for a in node.names)
+    return [(t, n) for t, n in out if t.split(".")[0] == "pyjulia4d"]
+
+
+def _graph() -> dict[str, set[str]]:
+    g: dict[str, set[str]] = {m: set() for m in MODULES}
+    for m, p in MODULES.items():
+        for target, name in _imports(m, p):
+            dep = f"{target}.{name}" if f"{target}.{name}" in MODULES else target
+            if dep in MODULES and dep != m:
+                g[m].add(dep)
+    return g
+
+
+def test_no_import_circles() -> None:
+    """Tarjan's strongly connected components of the import graph: all of size one.  The one
+    edge left out is a module's import from a package that contains it (``from pyjulia4d
+    import __version__`` in app/cli.py): Python has run that package's __init__ first anyway."""
+    g = _graph()
+    for m in g:
+        g[m] = {d for d in g[m] if not m.startswith(d + ".")}
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+    counter = [0]
+    sys.setrecursionlimit(max(10000, sys.getrecursionlimit()))
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in g[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in g:
+        if v not in index:
+            visit(v)
+    assert cycles == []
+
+
+def test_no_private_names_across_modules() -> None:
+    bad = [(m, t, n) for m, p in MODULES.items() for t, n in _imports(m, p)
+           if n.startswith("_") and not n.startswith("__")]
+    assert bad == []
+
+
+def test_modules_stay_small() -> None:
+    sizes = {m: len(p.read_text().splitlines()) for m, p in MODULES.items()}
+    assert {m: n for m, n in sizes.items() if n > MOST_LINES} == {}
+
+
+def test_reference_imports_without_opencl() -> None:
+    """pyjulia4d.reference is a second executor of the same plan: no pyopencl anywhere in
+    its imports (a blocked pyopencl fails any import of it)."""
+    code = ("import sys; sys.modules['pyopencl'] = None\n"
+            "import pyjulia4d.reference\n"
+            "from pyjulia4d import Scene\n"
+            "r = pyjulia4d.reference.render(Scene.default().with_overrides(['image.width=6', 'image.height=4']))\n"
+            "print(r.hit_fraction > 0)")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(PKG.parent), os.environ.get("PYTHONPATH")])))
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == "True"
+
+
+def test_registry_names_pieces_and_twins_that_exist() -> None:
+    import importlib
+
+    kd = kernel_dir()
+    for table in (registry.ALGEBRAS_TABLE, registry.FUNCTIONS_TABLE):
+        for entry in table.values():
+            assert (kd / f"{entry.piece}.cl").is_file(), entry
+            importlib.import_module(entry.twin)
+    for kind in registry.KINDS_TABLE.values():
+        if kind.piece:
+            assert (kd / f"{kind.piece}.cl").is_file(), kind
+    # every piece of algebra/ and function/ has its entry (power.cl and complex.cl are shared)
+    assert {p.stem for p in (kd / "function").glob("*.cl")} == set(registry.FUNCTIONS_TABLE)
+    assert {p.stem for p in (kd / "algebra").glob("*.cl")} - {"power", "complex"} == set(registry.ALGEBRAS_TABLE)
+
+
+@pytest.mark.parametrize("name", list(registry.FUNCTIONS_TABLE))
+def test_degree_is_the_pieces_own(name: str) -> None:
+    """A polynomial function's degree is stated twice by nature - in its piece, whose code is
+    that polynomial (#define FUNC_POWER), and in the registry; they must agree."""
+    text = (kernel_dir() / "function" / f"{name}.cl").read_text()
+    m = re.search(r"^#define FUNC_POWER (\d+)", text, re.M)
+    assert (int(m.group(1)) if m else None) == registry.FUNCTIONS_TABLE[name].degree
