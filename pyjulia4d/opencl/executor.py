@@ -19,15 +19,13 @@ from pyjulia4d.opencl import build
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.opencl.devices import has_fp64, select_device
 from pyjulia4d.opencl.lanes import lanes_for
-from pyjulia4d.geometry.camera import clip_planes, extra_lights
 from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, judge, predict, tile_side
-from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, fog_start, gradient_step, light_parameters, make_plan,  # noqa: F401
-                   make_tiles)  # (TILE, make_tiles: API)
-from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
+from pyjulia4d.pipeline.plan import TILE, Plan, Tile, gradient_step, make_plan, make_tiles
+from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
-from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.model import Scene
 
 
 _queues: dict[int, tuple[cl.Context, cl.CommandQueue]] = {}
@@ -148,7 +146,6 @@ class TileRunner:
         self.march_prg = (self.prg if plan.march_program == plan.program
                           else build.program(self.ctx, plan.march_program))
         self.pr = pr = Precision(plan.double)
-        sc, f, m, sh = plan.scene, plan.scene.fractal, plan.scene.march, plan.scene.shading
         nmax = max(t.n for t in plan.tiles)
         read = {"status", "flags", "depth", "bracket"} | {b for k in plan.outputs for b in _READ[k]}
         if plan.normals:
@@ -180,21 +177,21 @@ class TileRunner:
                                               else 1, cl.cltypes.float4)
             stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
             self.slots.append((bufs, stage))
-        fr = plan.frame
+        # the plan's argument records (pipeline/plan.py), in the order the kernels declare them
+        fr, ma, sa, la = plan.frame, plan.march, plan.shade, plan.light_args
         self.eye, self.fwd, self.right, self.up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
         self.camera = (self.eye, self.fwd, self.right, self.up, pr.scalar(fr.tan_half_fov),
-                       np.int32(sc.image.width), np.int32(sc.image.height))
-        self.march_const = (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(m.epsilon),
-                            pr.scalar(plan.radius), pr.scalar(plan.near), pr.scalar(plan.far),
-                            np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps))
-        self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(plan.light),
-                            _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
-                            _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-                            np.float32(sh.shininess))
-        self.fog = (np.float32(sh.fog), np.float32(fog_start(plan.frame.position, plan.radius)))
+                       np.int32(plan.scene.image.width), np.int32(plan.scene.image.height))
+        self.march_const = (pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
+                            pr.scalar(ma.radius), pr.scalar(ma.near), pr.scalar(ma.far),
+                            np.int32(ma.z_resolution), np.int32(ma.post_steps), np.int32(ma.max_steps))
+        self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(sa.light),
+                            _float4(sa.color), _float4(sa.background), _float4(sa.light_color),
+                            _float4(sa.sky), np.float32(sa.ambient), np.float32(sa.diffuse), np.float32(sa.specular),
+                            np.float32(sa.shininess))
+        self.fog = (np.float32(sa.fog), np.float32(sa.fog_start))
         self.march_k = cl.Kernel(self.march_prg, "march")
-        # [clip]: the half-spaces in world space, as march.cl and march/clip.cl take them
-        planes = clip_planes(sc)
+        planes = plan.clip.planes
         self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
         self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
                           (pr.v4([planes[k][1] if k < len(planes) else 0.0 for k in range(4)]),)
@@ -204,23 +201,26 @@ class TileRunner:
         # shade/light.cl: in the march's packets where the march has them (kernel_config.march_config)
         self.light_k = (cl.Kernel(self.march_prg if plan.lanes > 1 else self.prg, "light_terms")
                         if plan.light_terms else None)
-        self.light_const = light_arguments(plan, pr) if plan.light_terms else ()
-        lut = (colormap.table(sh.colormap) if sh.coloring != "flat" else np.zeros((2, 4), np.float32))
+        self.light_const = ((pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
+                             self.right, self.up, self.fwd, pr.v4(sa.light), pr.scalar(ma.radius),
+                             pr.scalar(la.step), pr.scalar(la.bias), pr.scalar(la.softness), np.int32(la.max_steps),
+                             pr.scalar(la.ao_distance), pr.scalar(la.ao_strength), pr.v4(la.trap))
+                            if plan.light_terms else ())
+        lut = colormap.table(sa.colormap) if sa.colormap is not None else np.zeros((2, 4), np.float32)
         self.lut = cla.to_device(self.queue, lut.view(cl.cltypes.float4).ravel())
         self.n_lut = np.int32(len(lut))
         self.no_terms = cla.empty(self.queue, 1, cl.cltypes.float4)
-        # shading.lights (camera.extra_lights): positions or directions, colours; their
-        # visibility per pixel where shadows are traced (-D EXTRA_SHADOWS)
-        geo, rgb = extra_lights(sc)
-        self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in geo]))
-        self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in rgb]))
+        # shading.lights: positions or directions, colours; their visibility per pixel where
+        # shadows are traced (-D EXTRA_SHADOWS)
+        self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in sa.lights_geo]))
+        self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in sa.lights_rgb]))
         self.extra_shadows = "EXTRA_SHADOWS" in plan.program.defines
         if plan.reflects:
             self.refl_prg = build.program(self.ctx, plan.reflect_program)
             self.refl_march_k = cl.Kernel(self.refl_prg, "march")
             self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
             self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
-            self.refl_bias = pr.scalar(light_parameters(sc, plan.radius)["bias"])
+            self.refl_bias = pr.scalar(la.bias)
 
     def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
                 ) -> tuple[list[cl.Event], list[cl.Event]]:
@@ -250,8 +250,7 @@ class TileRunner:
             kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
                                   self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
-                                  bufs["vis_extra"].data,
-                                  lanes=plan.lanes))
+                                  bufs["vis_extra"].data, lanes=plan.lanes))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
@@ -259,7 +258,7 @@ class TileRunner:
             kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
                                   bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
                                   self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
-                                  vis_extra.data, refl.data, np.float32(plan.scene.shading.reflection),
+                                  vis_extra.data, refl.data, np.float32(plan.shade.reflection),
                                   bufs["rgba"].data))
         copies = [cl.enqueue_copy(q, stage[k][:n], bufs[k].data, is_blocking=False) for k in self.read]
         return kernels, copies
@@ -268,7 +267,7 @@ class TileRunner:
         """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
         march reading given rays, in the same packets), its normals and its colour."""
         plan, pr, q, n = self.plan, self.pr, self.queue, tile.n
-        sh = plan.scene.shading
+        sa = plan.shade
         ev = [launch(q, self.reflect_rays_k, n, bufs["point"].data, bufs["normal"].data, bufs["status"].data,
                      self.eye, self.right, self.up, self.fwd, self.refl_bias, pr.scalar(plan.radius),
                      bufs["origins"].data, bufs["dirs"].data)]
@@ -285,8 +284,8 @@ class TileRunner:
                              self.fwd, *self.clip_n, bufs["normal2"].data))
         ev.append(launch(q, self.reflect_color_k, n, bufs["status2"].data, bufs["normal2"].data,
                          bufs["point2"].data, bufs["dirs"].data, self.right, self.up, self.fwd,
-                         pr.v4(plan.light), _float4(sh.color), _float4(sh.background), _float4(sh.light_color),
-                         _float4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), bufs["refl"].data))
+                         pr.v4(sa.light), _float4(sa.color), _float4(sa.background), _float4(sa.light_color),
+                         _float4(sa.sky), np.float32(sa.ambient), np.float32(sa.diffuse), bufs["refl"].data))
         return ev
 
     def collect(self, tile: Tile, slot: int) -> dict[str, np.ndarray]:
@@ -304,17 +303,6 @@ class TileRunner:
             else:
                 out[k] = a.reshape(shape)
         return out
-
-
-def light_arguments(plan: Plan, pr: Precision) -> tuple:
-    """The light_terms kernel's arguments after the buffers (kernels/shade/light.cl)."""
-    sc, fr = plan.scene, plan.frame
-    f = sc.fractal
-    lp = light_parameters(sc, plan.radius)
-    return (pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout), pr.scalar(sc.march.epsilon),
-            pr.v4(fr.right), pr.v4(fr.up), pr.v4(fr.forward), pr.v4(plan.light), pr.scalar(plan.radius),
-            pr.scalar(lp["step"]), pr.scalar(lp["bias"]), pr.scalar(lp["softness"]), np.int32(lp["max_steps"]),
-            pr.scalar(lp["ao_distance"]), pr.scalar(lp["ao_strength"]), pr.v4(lp["trap"]))
 
 
 def _seconds(events) -> float:

@@ -15,7 +15,7 @@ import numpy as np
 
 from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.pipeline.workload import resolve_outputs
-from pyjulia4d.geometry.camera import Frame, camera_frame, light_position, march_radius
+from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.fractal.registry import march_method
 
@@ -70,15 +70,107 @@ def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0,
     return tuple(out)
 
 
+# ---------------------------------------------------------------- the kernels' argument records
+# What each kernel takes besides its buffers, resolved from the scene once, in float64: the
+# OpenCL executor casts them to the device's precision in the order the kernel declares
+# them; the float64 reference executes the same records.
+
+
+@dataclass(frozen=True)
+class MarchArgs:
+    """march/march.cl's constants (and the reflected rays' march, shade/reflect.cl)."""
+    c: tuple[float, float, float, float]
+    max_iter: int
+    bailout: float
+    epsilon: float
+    radius: float          # the bounding 4-ball (camera.march_radius)
+    near: float            # march.near, or -1 for "the ball's entry"
+    far: float             # march.far, or -1 for "the ball's exit"
+    z_resolution: int
+    post_steps: int
+    max_steps: int
+    method: str            # "fixed" or "de": march.method resolved (fractal/registry.march_method)
+    refine: str
+
+
+@dataclass(frozen=True)
+class ClipArgs:
+    """[clip]'s half-spaces in world space, as march.cl and march/clip.cl take them."""
+    planes: tuple[tuple[np.ndarray, float], ...]
+
+
+@dataclass(frozen=True)
+class NormalsArgs:
+    method: str            # "jacobian", "gradient" or "zbuffer"
+    step: float            # the gradient's difference step (gradient_step)
+
+
+@dataclass(frozen=True)
+class LightArgs:
+    """shade/light.cl's numbers (light_parameters): shadow rays, occlusion, the orbit trap."""
+    step: float
+    max_steps: int
+    bias: float
+    softness: float
+    ao_distance: float
+    ao_strength: float
+    trap: tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class ShadeArgs:
+    """shade/shade.cl's constants and shade/reflect.cl's colour."""
+    light: np.ndarray      # the positioned light in world space, or the eye
+    color: tuple[float, ...]
+    background: tuple[float, ...]
+    light_color: tuple[float, ...]
+    sky: tuple[float, ...]
+    ambient: float
+    diffuse: float
+    specular: float
+    shininess: float
+    fog: float
+    fog_start: float       # the eye's distance to the bounding ball (fog_start)
+    reflection: float
+    colormap: str | None   # shading.colormap where a colour map is used, else None
+    lights_geo: np.ndarray     # shading.lights (camera.extra_lights)
+    lights_rgb: np.ndarray
+
+
+def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
+    """The argument records of every kernel of ``scene`` (Plan's march, clip, normals,
+    light_args, shade)."""
+    f, m, sh = scene.fractal, scene.march, scene.shading
+    lp = light_position(scene)
+    light = light_parameters(scene, radius)
+    geo, rgb = extra_lights(scene)
+    return dict(
+        march=MarchArgs(c=tuple(f.c), max_iter=f.max_iter, bailout=f.bailout, epsilon=m.epsilon, radius=radius,
+                        near=-1.0 if m.near == "auto" else float(m.near),
+                        far=-1.0 if m.far == "auto" else float(m.far), z_resolution=m.z_resolution,
+                        post_steps=m.post_steps, max_steps=m.max_steps, method=march_method(scene),
+                        refine=m.refine),
+        clip=ClipArgs(tuple(clip_planes(scene))),
+        normals=NormalsArgs(scene.normals.method, gradient_step(scene)),
+        light_args=LightArgs(**light),
+        shade=ShadeArgs(light=lp if lp is not None else frame.position, color=tuple(sh.color),
+                        background=tuple(sh.background), light_color=tuple(sh.light_color), sky=tuple(sh.sky),
+                        ambient=sh.ambient, diffuse=sh.diffuse, specular=sh.specular, shininess=sh.shininess,
+                        fog=sh.fog, fog_start=fog_start(frame.position, radius), reflection=sh.reflection,
+                        colormap=sh.colormap if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb))
+
+
 @dataclass(frozen=True)
 class Plan:
     """A scene resolved into what its kernels need (see the module docstring)."""
     scene: Scene
     frame: Frame
     radius: float                 # the march's bounding 4-ball (camera.march_radius)
-    light: np.ndarray             # positioned light in world space, or the eye
-    near: float                   # march.near, or -1 for "the ball's entry"
-    far: float                    # march.far, or -1 for "the ball's exit"
+    march: MarchArgs
+    clip: ClipArgs
+    normals_args: NormalsArgs
+    light_args: LightArgs
+    shade: ShadeArgs
     double: bool
     lanes: int                    # rays per work-item of the march (lanes.lanes_for)
     outputs: frozenset[str]
@@ -153,15 +245,13 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
     region = check_region(scene, region)
     kept = resolve_outputs(outputs)
     est = workload.check(scene, device, force=force, outputs=kept)
-    m = scene.march
-    lp = light_position(scene)
     frame = camera_frame(scene)
+    radius = march_radius(scene)
     halo = 1 if scene.normals.method == "zbuffer" and {"normal", "color"} & kept else 0
+    args = kernel_arguments(scene, frame, radius)
     return Plan(
-        scene=scene, frame=frame, radius=march_radius(scene),
-        light=lp if lp is not None else frame.position,
-        near=-1.0 if m.near == "auto" else float(m.near),
-        far=-1.0 if m.far == "auto" else float(m.far),
+        scene=scene, frame=frame, radius=radius, march=args["march"], clip=args["clip"],
+        normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
         program=kernel_config.scene_config(scene),
         march_program=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
