@@ -120,7 +120,8 @@ class LightArgs:
 @dataclass(frozen=True)
 class ShadeArgs:
     """shade/shade.cl's constants and shade/reflect.cl's colour."""
-    light: np.ndarray      # the positioned light in world space, or the eye
+    light: np.ndarray      # the positioned light in world space, or the eye (what the kernels take)
+    point_light: np.ndarray | None   # the positioned light, None for the light at the eye (-D LIGHT_POINT)
     color: tuple[float, ...]
     background: tuple[float, ...]
     light_color: tuple[float, ...]
@@ -153,7 +154,7 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
         clip=ClipArgs(tuple(clip_planes(scene))),
         normals=NormalsArgs(scene.normals.method, gradient_step(scene)),
         light_args=LightArgs(**light),
-        shade=ShadeArgs(light=lp if lp is not None else frame.position, color=tuple(sh.color),
+        shade=ShadeArgs(light=lp if lp is not None else frame.position, point_light=lp, color=tuple(sh.color),
                         background=tuple(sh.background), light_color=tuple(sh.light_color), sky=tuple(sh.sky),
                         ambient=sh.ambient, diffuse=sh.diffuse, specular=sh.specular, shininess=sh.shininess,
                         fog=sh.fog, fog_start=fog_start(frame.position, radius), reflection=sh.reflection,

@@ -5,7 +5,6 @@ import numpy as np
 
 from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.codes import STATUS_HIT
-from pyjulia4d.pipeline.plan import light_parameters
 # imported by the package at its end, once these are defined
 from pyjulia4d.reference.iterate import dot4, julia_distance_formula, julia_inside
 from pyjulia4d.reference.normals import to_camera
@@ -173,37 +172,26 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
     return out
 
 
-def extra_visibility_of_scene(scene, point, normal, status, F: Formula):
-    """extra_visibility with the scene's settings, or None without shadows or shading.lights."""
-    from pyjulia4d.geometry.camera import camera_frame, extra_lights, march_radius
-    sh = scene.shading
+def extra_visibility_of_plan(plan, point, normal, status, F: Formula):
+    """extra_visibility with the plan's records (pipeline/plan.py), or None without shadows
+    or shading.lights."""
+    sh, ma, la, sa = plan.scene.shading, plan.march, plan.light_args, plan.shade
     if sh.shadow == "none" or not sh.lights:
         return None
-    radius = march_radius(scene)
-    lp = light_parameters(scene, radius)
-    geo, rgb = extra_lights(scene)
-    f = scene.fractal
-    return extra_visibility(point, normal, status, camera_frame(scene), geo, rgb, f.c, f.max_iter, f.bailout,
-                            radius, lp["step"], lp["bias"], lp["softness"], lp["max_steps"], sh.shadow == "soft", F)
+    return extra_visibility(point, normal, status, plan.frame, sa.lights_geo, sa.lights_rgb, ma.c, ma.max_iter,
+                            ma.bailout, ma.radius, la.step, la.bias, la.softness, la.max_steps, sh.shadow == "soft", F)
 
 
-def light_terms_of_scene(scene, point, normal, status, bracket, F: Formula):
-    """light_terms with the scene's settings (render.light_parameters), or None when the
-    scene uses none of them."""
-    from pyjulia4d.geometry.camera import camera_frame, light_position, march_radius
-    sh = scene.shading
+def light_terms_of_plan(plan, point, normal, status, bracket, F: Formula):
+    """light_terms with the plan's records (LightArgs), or None when the scene uses none of
+    them."""
+    sh, ma, la, fr = plan.scene.shading, plan.march, plan.light_args, plan.frame
     shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # kernel_config.light_defines
     if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
         return None
-    fr = camera_frame(scene)
-    radius = march_radius(scene)
-    lp = light_parameters(scene, radius)
-    f = scene.fractal
-    light = light_position(scene)
-    return light_terms(point, normal, status, bracket, fr.position, f.c, f.max_iter, f.bailout, fr,
-                       light if light is not None else fr.position, radius, lp["step"], lp["bias"],
-                       lp["softness"], lp["max_steps"], lp["ao_distance"], lp["ao_strength"], lp["trap"],
-                       shadow, sh.ao > 0, sh.coloring, F, f.kind == "mandelbrot")
+    return light_terms(point, normal, status, bracket, fr.position, ma.c, ma.max_iter, ma.bailout, fr,
+                       plan.shade.light, ma.radius, la.step, la.bias, la.softness, la.max_steps, la.ao_distance,
+                       la.ao_strength, la.trap, shadow, sh.ao > 0, sh.coloring, F, plan.scene.fractal.kind == "mandelbrot")
 
 
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
