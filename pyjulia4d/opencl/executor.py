@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 
 import numpy as np
 import pyopencl as cl
@@ -19,7 +20,8 @@ from pyjulia4d.opencl import build
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.opencl.devices import has_fp64, select_device
 from pyjulia4d.opencl.lanes import lanes_for
-from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, judge, predict, tile_side
+from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
+from pyjulia4d.pipeline.framing import fit_camera
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.pipeline.plan import TILE, Plan, Tile, gradient_step, make_plan, make_tiles
 from pyjulia4d.pipeline.progress import Progress, silent
@@ -331,25 +333,35 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     dev = device if isinstance(device, cl.Device) else select_device(device)
+    plan, prediction = plan_render(scene, dev, lanes, outputs, force, tile, region, calibrate)
+    result = run_plan(plan, dev, progress)
+    result.prediction = prediction
+    result.seconds = time.perf_counter() - t_start
+    return result
+
+
+def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=None, force: bool = False,
+                tile: int = TILE, region=None, calibrate: bool = True) -> tuple[Plan, Prediction | None]:
+    """Planning, the steps before the render's tiles: refuse a double-precision scene on a
+    device without fp64; with camera.fit, refuse hopeless work, then place the camera from a
+    first pass (framing.py: the plan of a small probe image, run by run_plan); the packet
+    width (lanes.py); the plan (pipeline/plan.py); and, with ``calibrate``, the time
+    predicted from a probe of the plan's own kernels (calibrate.py: refuse, warn, retile).
+    Returns the plan and the prediction (None where none was made)."""
     double = scene.render.float == "double"
     if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
-    if scene.camera.fit:   # framing.py: a quick first pass places the camera
-        import warnings
-
-        from pyjulia4d.pipeline.framing import fit_camera
-
-        def first_pass(s: Scene, outs) -> RenderResult:
-            with warnings.catch_warnings():   # the render proper says them, once
-                warnings.simplefilter("ignore")
-                return render(s, device=dev, force=True, lanes=lanes, outputs=outs)
-
-        with warnings.catch_warnings():   # refuse before any pass runs; warn after it
-            warnings.simplefilter("ignore")
-            make_plan(scene, dev, lanes or 1, outputs=outputs, force=force, tile=tile, region=region)
-        scene, _ = fit_camera(scene, first_pass)
     if lanes is None:
         lanes = lanes_for(dev, scene.render.variant, double)
+    if scene.camera.fit:   # framing.py: a quick first pass places the camera
+        with warnings.catch_warnings():   # refuse before any pass runs; warn after it
+            warnings.simplefilter("ignore")
+            make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
+
+            def first_pass(s: Scene, outs) -> RenderResult:
+                return run_plan(make_plan(s, dev, lanes, outputs=outs, force=True), dev)
+
+            scene, _ = fit_camera(scene, first_pass)
     plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
     prediction = None
     if calibrate and plan.estimate.seconds > SKIP_BELOW_SECONDS:
@@ -368,6 +380,15 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         side = tile_side(prediction, tile)
         if side < tile:
             plan = plan.retile(side)
+    return plan, prediction
+
+
+def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult:
+    """Execute ``plan`` on ``dev``, tile by tile: its pixels through rays, march, normals and
+    shading, the antialiasing passes, filed into the image; the counts, guards and kernel
+    time go into the result (its ``seconds`` are the kernels' and the filing's)."""
+    t_start = time.perf_counter()
+    scene, lanes = plan.scene, plan.lanes
     runner = TileRunner(plan, dev)
     rx, ry, W, H = plan.region
     keep = plan.outputs
@@ -479,7 +500,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
         samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
         device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
-        guards=guards, scene=scene, prediction=prediction)
+        guards=guards, scene=scene)
     result.seconds = time.perf_counter() - t_start
     return result
 
