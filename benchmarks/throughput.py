@@ -2,7 +2,7 @@
 
 For each scene and precision it counts the iterations of f = q^2 + c that the march's set
 tests make - the same kernel source built with -D COUNT_ITERATIONS, which adds a per-ray
-counter (kernels/real.cl), summed on the host - and times the march kernel alone in the
+counter (kernels/common/lanes.cl), summed on the host - and times the march kernel alone in the
 normal build (median of --repeats after a warm-up launch, rays made once), one ray per
 work-item and in packets (the width pyjulia4d.lanes probes for the device, single
 precision), and in packets of rays shuffled across the image (what divergence costs:

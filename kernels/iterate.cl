@@ -1,5 +1,5 @@
 /* iterate.cl: the escape-time iteration and the distance estimate, on a lane type
- * (real.cl: one ray, or a packet of rays whose finished lanes are frozen).
+ * (common/lanes.cl: one ray, or a packet of rays whose finished lanes are frozen).
  *
  * A point p is inside when |q_n| <= bailout for n = 0 .. max_iter, with q_0 = p and
  * q_{n+1} = f(q_n) + c (seed 003: "none of the vectors in the sequence escapes";

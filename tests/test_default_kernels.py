@@ -27,7 +27,7 @@ from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.scene.model import Scene
 
 REFERENCE = Path(__file__).resolve().parent / "data" / "default_kernels.i"
-PIECES = ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate", "march/refine",
+PIECES = ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate", "march/refine",
           "march/de", "normals/jacobian")
 HEADER = "// tests/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)\n"
 
@@ -50,8 +50,8 @@ def preprocessed(config: kernel_config.KernelConfig) -> str:
 def test_default_scene_uses_the_pre_kinds_pieces_and_switches():
     cfg = kernel_config.march_config(Scene.default(), 1)
     # the iteration and the march as before the kinds (the shading pieces after them are its own),
-    # after codes.cl, which holds the status and guard codes real.cl defined before (#defines only)
-    assert cfg.pieces[:11] == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate",
+    # after common/codes.cl, which holds the status and guard codes common/lanes.cl defined before (#defines only)
+    assert cfg.pieces[:11] == ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate",
                                "march/refine", "march/de", "rays", "march/march", "normals/jacobian")
     assert not [p for p in cfg.pieces if p.startswith("kind/")]
     assert not [d for d in cfg.defines if d.startswith(("KIND_", "ROTATE_", "STACK_", "LOCUS_"))]

@@ -1,4 +1,4 @@
-"""iterate.cl (with real.cl, algebra/quaternion.cl, function/sqr.cl, through probe.cl)
+"""iterate.cl (with common/lanes.cl, algebra/quaternion.cl, function/sqr.cl, through probe.cl)
 against reference.julia_inside / julia_distance / julia_distance_formula."""
 import numpy as np
 import pytest

@@ -55,7 +55,7 @@ def test_default_compiles_todays_kernels():
     d = Scene.default()
     explicit = d.with_overrides(["fractal.kind=julia", "fractal.theta=0"])
     assert kernel_config.scene_config(explicit) == kernel_config.scene_config(d)
-    assert kernel_config.iteration_pieces(d) == ("codes", "real", "algebra/complex", "function/sqr", "algebra/quaternion",
+    assert kernel_config.iteration_pieces(d) == ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion",
                                          "iterate")
     assert kernel_config.fractal_defines(d) == ()
     src = kernel_config.source(kernel_config.scene_config(d))
@@ -208,7 +208,7 @@ def test_mandelbrot_render_matches_reference(over):
     ["fractal.theta=60", "fractal.function=cube", "fractal.c=0.3,0.4,0,0"],
 ])
 def test_new_kinds_packets_give_the_same_pixels(over, lanes):
-    # kind/*.cl on the lane types (real.cl): a packet of rays gives the one-ray pixels
+    # kind/*.cl on the lane types (common/lanes.cl): a packet of rays gives the one-ray pixels
     s = Scene.default().with_overrides(over + ["image.width=37", "image.height=29", "fractal.max_iter=10"])
     one, pk = render(s, lanes=1), render(s, lanes=lanes)
     assert np.mean(one.status == pk.status) >= 0.995

@@ -1,5 +1,5 @@
 """march.cl with march/fixed.cl / march/de.cl / march/refine.cl against reference.march, on
-identical rays, one ray per work-item and in packets of rays (kernels/real.cl, "Lanes")."""
+identical rays, one ray per work-item and in packets of rays (kernels/common/lanes.cl, "Lanes")."""
 import numpy as np
 import pytest
 
@@ -36,7 +36,7 @@ def run_march(s: Scene, lanes: int = 1):
     rflags = np.zeros(n, np.int32)
     rbracket = np.zeros(n)
     r = ref.march(o, d, *args, m.method, rflags, m.refine, rbracket) + (rbracket,)
-    # the guard flags (kernels/real.cl) agree wherever the statuses do
+    # the guard flags (kernels/common/codes.cl) agree wherever the statuses do
     same = k[2] == r[2]
     assert np.array_equal(flags.get()[same], rflags[same])
     return k, r

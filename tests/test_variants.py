@@ -1,4 +1,4 @@
-"""One source, two variants (kernels/real.cl, "Lanes"): the march run one ray per
+"""One source, two variants (kernels/common/lanes.cl, "Lanes"): the march run one ray per
 work-item and in packets of 4, 8 and 16 neighbouring rays must give the same pixels.
 
 Not bit for bit: the packet variant sums |q|^2 as four products where the one-ray variant

@@ -1,5 +1,5 @@
 /* algebra/complex.cl: complex arithmetic and the elementary complex functions on the lane
- * type (real.cl: one value, or a packet), for the function pieces (function/<name>.cl).
+ * type (common/lanes.cl: one value, or a packet), for the function pieces (function/<name>.cl).
  * Branch cuts are numpy's (C99's): log and sqrt principal (cut on the negative reals,
  * arg in (-pi, pi]); asin, acos, atanh cut on the reals outside [-1, 1]; asinh, atan on
  * the imaginary axis outside [-i, i]; acosh on the reals below 1; pwr through log.

@@ -23,7 +23,7 @@ inline real4 alg_mul(real4 a, real4 b)
 }
 
 /* q^2 = (q1^2 - q2^2 - q3^2 - q4^2, 2 q1 q2, 2 q1 q3, 2 q1 q4)  (seed 000, eq. 4), on a
- * lane type (real.cl): one ray or a packet of rays. */
+ * lane type (common/lanes.cl): one ray or a packet of rays. */
 inline quat alg_sqr(quat q)
 {
     return QUAT(q.x * q.x - q.y * q.y - q.z * q.z - q.w * q.w,

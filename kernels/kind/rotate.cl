@@ -14,7 +14,7 @@
  * Compiled between algebra/quaternion.cl and iterate.cl: every later piece iterates the
  * rotated map (julia_f and julia_f_jvp name it from here on). */
 
-/* u q, u = cos t + i sin t (and u^-1 q with s = -sin t), on a lane type (real.cl) */
+/* u q, u = cos t + i sin t (and u^-1 q with s = -sin t), on a lane type (common/lanes.cl) */
 inline quat rot_left(quat q, real co, real si)
 {
     return QUAT(co * q.x - si * q.y, co * q.y + si * q.x, co * q.z - si * q.w, co * q.w + si * q.z);

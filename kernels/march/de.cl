@@ -1,5 +1,5 @@
 /* march/de.cl: distance-estimate marching (seed 001 §3.2, eq. 9), on a lane type
- * (real.cl):
+ * (common/lanes.cl):
  *     r_{n+1} = r_n + max(d(r_n), epsilon),
  * until a point is inside the truncated set (d = 0: its orbit never escaped, the
  * scene's own definition), which with the previous point - outside, since its orbit

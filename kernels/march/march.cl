@@ -1,11 +1,11 @@
-/* march/march.cl: the march kernel, LANES rays per work-item (real.cl; 1 by default).  Each work-item
+/* march/march.cl: the march kernel, LANES rays per work-item (common/lanes.cl; 1 by default).  Each work-item
  * makes its rays from the camera (rays.cl camera_ray) for pixels (x0, y0) + its index in a tile
  * tile_w wide; -D RAYS_FROM_BUFFERS reads them from origins/dirs instead (the tests' and
  * benchmarks' arbitrary rays).  The ray o + t d (|d| = 1)
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
- * guard flags (real.cl), 0 when none fired; bracket the width of the certified
+ * guard flags (common/codes.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit. */
 
 #ifdef RAYS_FROM_BUFFERS
@@ -28,7 +28,7 @@
  * each clips [near, far]; a hit at the first point of an interval that a plane started
  * lies on that plane's cut face, flagged FLAG_CUT_FACE | k << 5 for march/clip.cl. */
 #ifdef CLIP
-/* FLAG_CUT_FACE: codes.cl */
+/* FLAG_CUT_FACE: common/codes.cl */
 #define CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
                   const real4 clip_n3, const real4 clip_off
 #else
@@ -43,7 +43,7 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
                     __global int *status, __global int *samples, __global int *flags,
                     __global real *bracket COUNTER_ARG CLIP_ARGS)
 {
-    /* LANES neighbouring rays per work-item (real.cl): one ray, or a block of BLOCK_W x
+    /* LANES neighbouring rays per work-item (common/lanes.cl): one ray, or a block of BLOCK_W x
      * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
      * to whole work-groups (render.launch) and a block may reach past the tile's edges */
 #if LANES == 1

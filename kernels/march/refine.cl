@@ -3,7 +3,7 @@
  * definition, iterate.cl), so the surface crossing lies in [a, b].  The march returns
  * the outside end a as the depth and b - a as the bracket width: the crossing lies
  * within the width behind the depth (a thin part stepped over before a is not covered).
- * On a lane type (real.cl): lanes outside ``todo`` are left as they are.
+ * On a lane type (common/lanes.cl): lanes outside ``todo`` are left as they are.
  *
  * Bisection (-U REFINE_ITP): seed 000_1dc675fe64448cc1.txt §7.1 eq. 11, post-stepping,
  * each step halves the bracket: after n steps its width is h / 2^n (eq. 12).  Unlike the

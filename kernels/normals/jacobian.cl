@@ -111,7 +111,7 @@ inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *
     *guard |= L_SEL((lmask)GUARD_NORMAL_FALLBACK, (lmask)0, ok);
 }
 
-/* LANES hit points per work-item (real.cl), like the march. */
+/* LANES hit points per work-item (common/lanes.cl), like the march. */
 __kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real4 right, const real4 up, const real4 forward,
@@ -129,7 +129,7 @@ __kernel void normals_jacobian(const int n_items, __global const real4 *point, _
     int guard = 0;
     real nx, ny, nz;
     to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
-    normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (real.cl) */
+    normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (common/codes.cl) */
 #else
     quat p;
     int any_hit = 0;

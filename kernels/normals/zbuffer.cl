@@ -67,7 +67,7 @@ __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __
     int guard = 0;
     if (!(l > (real)0) || !isfinite(l)) {
         /* degenerate plane: face the eye; if the hit is the eye itself (camera inside the
-         * set, depth 0) the view axis.  Flagged either way (real.cl). */
+         * set, depth 0) the view axis.  Flagged either way (common/codes.cl). */
         guard = GUARD_NORMAL_FALLBACK;
         n = view, l = length(view);
         if (!(l > (real)0) || !isfinite(l))

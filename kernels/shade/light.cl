@@ -1,5 +1,5 @@
 /* shade/light.cl: the lighting terms of each hit that need the fractal itself, on a lane type
- * (real.cl; LANES hits per work-item, like the Jacobian normals): visibility of the
+ * (common/lanes.cl; LANES hits per work-item, like the Jacobian normals): visibility of the
  * positioned light (shadows, seed 001 §6's self-shadowing), ambient occlusion, and the
  * value a colour map turns into colour.  Compiled only when the scene uses one of them
  * (-D SHADOW_HARD / SHADOW_SOFT, AO, COLOR_ITERATION / COLOR_TRAP / COLOR_W); output

@@ -410,7 +410,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
         for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
             counts[name] += int(np.count_nonzero(st == code))
         guard = got["flags"][own]
-        if "normal" in got:  # guard flags (kernels/codes.cl): the march's buffer and the normals' w
+        if "normal" in got:  # guard flags (kernels/common/codes.cl): the march's buffer and the normals' w
             guard = guard | got["normal"][own][..., 3].astype(np.int32)
         add_counts(guards, count_guards(st, got["depth"][own], guard))
         if "color" in keep:

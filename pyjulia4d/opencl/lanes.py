@@ -1,4 +1,4 @@
-"""How many rays a work-item of the march carries on a device (kernels/real.cl, "Lanes").
+"""How many rays a work-item of the march carries on a device (kernels/common/lanes.cl, "Lanes").
 
 CPUs run a packet of rays per work-item in their vector lanes (PoCL does not vectorise a
 data-dependent loop across work-items: the packet march of the default scene runs 5x

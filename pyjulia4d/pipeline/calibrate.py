@@ -42,7 +42,7 @@ class Prediction:
                 f"{self.probe_seconds * 1e3:.0f} ms")
 
 
-PROBE_BOX = 8   # the probe's blocks of pixels: whole packets of rays (real.cl), as the render has them
+PROBE_BOX = 8   # the probe's blocks of pixels: whole packets of rays (common/lanes.cl), as the render has them
 
 
 def probe_tiles(plan: Plan) -> tuple:

@@ -1,5 +1,5 @@
 """The status codes and guard flags the kernels write, read from their one definition,
-kernels/codes.cl (``#define NAME value`` lines), so that the host, the float64 reference
+kernels/common/codes.cl (``#define NAME value`` lines), so that the host, the float64 reference
 and the kernels cannot disagree."""
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ _DEFINE = re.compile(r"^#define\s+([A-Z][A-Z0-9_]*)\s+(\d+)\b", re.M)
 
 
 def read_codes() -> dict[str, int]:
-    """{name: value} of every integer #define in kernels/codes.cl."""
-    return {name: int(value) for name, value in _DEFINE.findall((kernel_dir() / "codes.cl").read_text())}
+    """{name: value} of every integer #define in kernels/common/codes.cl."""
+    return {name: int(value) for name, value in _DEFINE.findall((kernel_dir() / "common/codes.cl").read_text())}
 
 
 CODES = read_codes()

@@ -24,7 +24,7 @@ class KernelConfig:
 
 
 def iteration_pieces(scene: Scene) -> tuple[str, ...]:
-    """codes.cl (status and guard codes), real.cl, complex arithmetic, the scene's one
+    """common/codes.cl (status and guard codes), common/lanes.cl, complex arithmetic, the scene's one
     function (function/<name>.cl: a complex function and its derivative) and one algebra
     (algebra/<name>.cl: the map q -> f(q) + c built from them; a table algebra's powers from
     algebra/power.cl), the iteration: the pieces the registry (fractal/registry.py) names."""
@@ -37,7 +37,7 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
     rotate = ("kind/rotate",) if f.theta != 0 else ()
     kind_piece = KINDS_TABLE[f.kind].piece
     kind = ("kind/level", kind_piece) if kind_piece else ()
-    return (("codes", "real", "algebra/complex", FUNCTIONS_TABLE[f.function].piece, algebra.piece) + power
+    return (("common/codes", "common/lanes", "algebra/complex", FUNCTIONS_TABLE[f.function].piece, algebra.piece) + power
             + rotate + ("iterate",) + kind)
 
 
@@ -125,7 +125,7 @@ def light_defines(scene: Scene) -> tuple[str, ...]:
     return tuple(out + ["LIGHT_TERMS"]) if out else ()
 
 
-# The pixel block a packet of rays covers, by lane count (kernels/real.cl BLOCK_W x
+# The pixel block a packet of rays covers, by lane count (kernels/common/lanes.cl BLOCK_W x
 # BLOCK_H): square blocks keep a packet's rays closer together than a row would (the
 # default scene's march: 0.031 s in 4x4 blocks against 0.040 s in rows of 16).
 PACKET_BLOCKS = {16: (4, 4), 8: (4, 2), 4: (2, 2)}
@@ -138,7 +138,7 @@ def packet_block(lanes: int) -> tuple[int, int]:
 
 def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
     """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
-    per work-item (-D LANES, kernels/real.cl): the same pieces as scene_config up to
+    per work-item (-D LANES, kernels/common/lanes.cl): the same pieces as scene_config up to
     march/march.cl; rays, shading and the other normals stay one per work-item in the scene's
     program."""
     cfg = scene_config(scene, ray_buffers)

@@ -155,7 +155,7 @@ def add_counts(total: dict[str, int], more: dict[str, int]) -> dict[str, int]:
 
 def count_guards(status, depth, guard) -> dict[str, int]:
     """Pixels each numerical guard fired on (nothing clamped without being counted).
-    ``guard`` holds the flags (kernels/codes.cl) of the march kernel's flags buffer ORed
+    ``guard`` holds the flags (kernels/common/codes.cl) of the march kernel's flags buffer ORed
     with those the normals kernels write into the normal's w."""
     status, guard = (np.asarray(a).ravel() for a in (status, guard))
     hit = status == STATUS_HIT

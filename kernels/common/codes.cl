@@ -1,4 +1,4 @@
-/* codes.cl: the numbers the kernels and the host share, defined once.  pyjulia4d/pipeline/codes.py
+/* common/codes.cl: the numbers the kernels and the host share, defined once.  pyjulia4d/pipeline/codes.py
  * reads this file's #define lines (name, integer value), so Python never restates them. */
 
 /* Pixel status codes written by the march kernel. */

@@ -1,4 +1,4 @@
-/* real.cl: the scalar and vector types every kernel piece is written in.
+/* common/lanes.cl: the scalar and vector types every kernel piece is written in.
  * -D REAL_DOUBLE builds the double-precision variant (needs cl_khr_fp64);
  * the default is float, which is what GPUs run fast. */
 #ifdef REAL_DOUBLE
@@ -44,7 +44,7 @@ typedef struct {
 #define COUNTER_INIT(i)
 #endif
 
-/* Pixel status codes and guard flags: codes.cl (read by pyjulia4d/pipeline/codes.py too). */
+/* Pixel status codes and guard flags: common/codes.cl (read by pyjulia4d/pipeline/codes.py too). */
 
 /* Lanes: the per-ray code is written once on these types.  LANES = 1 (the default) is one
  * ray per work-item, quat = real4 (GPUs, and the normals and shading everywhere); LANES = N
