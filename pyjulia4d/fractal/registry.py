@@ -18,8 +18,23 @@ Vec4 = tuple[float, float, float, float]
 _ZERO = (0.0, 0.0, 0.0, 0.0)
 
 
+class _Entry:
+    """An entry of a table of pieces: kernels/<folder>/<name>.cl and its twin,
+    pyjulia4d/reference/<folder>/<name>.py."""
+    folder = ""
+    name: str
+
+    @property
+    def piece(self) -> str:
+        return f"{self.folder}/{self.name}"
+
+    @property
+    def twin(self) -> str:
+        return f"pyjulia4d.reference.{self.folder}.{self.name}"
+
+
 @dataclass(frozen=True)
-class Function:
+class Function(_Entry):
     """f in q -> f(q) + c.  ``degree``: the polynomial maps' degree - they escape to infinity
     like |q|^degree, which gives the bounding ball and the distance estimate (camera.
     bounding_radius, iterate.cl); None for the others.  ``critical``: f's one critical (or
@@ -27,21 +42,14 @@ class Function:
     starts (q_1 = v + c, kernels/kind/mandelbrot.cl); None where f has several singular
     values (tan, tanh) or none (ln, the inverse functions): no one Mandelbrot set."""
 
+    folder = "function"
     name: str
     degree: int | None = None
     critical: Vec4 | None = None
 
-    @property
-    def piece(self) -> str:
-        return f"function/{self.name}"
-
-    @property
-    def twin(self) -> str:
-        return f"pyjulia4d.reference.function.{self.name}"
-
 
 @dataclass(frozen=True)
-class Algebra:
+class Algebra(_Entry):
     """A 4D algebra.  ``functions``: the f it takes (quaternions sqr and cube only, as in
     POV-Ray).  ``norm_bounded``: |q^D| >= |q|^D, so the escape bound holds - quaternions (the
     norm is multiplicative) and the hypercomplex numbers (the power mean of their two complex
@@ -50,19 +58,12 @@ class Algebra:
     quaternions; the product of two complex Julia sets for the hypercomplex numbers).
     ``table``: a multiplication-table algebra whose powers come from algebra/power.cl."""
 
+    folder = "algebra"
     name: str
     functions: tuple[str, ...]
     norm_bounded: bool = False
     estimate: bool = False
     table: bool = False
-
-    @property
-    def piece(self) -> str:
-        return f"algebra/{self.name}"
-
-    @property
-    def twin(self) -> str:
-        return f"pyjulia4d.reference.algebra.{self.name}"
 
 
 @dataclass(frozen=True)
