@@ -144,9 +144,9 @@ class TileRunner:
     def __init__(self, plan: Plan, dev: cl.Device):
         self.plan = plan
         self.ctx, self.queue = queue_for(dev)
-        self.prg = build.program(self.ctx, plan.program)
-        self.march_prg = (self.prg if plan.march_program == plan.program
-                          else build.program(self.ctx, plan.march_program))
+        self.prg = build.program(self.ctx, plan.config)
+        self.march_prg = (self.prg if plan.march_config == plan.config
+                          else build.program(self.ctx, plan.march_config))
         self.pr = pr = Precision(plan.double)
         nmax = max(t.n for t in plan.tiles)
         read = {"status", "flags", "depth", "bracket"} | {b for k in plan.outputs for b in _READ[k]}
@@ -175,7 +175,7 @@ class TileRunner:
                 bufs["refl"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
             if plan.light_terms:
                 bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
-                bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.program.defines
+                bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.config.defines
                                               else 1, cl.cltypes.float4)
             stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
             self.slots.append((bufs, stage))
@@ -216,9 +216,9 @@ class TileRunner:
         # shadows are traced (-D EXTRA_SHADOWS)
         self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in sa.lights_geo]))
         self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in sa.lights_rgb]))
-        self.extra_shadows = "EXTRA_SHADOWS" in plan.program.defines
+        self.extra_shadows = "EXTRA_SHADOWS" in plan.config.defines
         if plan.reflects:
-            self.refl_prg = build.program(self.ctx, plan.reflect_program)
+            self.refl_prg = build.program(self.ctx, plan.reflect_config)
             self.refl_march_k = cl.Kernel(self.refl_prg, "march")
             self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
             self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
@@ -238,7 +238,7 @@ class TileRunner:
                           bufs["bracket"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
         if plan.normals:
             method = plan.scene.normals.method
-            packet = plan.normals_in_march_program
+            packet = plan.normals_in_march_config
             kernels.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, method,
                                           plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
                                           bufs["normal"], size=(tile.aw, tile.ah),
@@ -277,7 +277,7 @@ class TileRunner:
                          *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
                          bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data, *self.clip_args,
                          items=march_items(n, tile.aw, plan.lanes)))
-        packet = plan.normals_in_march_program
+        packet = plan.normals_in_march_config
         ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
                                  plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],
                                  size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))

@@ -175,8 +175,8 @@ class Plan:
     double: bool
     lanes: int                    # rays per work-item of the march (lanes.lanes_for)
     outputs: frozenset[str]
-    program: kernel_config.KernelConfig   # rays' tests, normals (other than packet Jacobian), shading
-    march_program: kernel_config.KernelConfig
+    config: kernel_config.KernelConfig         # the scene's kernels: rays, normals (but the packet Jacobian), shading
+    march_config: kernel_config.KernelConfig
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
@@ -203,22 +203,22 @@ class Plan:
     @property
     def light_terms(self) -> bool:
         """Whether shade/light.cl runs (shadows, ambient occlusion, a colour map): only for shading."""
-        return self.shades and "shade/light" in self.program.pieces
+        return self.shades and "shade/light" in self.config.pieces
 
     @property
     def reflects(self) -> bool:
         """Whether the mirror bounce runs (shading.reflection > 0; shade/reflect.cl): only for shading."""
-        return self.shades and "shade/reflect" in self.program.pieces
+        return self.shades and "shade/reflect" in self.config.pieces
 
     @property
-    def reflect_program(self) -> kernel_config.KernelConfig:
+    def reflect_config(self) -> kernel_config.KernelConfig:
         """The march of the reflected rays: this plan's march reading given rays."""
         if self.lanes > 1:
             return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
         return kernel_config.scene_config(self.scene, ray_buffers=True)
 
     @property
-    def normals_in_march_program(self) -> bool:
+    def normals_in_march_config(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
         return self.scene.normals.method == "jacobian"
 
@@ -254,8 +254,8 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
         scene=scene, frame=frame, radius=radius, march=args["march"], clip=args["clip"],
         normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
-        program=kernel_config.scene_config(scene),
-        march_program=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
+        config=kernel_config.scene_config(scene),
+        march_config=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
         tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height),
         estimate=est)
