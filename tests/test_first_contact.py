@@ -374,3 +374,49 @@ def test_cluster_tiles_record_the_fitted_camera() -> None:
     whole = render(scene)
     assert whole.scene == used
     assert np.array_equal(whole.color, result.color)
+
+
+# ------------------------------------------------------------------ render()'s own arguments
+
+@pytest.mark.parametrize("kw,message", [
+    (dict(outputs=3), "outputs: expected a list of output names"),
+    (dict(outputs=[1, 2]), "outputs: expected output names"),
+    (dict(outputs=["bogus"]), "outputs: unknown output 'bogus'"),
+    (dict(region=(0.5, 0, 4, 4)), "region: expected (x0, y0, width, height), whole numbers"),
+    (dict(region="abcd"), "region: expected (x0, y0, width, height)"),
+    (dict(region=(0, 0, 100, 100)), "region: (0, 0, 100, 100) is not inside the 16x12 image"),
+    (dict(device=123), "device: expected None, a pyopencl Device or a --device text"),
+    (dict(lanes=7), "lanes: expected one of 1, 4, 8, 16 rays per work-item, got 7"),
+    (dict(lanes=0), "lanes: expected one of 1, 4, 8, 16"),
+    (dict(lanes="x"), "lanes: expected one of 1, 4, 8, 16"),
+    (dict(lanes=True), "lanes: expected one of 1, 4, 8, 16"),
+    (dict(tile=0), "tile: expected a tile side in [1, 8192] pixels, got 0"),
+    (dict(tile=10 ** 9), "tile: expected a tile side in [1, 8192]"),
+    (dict(tile="a"), "tile: expected a tile side"),
+    (dict(progress="yes"), "progress: expected True or False, got 'yes'"),
+    (dict(force="no"), "force: expected True or False"),
+    (dict(calibrate=None), "calibrate: expected True or False"),
+])
+def test_render_arguments_are_checked(kw, message) -> None:
+    """Bad Python arguments get the one-line SceneError naming the argument, before any
+    kernel is built - never a TypeError, a ZeroDivisionError or a driver's build failure."""
+    from pyjulia4d import render
+
+    with pytest.raises(SceneError) as e:
+        render(Scene.default().with_overrides(["image.width=16", "image.height=12"]), **kw)
+    assert str(e.value).startswith(message)
+
+
+def test_one_output_name_is_one_output() -> None:
+    from pyjulia4d import render
+
+    r = render(Scene.default().with_overrides(["image.width=16", "image.height=12"]), outputs="depth")
+    assert r.depth is not None and r.color is None
+
+
+@pytest.mark.parametrize("bad", [None, 3, "scene", {"fractal": {}}])
+def test_reference_refuses_a_non_scene(bad) -> None:
+    from pyjulia4d import reference
+
+    with pytest.raises(SceneError, match=r"^scene: expected a pyjulia4d.Scene"):
+        reference.render(bad)

@@ -23,7 +23,8 @@ from pyjulia4d.opencl.lanes import lanes_for
 from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
 from pyjulia4d.pipeline.framing import fit_camera
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
-from pyjulia4d.pipeline.plan import TILE, Plan, Tile, gradient_step, make_plan, make_tiles
+from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, check_flag, check_lanes, check_tile, gradient_step, make_plan,
+                                     make_tiles)
 from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
 from pyjulia4d.scene.checks import SceneError
@@ -332,6 +333,14 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     t_start = time.perf_counter()
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
+    if not (device is None or isinstance(device, (str, cl.Device))):
+        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
+                                   f"{type(device).__name__}")
+    for name, value in (("progress", progress), ("calibrate", calibrate), ("force", force)):
+        check_flag(name, value)
+    if lanes is not None:
+        check_lanes(lanes)
+    check_tile(tile)
     dev = device if isinstance(device, cl.Device) else select_device(device)
     plan, prediction = plan_render(scene, dev, lanes, outputs, force, tile, region, calibrate)
     result = run_plan(plan, dev, progress)

@@ -9,6 +9,7 @@ and a tile of it executed anywhere the same kernels build; opencl/executor.py ex
 from __future__ import annotations
 
 import dataclasses
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +17,7 @@ import numpy as np
 from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
+from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.fractal.registry import march_method
 
@@ -227,22 +229,56 @@ def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
     """``region`` = (x0, y0, w, h) as ints, checked to lie in the image (None: the whole)."""
     if region is None:
         return None
-    from pyjulia4d.scene.checks import SceneError
     try:
-        x0, y0, w, h = (int(v) for v in region)
-    except (TypeError, ValueError):
-        raise SceneError("region", f"expected (x0, y0, width, height), got {region!r}") from None
+        vals = list(region)
+    except TypeError:
+        vals = []
+    if len(vals) != 4 or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in vals):
+        raise SceneError("region", f"expected (x0, y0, width, height), whole numbers, got {region!r}"[:200])
+    x0, y0, w, h = (int(v) for v in vals)
     W, H = scene.image.width, scene.image.height
     if not (0 <= x0 and 0 <= y0 and w >= 1 and h >= 1 and x0 + w <= W and y0 + h <= H):
         raise SceneError("region", f"{(x0, y0, w, h)} is not inside the {W}x{H} image")
     return x0, y0, w, h
 
 
+LANE_COUNTS = (1, 4, 8, 16)   # rays per work-item of the march (opencl/lanes.py WIDTHS and one)
+MAX_TILE = 8192               # a tile's side: device buffers grow with its square
+
+
+def check_lanes(lanes) -> int:
+    """``lanes``: one of LANE_COUNTS (an int, not a bool)."""
+    if isinstance(lanes, bool) or not isinstance(lanes, int) or lanes not in LANE_COUNTS:
+        raise SceneError("lanes", f"expected one of {', '.join(map(str, LANE_COUNTS))} rays per work-item, "
+                                  f"got {lanes!r}"[:200])
+    return lanes
+
+
+def check_tile(tile) -> int:
+    """``tile``: a whole number of pixels in [1, MAX_TILE]."""
+    if isinstance(tile, bool) or not isinstance(tile, int) or not 1 <= tile <= MAX_TILE:
+        raise SceneError("tile", f"expected a tile side in [1, {MAX_TILE}] pixels, got {tile!r}"[:200])
+    return tile
+
+
+def check_flag(name: str, value) -> bool:
+    """A yes/no argument of render(): True or False only (a string "no" would be true)."""
+    if not isinstance(value, bool):
+        raise SceneError(name, f"expected True or False, got {value!r}"[:200])
+    return value
+
+
 def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
               tile: int = TILE, region=None) -> Plan:
     """Check and resolve ``scene`` for ``device`` (a pyopencl Device, "CPU" or "GPU") with
     ``lanes`` rays per work-item of the march, keeping ``outputs`` (None: all), over the
-    image or its ``region`` (x0, y0, w, h) alone."""
+    image or its ``region`` (x0, y0, w, h) alone; each argument is checked, with the one-line
+    SceneError naming it."""
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
+    check_lanes(lanes)
+    check_tile(tile)
+    check_flag("force", force)
     region = check_region(scene, region)
     kept = resolve_outputs(outputs)
     est = workload.check(scene, device, force=force, outputs=kept)

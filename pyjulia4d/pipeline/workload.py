@@ -169,7 +169,16 @@ def resolve_outputs(outputs) -> frozenset[str]:
     """The outputs kept: all (None) or the named ones, plus "bracket" (always)."""
     if outputs is None:
         return frozenset(OUTPUTS)
-    names = set(outputs)
+    if isinstance(outputs, str):   # one name, not its letters
+        outputs = [outputs]
+    try:
+        names = set(outputs)
+    except TypeError:   # not iterable, or unhashable items
+        raise SceneError("outputs", f"expected a list of output names ({', '.join(OUTPUTS)}), got "
+                                    f"{type(outputs).__name__}") from None
+    if not all(isinstance(n, str) for n in names):
+        raise SceneError("outputs", f"expected output names ({', '.join(OUTPUTS)}), got "
+                                    f"{sorted(repr(n) for n in names if not isinstance(n, str))[0]}")
     unknown = sorted(names - set(OUTPUTS))
     if unknown:
         raise SceneError("outputs", f"unknown output {unknown[0]!r}; one of {', '.join(OUTPUTS)}")

@@ -18,6 +18,7 @@ from pyjulia4d.reference.march import march
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian, normals_zbuffer
 from pyjulia4d.reference.rays import generate_rays
 from pyjulia4d.reference.shade import extra_visibility_of_plan, light_terms_of_plan, reflect_color, reflect_rays, shade
+from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
 def render(scene: Scene) -> RenderResult:
@@ -31,6 +32,8 @@ def render(scene: Scene) -> RenderResult:
     differ from the kernels' in its last bits (their pass is float32), so compare with
     ``reference.render(result.scene)`` for the kernels' own camera."""
     t0 = time.perf_counter()
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     if scene.camera.fit:
         scene, _ = fit_camera(scene, lambda s, outs: render(s))
     with warnings.catch_warnings():   # the work bound is the OpenCL executor's concern
