@@ -12,7 +12,7 @@ OpenCL: ``import pyjulia4d.reference`` works without pyopencl.
 """
 from pyjulia4d.reference.algebra.quaternion import alg_mul, alg_sqr, alg_sqr_jvp
 from pyjulia4d.reference.antialias import flag_edges
-from pyjulia4d.reference.executor import render
+from pyjulia4d.reference.executor import execute, render
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula, formula_of
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance, julia_distance_formula, julia_inside, julia_level
 from pyjulia4d.reference.march import march, march_de, march_fixed, refine_bracket
@@ -22,7 +22,7 @@ from pyjulia4d.reference.normals import (clip_normals, de_field, normal_gradient
 from pyjulia4d.reference.rays import generate_rays, sample_hash, sample_offset
 from pyjulia4d.reference.shade import light_terms, reflect_color, reflect_rays, shade
 
-__all__ = ["alg_mul", "alg_sqr", "alg_sqr_jvp", "flag_edges", "render", "QUATERNION_SQR", "Formula", "formula_of",
+__all__ = ["alg_mul", "alg_sqr", "alg_sqr_jvp", "flag_edges", "execute", "render", "QUATERNION_SQR", "Formula", "formula_of",
            "REAL_MIN", "dot4", "julia_distance", "julia_distance_formula", "julia_inside", "julia_level", "march",
            "march_de", "march_fixed", "refine_bracket", "clip_normals", "de_field", "normal_gradient",
            "normal_jacobian", "normals_gradient", "normals_jacobian", "normals_zbuffer", "to_camera",
