@@ -116,3 +116,21 @@ def test_peers_report_runs(tmp_path):
     assert peers.main(["--size", "16x12", "--repeats", "1", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "peers.md").read_text()
     assert "| pyjulia4d default |" in md and "pixels per CPU-second" in md
+
+
+def test_cpu_runtimes_benchmark_runs(tmp_path, capsys):
+    """benchmarks/cpu_runtimes.py on one pair, tiny: a table row per pair with every CPU
+    device that compiles, and the results file with its commit and devices."""
+    spec = importlib.util.spec_from_file_location("cpu_runtimes", ROOT / "benchmarks" / "cpu_runtimes.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--only", "quaternion_sqr", "--size", "24x18", "--repeats", "1", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.startswith("| quaternion_sqr |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    n = (len(cells) - 2) // 2   # kernel and first-build columns per device, then the ratio
+    # kernel times (may print 0.000 at this size), then first renders, which build: > 0
+    assert n >= 1 and all(float(c) >= 0 for c in cells[1:1 + n]) and all(float(c) > 0 for c in cells[1 + n:1 + 2 * n])
+    text = (tmp_path / "cpu_runtimes.md").read_text()
+    assert "commit" in text and "Devices:" in text and "| quaternion_sqr |" in text
+    assert set(bench.pairs()) >= {f"{a}_{f}" for a, fs in __import__("pyjulia4d").scene.FUNCTIONS_OF.items() for f in fs}
