@@ -61,7 +61,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W; not both)")
     r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H; not both)")
     r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; README lists every key and its valid range)")
+                   help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; 'pyjulia4d keys' lists every key, its default and valid range)")
     r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
     r.add_argument("--channels", metavar="LIST",
                    help="EXR channel groups to compute and write, comma-separated from RGBA, Z (depth and "
@@ -108,7 +108,8 @@ def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
     """--workers and --scheduler (app/cluster.py): Dask renders ``units``."""
     p.add_argument("--workers", metavar="N",
                    help=f"render {units} on a local Dask cluster of N worker processes (0: in this "
-                        f"process; animate's default: one per GPU, or 1 on a CPU)")
+                        f"process; animate's default: one per GPU, or 1 on a CPU; in this process without the cluster "
+                        f"extra)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help=f"render {units} on an existing Dask cluster, e.g. tcp://HOST:8786 "
                         f"(dask scheduler; dask worker tcp://HOST:8786 on each node)")
