@@ -134,3 +134,18 @@ def test_cpu_runtimes_benchmark_runs(tmp_path, capsys):
     text = (tmp_path / "cpu_runtimes.md").read_text()
     assert "commit" in text and "Devices:" in text and "| quaternion_sqr |" in text
     assert set(bench.pairs()) >= {f"{a}_{f}" for a, fs in __import__("pyjulia4d").scene.FUNCTIONS_OF.items() for f in fs}
+
+
+def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
+    """benchmarks/pair_accuracy.py on one pair, tiny: its row, and the verdict for the c = 0
+    ball, whose every number is known (a ball is as accurate as any render reports)."""
+    spec = importlib.util.spec_from_file_location("pair_accuracy", ROOT / "benchmarks" / "pair_accuracy.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert len(bench.pairs()) == 24
+    assert bench.main(["--only", "quaternion_sqr", "--size", "24x18", "--set", "fractal.c=0,0,0,0",
+                       "--set", "fractal.max_iter=3", "--out", str(tmp_path)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("| quaternion sqr |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1] == "de" and cells[4] == "0.00 %" and cells[5] == "0.00 %" and cells[6] == "yes"
+    assert "commit" in (tmp_path / "pair_accuracy.md").read_text()

@@ -130,3 +130,34 @@ def test_de_search_finds_hairs_the_scan_steps_over():
     p = o[hit] + t[hit, None] * d[hit]
     inside = ref.julia_inside(p, s.fractal.c, 50, 4.0) | truth.real_c_inside(p, -1.0, 50, 4.0)
     assert np.mean(inside) >= 0.99
+
+
+def test_brute_force_depth_is_the_analytic_ball():
+    """c = 0: the brute force's first crossing is the ray-ball entry to float64 rounding."""
+    s = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", "fractal.c=0,0,0,0",
+                                        "fractal.max_iter=3"])
+    o, d = rays(s)
+    t = truth.brute_force_depth(s, o, d)
+    ts = truth.sphere_depth(o, d, truth.sphere_radius(3, 4.0))
+    assert np.array_equal(np.isfinite(t), np.isfinite(ts)) and np.isfinite(t).sum() > 100
+    m = np.isfinite(ts)
+    assert np.max(np.abs(t[m] - ts[m])) < 1e-12
+
+
+@pytest.mark.parametrize("algebra,function", [("quaternion", "sqr"), ("hypercomplex", "sin"), ("cquat", "cube")])
+def test_brute_force_depth_is_a_verified_crossing(algebra, function):
+    """Any pair: each crossing is inside the set (its float64 twin) with an outside point
+    1e-9 in front of it (bisection to float64 resolution)."""
+    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "max_iter": 6},
+                         "camera": {"position": [2.5, 2.0, -3.0]}, "image": {"width": 16, "height": 12}})
+    o, d = rays(s)
+    t = truth.brute_force_depth(s, o, d)
+    hit = np.isfinite(t)
+    assert hit.sum() > 5
+    F, f = ref.formula_of(s.fractal), s.fractal
+    inside = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)  # noqa: E731
+    k = np.nonzero(hit)[0]
+    assert inside(o[k] + t[k, None] * d[k]).all()
+    front = np.maximum(t[k] - 1e-9, 0)
+    entered = t[k] - 1e-9 > 0
+    assert not inside(o[k][entered] + front[entered, None] * d[k][entered]).any()
