@@ -230,7 +230,8 @@ def test_render_an_image_default_output_and_overrides(tmp_path: Path, monkeypatc
 
 @pytest.mark.parametrize("make,why", [
     (lambda p: None, "cannot read: no such file"),
-    (lambda p: p.write_bytes(b"not a png"), "cannot read it as a PNG image"),
+    (lambda p: p.write_bytes(b"not a png"), "not a readable PNG file"),
+    (lambda p: p.mkdir(), "is a directory, not an image"),
     (lambda p: Image.new("RGB", (4, 4)).save(p), "holds no pyjulia4d scene"),
 ])
 def test_render_an_image_bad(tmp_path: Path, capsys, make, why) -> None:

@@ -146,11 +146,14 @@ def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
     from pyjulia4d.scene.text import MAX_SCENE_BYTES, scene_table_from_text
 
     shown = path if path.isprintable() else repr(path)
+    if Path(path).is_dir():
+        raise SceneError(shown, "is a directory, not an image")
     if not Path(path).is_file():
         raise SceneError(shown, "cannot read: no such file")
     header = read_header(Path(path))
     if header is None:
-        raise SceneError(shown, f"cannot read it as a {Path(path).suffix.lower()[1:].upper()} image")
+        raise SceneError(shown, f"not a readable {Path(path).suffix.lower()[1:].upper()} file (damaged, truncated "
+                                f"or another format)")
     text = header.get("pyjulia4d.scene")
     if text is None:
         raise SceneError(shown, "holds no pyjulia4d scene (not rendered by pyjulia4d, or its metadata "
