@@ -421,3 +421,21 @@ def test_reference_refuses_a_non_scene(bad) -> None:
 
     with pytest.raises(SceneError, match=r"^scene: expected a pyjulia4d.Scene"):
         reference.render(bad)
+
+
+@pytest.mark.parametrize("text,message", [
+    ("[fractal\n", "src.png (its scene): invalid TOML"),
+    ("[animation]\nframes = 3\n", "animation: a keyframed scene"),
+    ("x" * (1 << 20 + 1), "src.png: its scene is larger than 1 MiB"),
+])
+def test_render_an_image_whose_scene_is_bad(tmp_path: Path, capsys, monkeypatch, text, message) -> None:
+    from PIL import PngImagePlugin
+
+    monkeypatch.chdir(tmp_path)
+    info = PngImagePlugin.PngInfo()
+    info.add_text("pyjulia4d.scene", text)
+    Image.new("RGBA", (4, 4)).save("src.png", pnginfo=info)
+    assert cli.main(["render", "src.png"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pyjulia4d: error: {message}") and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["src.png"]
