@@ -37,7 +37,10 @@ class Progress:
         if now - self.last >= self.every and self.n < self.total:
             self.last = now
             left = (now - self.t0) * (self.total - self.n) / max(self.n, 1)
-            print(self.line(self.n, self.total, now - self.t0, left, note), file=sys.stderr, flush=True)
+            # one write, newline included: a signal's exception (the command line's SIGTERM and
+            # SIGHUP) raised between print's two writes would leave the line unterminated
+            sys.stderr.write(self.line(self.n, self.total, now - self.t0, left, note) + "\n")
+            sys.stderr.flush()
 
     def set_total(self, total: int) -> None:
         """A new total, once the work is known (antialiasing's adaptive passes)."""
