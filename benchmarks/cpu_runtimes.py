@@ -68,26 +68,10 @@ def pairs() -> dict[str, list[str]]:
 def cpu_devices() -> list[tuple[str, str, str]]:
     """(P:D spec, short name, why skipped or "") for every CPU device."""
     from pyjulia4d.opencl.devices import compile_error, device_type, list_devices
+    from pyjulia4d.opencl.lanes import device_spec
 
-    out = []
-    for pi_di, (p, d) in zip(_specs(), list_devices()):
-        if device_type(d) != "CPU":
-            continue
-        name = f"{p.name.strip()} {d.driver_version.strip()}"
-        out.append((pi_di, name, compile_error(d)))
-    return out
-
-
-def _specs() -> list[str]:
-    import pyopencl as cl
-
-    specs = []
-    for pi, p in enumerate(cl.get_platforms()):
-        try:
-            specs += [f"{pi}:{di}" for di in range(len(p.get_devices()))]
-        except cl.Error:
-            pass
-    return specs
+    return [(device_spec(d), f"{p.name.strip()} {d.driver_version.strip()}", compile_error(d))
+            for p, d in list_devices() if device_type(d) == "CPU"]
 
 
 def run_child(spec: str, overrides: list[str], repeats: int, lanes_file: Path | None) -> dict:

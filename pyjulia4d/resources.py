@@ -1,4 +1,5 @@
-"""Where the OpenCL sources live, installed or in a source checkout."""
+"""What is installed where: the OpenCL sources (installed or in a source checkout), the
+cache folder, and whether an optional extra's module is there."""
 from __future__ import annotations
 
 import os
@@ -22,3 +23,14 @@ def cache_dir() -> Path:
     """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
     root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")
     return Path(root)
+
+
+def module_installed(name: str) -> bool:
+    """Whether the module ``name`` can be imported, without importing it (an extra's: the
+    cluster's ``distributed``, the video's ``imageio_ffmpeg``)."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec(name) is not None
+    except ValueError:   # sys.modules[name] is None (blocked)
+        return False

@@ -16,7 +16,7 @@ from typing import Any, Iterator, NoReturn, Sequence
 
 from pyjulia4d.app.output import check_output_path, write_image
 from pyjulia4d.scene.model import Scene
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show_key
 from pyjulia4d.scene.text import override_key
 
 PROG = "pyjulia4d"
@@ -286,10 +286,6 @@ def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
     return tuple(o for g in groups for o in CHANNEL_GROUPS[g])
 
 
-def _show_arg(text: str) -> str:
-    return text if text.isprintable() and len(text) <= 80 else repr(text[:80])
-
-
 def _one_line(e: BaseException) -> str:
     return " ".join(str(e).splitlines()) or type(e).__name__
 
@@ -360,7 +356,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 from pyjulia4d.scene.model import SECTION_NAMES
 
                 if args.section is not None and args.section not in SECTION_NAMES:
-                    raise SceneError(_show_arg(args.section), f"unknown section; use one of "
+                    raise SceneError(show_key(args.section), f"unknown section; use one of "
                                                               f"{', '.join(SECTION_NAMES)}")
                 print(describe_keys(args.section))
                 return 0

@@ -31,6 +31,7 @@ from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.resources import module_installed
 
 
 class ClusterError(ValueError):
@@ -141,12 +142,7 @@ def fit_unit(scene: Scene, device: str | None = None, force: bool = False) -> Sc
 
 def have_cluster() -> bool:
     """Whether Dask distributed is installed (the ``cluster`` extra)."""
-    import importlib.util
-
-    try:
-        return importlib.util.find_spec("distributed") is not None
-    except ValueError:   # sys.modules["distributed"] is None (blocked)
-        return False
+    return module_installed("distributed")
 
 
 def require_cluster(workers: int | None, scheduler: str | None) -> None:

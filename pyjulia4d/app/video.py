@@ -17,6 +17,7 @@ import numpy as np
 
 from pyjulia4d.app.output import OutputError, check_directory
 from pyjulia4d.files import atomic_write, quoted_path, shown_path
+from pyjulia4d.resources import module_installed
 
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 # H.264's constant rate factor and VP9's constant quality (lower is better; both about
@@ -26,12 +27,7 @@ QUALITY = {".mp4": ["-crf", "18", "-preset", "medium"], ".webm": ["-crf", "24", 
 
 def have_ffmpeg() -> bool:
     """Whether imageio-ffmpeg (the ``video`` extra) is installed."""
-    import importlib.util
-
-    try:
-        return importlib.util.find_spec("imageio_ffmpeg") is not None
-    except ValueError:   # sys.modules["imageio_ffmpeg"] is None (blocked)
-        return False
+    return module_installed("imageio_ffmpeg")
 
 
 def check_video_path(path: str | os.PathLike) -> Path:

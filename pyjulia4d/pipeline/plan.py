@@ -168,7 +168,6 @@ class Plan:
     """A scene resolved into what its kernels need (see the module docstring)."""
     scene: Scene
     frame: Frame
-    radius: float                 # the march's bounding 4-ball (camera.march_radius)
     march: MarchArgs
     clip: ClipArgs
     normals_args: NormalsArgs
@@ -182,6 +181,11 @@ class Plan:
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
+
+    @property
+    def radius(self) -> float:
+        """The march's bounding 4-ball (camera.march_radius), as the march takes it."""
+        return self.march.radius
 
     @property
     def normals(self) -> bool:
@@ -287,7 +291,7 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
     halo = 1 if scene.normals.method == "zbuffer" and {"normal", "color"} & kept else 0
     args = kernel_arguments(scene, frame, radius)
     return Plan(
-        scene=scene, frame=frame, radius=radius, march=args["march"], clip=args["clip"],
+        scene=scene, frame=frame, march=args["march"], clip=args["clip"],
         normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
         config=kernel_config.scene_config(scene),

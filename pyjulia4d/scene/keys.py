@@ -5,6 +5,7 @@ list cannot drift from what is accepted; docs/scene-keys.md holds the long form,
 tests/test_scene.py holds both to the checkers."""
 from __future__ import annotations
 
+from pyjulia4d.scene.checks import fmt
 from pyjulia4d.scene.model import Scene, key_names, valid_range
 
 # One line per key: what it is, in the words of docs/scene-keys.md, shortened.
@@ -76,11 +77,9 @@ def _value_text(v) -> str:
         return "true" if v else "false"
     if isinstance(v, str):
         return f'"{v}"'
-    if isinstance(v, float):
-        if v != 0 and not 1e-2 <= abs(v) < 1e3:
-            mantissa, exponent = f"{v:.14e}".split("e")
-            return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
-        return f"{v:.1f}" if v == int(v) else f"{v:g}"
+    if isinstance(v, float):   # as the ranges are written (checks.fmt), a whole float as 4.0
+        text = fmt(v)
+        return f"{text}.0" if text.lstrip("-").isdigit() else text
     if isinstance(v, (tuple, list)):   # components as short as they go: [-0.2, 0.8, 0, 0]
         return "[" + ", ".join(f"{x:g}" if isinstance(x, float) else _value_text(x) for x in v) + "]"
     return str(v)
