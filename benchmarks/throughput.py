@@ -144,7 +144,7 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
     frame = camera_frame(scene)
     f, m = scene.fractal, scene.march
     origins, dirs, point = (cla.empty(queue, n, pr.vec_dtype) for _ in range(3))
-    depth, bracket = (cla.empty(queue, n, pr.scalar) for _ in range(2))
+    depth, bracket, unresolved = (cla.empty(queue, n, pr.scalar) for _ in range(3))
     status, samples, flags = (cla.empty(queue, n, np.int32) for _ in range(3))
     counts = cla.zeros(queue, n, np.int32)
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
@@ -153,7 +153,7 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
     args = (origins.data, dirs.data, pr.v4(f.c), np.int32(f.max_iter), pr.scalar(f.bailout),
             pr.scalar(m.epsilon), pr.scalar(march_radius(scene)), pr.scalar(near), pr.scalar(far),
             np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps), depth.data,
-            point.data, status.data, samples.data, flags.data, bracket.data)
+            point.data, status.data, samples.data, flags.data, bracket.data, unresolved.data)
     prg = build.program(ctx, cfg)
     mprg = prg if lanes == 1 else build.program(ctx, kernel_config.march_config(scene, lanes, ray_buffers=True))
     launch(queue, cl.Kernel(prg, "generate_rays"), n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),

@@ -24,13 +24,13 @@ def run_march(s: Scene, lanes: int = 1):
     near = -1.0 if m.near == "auto" else m.near
     far = -1.0 if m.far == "auto" else m.far
     depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
-    flags, bracket = R.out(n, np.int32), R.out(n)
+    flags, bracket, unresolved = R.out(n, np.int32), R.out(n), R.out(n)
     args = (f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), near, far,
             m.z_resolution, m.post_steps, m.max_steps)
     R("march", (n,), np.int32(W), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
       R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(near), R.scalar(far),
       np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples, flags, bracket, items=march_items(n, W, lanes))
+      depth, point, status, samples, flags, bracket, unresolved, items=march_items(n, W, lanes))
     k = (depth.get().astype(float), R.get4(point), status.get(), samples.get(),
          bracket.get().astype(float))
     rflags = np.zeros(n, np.int32)

@@ -18,3 +18,12 @@ inline quat julia_f_jvp(quat q, quat h)
 }
 #endif
 #define JULIA_GROWTH FUNC_POWER
+
+/* enclose/ball.cl: the table's product bounds.  Each coordinate of a b is a^T P b with P a
+ * signed permutation matrix (algebra/table.py's INDEX is a Latin square), so |a b| <= 2 |a| |b|,
+ * and h -> m h is a matrix whose rows and columns each hold the m_i once, signed: its norm
+ * is at most |m|_1. */
+#define ALG_ENCLOSE_K 2
+inline lreal alg_norm1(quat m) { return fabs(m.x) + fabs(m.y) + fabs(m.z) + fabs(m.w); }
+#define ALG_LBOUND(m) alg_norm1(m)
+#define ALG_LBOUND_SQR(m) alg_norm1(alg_mul((m), (m)))

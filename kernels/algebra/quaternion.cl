@@ -75,3 +75,8 @@ inline quat julia_f_jvp(quat q, quat h) { return alg_cube_jvp(q, h); }
 #endif
 #define ALG_HAS_DE            /* march/de.cl and normals/gradient.cl may be built */
 #define JULIA_GROWTH FUNC_POWER
+
+/* enclose/ball.cl: |a b| = |a| |b| */
+#define ALG_ENCLOSE_K 1
+#define ALG_LBOUND(m) QLEN(m)
+#define ALG_LBOUND_SQR(m) QNORM2(m)

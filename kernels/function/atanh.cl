@@ -4,3 +4,7 @@
  */
 inline cplx cfun(cplx z) { return c_atanh(z); }
 inline cplx cfun_d(cplx z) { return c_recip(c_sub(C((lreal)1, (lreal)0), c_sqr(z))); }
+
+#ifdef ENCLOSE   /* march/proven.cl: (log(1 + z) - log(1 - z)) / 2 (enclose/disc.cl) */
+inline cdisc cfun_disc(cdisc z) { return d_atanh(z); }
+#endif

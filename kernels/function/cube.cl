@@ -7,3 +7,10 @@
 #define FUNC_POWER 3
 inline cplx cfun(cplx z) { return c_mul(c_sqr(z), z); }
 inline cplx cfun_d(cplx z) { return c_scale((lreal)3, c_sqr(z)); }
+
+#ifdef ENCLOSE   /* march/proven.cl: (m + e)^3 by two products (enclose/disc.cl) */
+/* enclose/split.cl's Taylor bound: |f''| = 6 |z| <= 6 (|m| + rho) */
+#define FUNC_M2(m, rho) ((real)6 * (c_abs(m) + (rho)))
+/* its disc enclosure */
+inline cdisc cfun_disc(cdisc z) { return d_mul(d_sqr(z), z); }
+#endif

@@ -4,3 +4,7 @@
  */
 inline cplx cfun(cplx z) { return c_log(z); }
 inline cplx cfun_d(cplx z) { return c_recip(z); }
+
+#ifdef ENCLOSE   /* march/proven.cl: the principal log, its cut included (enclose/disc.cl) */
+inline cdisc cfun_disc(cdisc z) { return d_log(z); }
+#endif

@@ -9,3 +9,19 @@
 #define FUNC_EXPONENT C((lreal)(real)(FUNC_EXPONENT_RE), (lreal)(real)(FUNC_EXPONENT_IM))
 inline cplx cfun(cplx z) { return c_pow(z, FUNC_EXPONENT); }
 inline cplx cfun_d(cplx z) { return c_mul(FUNC_EXPONENT, c_pow(z, C((lreal)((real)(FUNC_EXPONENT_RE) - (real)1), (lreal)(real)(FUNC_EXPONENT_IM)))); }
+
+#ifdef ENCLOSE   /* march/proven.cl: exp(p log z), both sides of log's cut (enclose/disc.cl) */
+/* enclose/split.cl's Taylor bound: |f''| = |p (p - 1) z^(p - 2)| <= |p (p - 1)| e^(max(Re q ln|z|) + |Im q| pi), q = p - 2, over the disc; none where it meets log's cut or 0 */
+inline lreal func_m2(cplx m, lreal rho)
+{
+    real qr = (real)(FUNC_EXPONENT_RE) - (real)2, qi = (real)(FUNC_EXPONENT_IM);
+    real pp = hypot((real)(FUNC_EXPONENT_RE), qi) * hypot((real)(FUNC_EXPONENT_RE) - (real)1, qi);
+    lreal lo = log(c_abs(m) - rho), hi = log(c_abs(m) + rho);
+    lreal e = fmax(qr * lo, qr * hi) + fabs(qi) * ENC_PI;
+    lmask bad = d_meets_cut(D(m, rho)) | !(c_abs(m) > rho);
+    return L_SEL(pp * exp(e) * ENC_UP, (lreal)INFINITY, bad);
+}
+#define FUNC_M2(m, rho) func_m2((m), (rho))
+/* its disc enclosure */
+inline cdisc cfun_disc(cdisc z) { return d_pwr(z, FUNC_EXPONENT); }
+#endif

@@ -7,3 +7,10 @@
 #define FUNC_POWER 2
 inline cplx cfun(cplx z) { return c_sqr(z); }
 inline cplx cfun_d(cplx z) { return c_scale((lreal)2, z); }
+
+#ifdef ENCLOSE   /* march/proven.cl: (m + e)^2 = m^2 + 2 m e + e^2 (enclose/disc.cl) */
+/* enclose/split.cl's Taylor bound: f'' = 2 */
+#define FUNC_M2(m, rho) ((lreal)2)
+/* its disc enclosure */
+inline cdisc cfun_disc(cdisc z) { return d_sqr(z); }
+#endif

@@ -4,3 +4,7 @@
  */
 inline cplx cfun(cplx z) { return c_tan(z); }
 inline cplx cfun_d(cplx z) { return c_add(C((lreal)1, (lreal)0), c_sqr(c_tan(z))); }
+
+#ifdef ENCLOSE   /* march/proven.cl: 1 / |cos z|^2 bounded away from the poles (enclose/disc.cl) */
+inline cdisc cfun_disc(cdisc z) { return d_tan(z); }
+#endif

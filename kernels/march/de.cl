@@ -21,7 +21,7 @@
 
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
                        int z_resolution, int post_steps, int max_steps, lmask *status,
-                       lmask *samples, lmask *flags, lreal *width)
+                       lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
     lreal t = near, t_prev = near;
     lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
@@ -53,5 +53,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal w;
     lreal a = refine_bracket(o, d, t_prev, t, hit & !first, post_steps, jp, &w);
     *width = L_SEL(*width, L_SEL((lreal)0, w, hit & !first), hit);
-    return L_SEL((lreal)INFINITY, L_SEL(t, a, hit & !first), hit);
+    lreal depth = L_SEL((lreal)INFINITY, L_SEL(t, a, hit & !first), hit);
+    /* the estimate is no proof for the truncated set (above): nothing in front is proven */
+    *unresolved = L_SEL(*unresolved, L_SEL(far - near, depth - near, hit), live);
+    return depth;
 }

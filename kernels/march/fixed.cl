@@ -9,7 +9,7 @@
 
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
                        int z_resolution, int post_steps, int max_steps, lmask *status,
-                       lmask *samples, lmask *flags, lreal *width)
+                       lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
     lreal h = (far - near) / (real)z_resolution;
     lreal t_prev = near, t_hit = near;
@@ -30,5 +30,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal w;
     lreal a = refine_bracket(o, d, t_prev, t_hit, found & !first, post_steps, jp, &w);
     *width = L_SEL(*width, L_SEL((lreal)0, w, found & !first), found);
-    return L_SEL((lreal)INFINITY, L_SEL(t_hit, a, found & !first), found);
+    lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_hit, a, found & !first), found);
+    /* samples prove nothing between them: all of the ray in front of the depth is unproven */
+    *unresolved = L_SEL(*unresolved, L_SEL(far - near, depth - near, found), live);
+    return depth;
 }

@@ -6,7 +6,10 @@
  * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
  * guard flags (common/codes.cl), 0 when none fired; bracket the width of the certified
- * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit. */
+ * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit;
+ * unresolved the width of the ray in front of the depth (the whole ray on a miss) that
+ * the march did not prove empty (march/proven.cl; the other marches prove nothing: all of
+ * it), 0 for rays that miss the bounding ball. */
 
 #ifdef RAYS_FROM_BUFFERS
 #define RAY_ARGS __global const real4 *origins, __global const real4 *dirs
@@ -41,7 +44,7 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
                     __global int *status, __global int *samples, __global int *flags,
-                    __global real *bracket COUNTER_ARG CLIP_ARGS)
+                    __global real *bracket, __global real *unresolved COUNTER_ARG CLIP_ARGS)
 {
     /* LANES neighbouring rays per work-item (common/lanes.cl): one ray, or a block of BLOCK_W x
      * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
@@ -115,10 +118,10 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
 #endif
     live &= far >= near;
     lmask st = STATUS_MISS, n = 0, fl = 0;
-    lreal t = INFINITY, width = INFINITY;
+    lreal t = INFINITY, width = INFINITY, unres = 0;
     if (L_ANY(live))
         t = march_ray(o, d, near, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
-                      &width);
+                      &width, &unres);
 #ifdef CLIP
     fl |= L_SEL((lmask)0, (lmask)FLAG_CUT_FACE | ((cut - 1) << 5), (st == STATUS_HIT) & (width == (real)0) & (cut > 0));
 #endif
@@ -129,6 +132,7 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
     samples[i0] = n;
     flags[i0] = fl;
     bracket[i0] = st == STATUS_HIT ? width : INFINITY;
+    unresolved[i0] = unres;
 #else
     for (int k = 0; k < LANES; ++k) {   /* scatter */
         size_t i = lane_index[k];
@@ -144,6 +148,7 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
         samples[i] = ((int *)&n)[k];
         flags[i] = ((int *)&fl)[k];
         bracket[i] = sk == STATUS_HIT ? ((real *)&width)[k] : INFINITY;
+        unresolved[i] = ((real *)&unres)[k];
     }
 #endif
 }

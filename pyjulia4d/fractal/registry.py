@@ -64,6 +64,13 @@ class Algebra(_Entry):
     norm_bounded: bool = False
     estimate: bool = False
     table: bool = False
+    enclosure: str = "ball"
+
+    @property
+    def enclosure_piece(self) -> str:
+        """Its orbit enclosures for the proven march: kernels/enclose/<enclosure>.cl (4D balls,
+        or a disc per complex component of a split algebra) and their twin."""
+        return f"enclose/{self.enclosure}"
 
 
 @dataclass(frozen=True)
@@ -103,7 +110,7 @@ FUNCTIONS = tuple(FUNCTIONS_TABLE)
 
 ALGEBRAS_TABLE: dict[str, Algebra] = {a.name: a for a in (
     Algebra("quaternion", ("sqr", "cube"), norm_bounded=True, estimate=True),
-    Algebra("hypercomplex", FUNCTIONS, norm_bounded=True, estimate=True),
+    Algebra("hypercomplex", FUNCTIONS, norm_bounded=True, estimate=True, enclosure="split"),
     Algebra("cquat", ("sqr", "cube"), table=True),
     Algebra("commutative", ("sqr", "cube"), table=True),
 )}
@@ -137,6 +144,12 @@ def has_distance_estimate(f: Any) -> bool:
     scan (march.method = "auto")."""
     return (KINDS_TABLE[f.kind].estimate and ALGEBRAS_TABLE[f.algebra].estimate
             and FUNCTIONS_TABLE[f.function].degree is not None)
+
+
+def can_prove(f: Any) -> bool:
+    """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the Julia
+    sets of every algebra and function, unrotated (kernels/enclose/)."""
+    return f.kind == "julia" and f.theta == 0
 
 
 def march_method(scene: Any) -> str:

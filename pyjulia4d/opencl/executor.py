@@ -132,6 +132,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
 # depth, bracket and the normals' guard word are read back always (one tile's worth): the
 # streamed counts, guards and bracket statistics come from them.
 _READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket": ("bracket",),
+         "unresolved": ("unresolved",),
          "normal": ("normal",), "position": ("point",), "status": ("status",),
          "samples": ("samples",)}
 
@@ -150,7 +151,7 @@ class TileRunner:
                           else build.program(self.ctx, plan.march_config))
         self.pr = pr = Precision(plan.double)
         nmax = max(t.n for t in plan.tiles)
-        read = {"status", "flags", "depth", "bracket"} | {b for k in plan.outputs for b in _READ[k]}
+        read = {"status", "flags", "depth", "bracket", "unresolved"} | {b for k in plan.outputs for b in _READ[k]}
         if plan.normals:
             read.add("normal")
         self.read = read
@@ -158,6 +159,7 @@ class TileRunner:
         for _ in range(self.SLOTS):
             bufs = {"depth": cla.empty(self.queue, nmax, pr.scalar),
                     "bracket": cla.empty(self.queue, nmax, pr.scalar),
+                    "unresolved": cla.empty(self.queue, nmax, pr.scalar),
                     "point": cla.empty(self.queue, nmax, pr.vec_dtype),
                     "status": cla.empty(self.queue, nmax, np.int32),
                     "samples": cla.empty(self.queue, nmax, np.int32),
@@ -169,7 +171,7 @@ class TileRunner:
             if plan.reflects:   # the reflected rays, their march, normals and colour
                 for k in ("origins", "dirs", "point2", "normal2"):
                     bufs[k] = cla.empty(self.queue, nmax, pr.vec_dtype)
-                for k in ("depth2", "bracket2"):
+                for k in ("depth2", "bracket2", "unresolved2"):
                     bufs[k] = cla.empty(self.queue, nmax, pr.scalar)
                 for k in ("status2", "samples2", "flags2"):
                     bufs[k] = cla.empty(self.queue, nmax, np.int32)
@@ -236,7 +238,7 @@ class TileRunner:
         kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
                           np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const, bufs["depth"].data, bufs["point"].data,
                           bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
-                          bufs["bracket"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
+                          bufs["bracket"].data, bufs["unresolved"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
         if plan.normals:
             method = plan.scene.normals.method
             packet = plan.normals_in_march_config
@@ -276,7 +278,8 @@ class TileRunner:
                      bufs["origins"].data, bufs["dirs"].data)]
         ev.append(launch(q, self.refl_march_k, n, np.int32(tile.aw), bufs["origins"].data, bufs["dirs"].data,
                          *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
-                         bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data, *self.clip_args,
+                         bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data,
+                         bufs["unresolved2"].data, *self.clip_args,
                          items=march_items(n, tile.aw, plan.lanes)))
         packet = plan.normals_in_march_config
         ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
@@ -401,7 +404,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
     runner = TileRunner(plan, dev)
     rx, ry, W, H = plan.region
     keep = plan.outputs
-    shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W),
+    shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W), "unresolved": (H, W),
               "normal": (H, W, 3), "position": (H, W, 4), "status": (H, W), "samples": (H, W)}
     img = {k: np.empty(shapes[k], np.int32 if k in ("status", "samples") else np.float32) for k in keep}
     counts = {"miss": 0, "hit": 0, "capped": 0}
@@ -426,7 +429,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
             img["color"][dst] = got["rgba"][own][..., :3]
         if "alpha" in keep:
             img["alpha"][dst] = got["rgba"][own][..., 3] if "rgba" in got else (st == STATUS_HIT)
-        for k, src in (("depth", "depth"), ("bracket", "bracket"), ("status", "status"),
+        for k, src in (("depth", "depth"), ("bracket", "bracket"), ("unresolved", "unresolved"), ("status", "status"),
                        ("samples", "samples")):
             if k in keep:
                 img[k][dst] = got[src][own]
@@ -467,7 +470,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
         if aa:
             # image.samples more passes of colour and alpha alone, each through its own
             # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
-            cplan = dataclasses.replace(plan, outputs=frozenset({"color", "alpha", "bracket"}))
+            cplan = dataclasses.replace(plan, outputs=frozenset({"color", "alpha", "bracket", "unresolved"}))
             tiles, flags = cplan.tiles, None
             if adaptive:
                 # image.adaptive: the samples run over the blocks holding a flagged pixel,
@@ -507,7 +510,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
     result = RenderResult(
         color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
         normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
-        samples=img.get("samples"), bracket=img.get("bracket"), counts=counts,
+        samples=img.get("samples"), bracket=img.get("bracket"), unresolved=img.get("unresolved"), counts=counts,
         device_name=dev.name.strip(), kernel_seconds=_seconds(kernel_events), lanes=lanes,
         guards=guards, scene=scene)
     result.seconds = time.perf_counter() - t_start

@@ -78,6 +78,12 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     m = scene.march
     pieces = list(iteration_pieces(scene))
     defines = list(precision_defines(scene)) + list(fractal_defines(scene))
+    if march_method(scene) == "proven":
+        # circular arithmetic before the function pieces, which give their enclosures under
+        # -D ENCLOSE; the algebra's orbit enclosure after the iteration (kernels/enclose/)
+        pieces.insert(pieces.index("algebra/complex") + 1, "enclose/disc")
+        pieces.append(ALGEBRAS_TABLE[scene.fractal.algebra].enclosure_piece)
+        defines.append("ENCLOSE")
     pieces.append("march/refine")
     if m.refine == "itp":
         defines.append("REFINE_ITP")

@@ -91,7 +91,7 @@ class MarchArgs:
     z_resolution: int
     post_steps: int
     max_steps: int
-    method: str            # "fixed" or "de": march.method resolved (fractal/registry.march_method)
+    method: str            # "fixed", "de" or "proven": march.method resolved (fractal/registry.march_method)
     refine: str
 
 

@@ -30,6 +30,10 @@ class RenderResult:
     status: np.ndarray | None    # (H, W) int32, STATUS_* per pixel
     samples: np.ndarray | None   # (H, W) int32, set tests (fixed) or estimates (de) before the hit
     bracket: np.ndarray = None   # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
+    # (H, W) float32: how far in front of the depth (on a miss: how much of the ray) the march
+    # did not prove empty (kernels/march/proven.cl); the first crossing lies in
+    # [depth - unresolved, depth + bracket].  The fixed and de marches prove nothing: all of it.
+    unresolved: np.ndarray = None
     counts: dict = field(default_factory=dict)  # pixels by status: "miss", "hit", "capped" (all tiles)
     device_name: str = ""
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
@@ -88,6 +92,29 @@ class RenderResult:
             return {"p50": math.nan, "p99": math.nan, "max": math.nan}
         p50, p99 = np.percentile(b, [50, 99])
         return {"p50": float(p50), "p99": float(p99), "max": float(b.max())}
+
+    def error_stats(self) -> dict[str, float]:
+        """p50 / p99 / max over the pixels hit of the depth error each states: its bracket
+        behind the depth plus its unresolved width in front (kernels/march/proven.cl).  NaN when
+        nothing was hit."""
+        if self.bracket is None or self.unresolved is None:
+            return self.bracket_stats()
+        hit = np.isfinite(self.bracket)
+        e = (self.bracket[hit] + self.unresolved[hit]).astype(np.float64)
+        if e.size == 0:
+            return {"p50": math.nan, "p99": math.nan, "max": math.nan}
+        p50, p99 = np.percentile(e, [50, 99])
+        return {"p50": float(p50), "p99": float(p99), "max": float(e.max())}
+
+    def unresolved_counts(self) -> dict[str, int]:
+        """Pixels whose ray the march left partly unproven: hits with space in front of the
+        depth not proven empty, and misses with any of the ray unproven (where a thin part may
+        hide); none for a render without the array."""
+        if self.unresolved is None or self.bracket is None:
+            return {"hit": 0, "miss": 0}
+        hit = np.isfinite(self.bracket)
+        open_ = self.unresolved > 0
+        return {"hit": int(np.count_nonzero(open_ & hit)), "miss": int(np.count_nonzero(open_ & ~hit))}
 
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
         """What a render says about itself: (header entries for PNG/EXR, the tail of the

@@ -157,16 +157,16 @@ def check_numerics(scene: Scene) -> None:
 
 
 # What a render can keep on the host, per pixel (RenderResult's arrays, float32 / int32):
-# bytes each.  "bracket" is always kept: it is the depth's certificate and every render
-# reports its statistics.  The device holds two tiles at a time (plan.TILE), whatever the size.
-OUTPUT_BYTES = {"color": 12, "alpha": 4, "depth": 4, "bracket": 4, "normal": 12, "position": 16,
+# bytes each.  "bracket" and "unresolved" are always kept: they are the depth's certificate
+# and every render reports their statistics.  The device holds two tiles at a time (plan.TILE), whatever the size.
+OUTPUT_BYTES = {"color": 12, "alpha": 4, "depth": 4, "bracket": 4, "unresolved": 4, "normal": 12, "position": 16,
                 "status": 4, "samples": 4}
 OUTPUTS = tuple(OUTPUT_BYTES)
 HOST_MEMORY_SHARE = 0.5     # of the physical memory
 
 
 def resolve_outputs(outputs) -> frozenset[str]:
-    """The outputs kept: all (None) or the named ones, plus "bracket" (always)."""
+    """The outputs kept: all (None) or the named ones, plus "bracket" and "unresolved" (always)."""
     if outputs is None:
         return frozenset(OUTPUTS)
     if isinstance(outputs, str):   # one name, not its letters
@@ -182,7 +182,7 @@ def resolve_outputs(outputs) -> frozenset[str]:
     unknown = sorted(names - set(OUTPUTS))
     if unknown:
         raise SceneError("outputs", f"unknown output {unknown[0]!r}; one of {', '.join(OUTPUTS)}")
-    return frozenset(names | {"bracket"})
+    return frozenset(names | {"bracket", "unresolved"})
 
 
 def host_bytes_per_pixel(outputs=None) -> int:

@@ -63,9 +63,10 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
         origins, dirs = generate_rays(frame, w, h, sample=sample, samples=samples)
         guard = np.zeros(len(origins), np.int64)
         bracket = np.full(len(origins), np.inf)
+        unresolved = np.zeros(len(origins))
         depth, point, status, smp = march(origins, dirs, ma.c, ma.max_iter, ma.bailout, ma.epsilon, ma.radius,
                                           ma.near, ma.far, ma.z_resolution, ma.post_steps, ma.max_steps,
-                                          ma.method, guard, ma.refine, bracket, F, planes)
+                                          ma.method, guard, ma.refine, bracket, F, planes, unresolved)
         normal = clip_normals(guard, status, frame, planes, normals(point, depth, status, guard))
         refl = None
         if sa.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray
@@ -83,9 +84,9 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
         rgba = shade(status, normal, point, frame, sa.point_light, sa.color, sa.background, sa.light_color, sa.ambient,
                      sa.diffuse, sa.specular, sa.shininess, terms, lut, sa.fog, sa.fog_start, sa.sky, geo, rgb,
                      extra_visibility_of_plan(plan, point, normal, status, F), refl, sa.reflection)
-        return rgba, depth, point, status, smp, normal, guard, bracket
+        return rgba, depth, point, status, smp, normal, guard, bracket, unresolved
 
-    rgba, depth, point, status, smp, normal, guard, bracket = one_pass(0, 1)
+    rgba, depth, point, status, smp, normal, guard, bracket, unresolved = one_pass(0, 1)
     S = scene.image.samples
     if S > 1:
         mean = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
@@ -97,6 +98,7 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
                        depth=depth.reshape(h, w), normal=normal.reshape(h, w, 3),
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
                        samples=smp.reshape(h, w), bracket=bracket.reshape(h, w),
+                       unresolved=unresolved.reshape(h, w),
                        device_name="numpy float64 reference", scene=scene,
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0

@@ -37,9 +37,10 @@ class Formula:
         mod = importlib.import_module(entry.twin)
         if self.function == "pwr":
             p = complex(*self.exponent)
-            fn = _Bound(functools.partial(mod.cfun, p=p), functools.partial(mod.cfun_d, p=p), None)
+            fn = _Bound(functools.partial(mod.cfun, p=p), functools.partial(mod.cfun_d, p=p), None,
+                        functools.partial(mod.cfun_disc, p=p), functools.partial(mod.FUNC_M2, p=p))
         else:
-            fn = _Bound(mod.cfun, mod.cfun_d, entry.degree)
+            fn = _Bound(mod.cfun, mod.cfun_d, entry.degree, mod.cfun_disc, getattr(mod, "FUNC_M2", None))
         object.__setattr__(self, "alg", alg)
         object.__setattr__(self, "fn", fn)
 
@@ -74,6 +75,12 @@ class Formula:
         return bool(self.fn.FUNC_POWER) if de == "polynomial" else bool(de)
 
     @property
+    def enclose(self):
+        """The algebra's orbit enclosures for the proven march (reference/enclose/, the twin
+        of the registry's enclosure piece)."""
+        return importlib.import_module("pyjulia4d.reference." + ALGEBRAS_TABLE[self.algebra].enclosure_piece.replace("/", "."))
+
+    @property
     def split(self) -> bool:
         """A split algebra: the estimate is that of a product of two sets (iterate.cl)."""
         return bool(getattr(self.alg, "ALG_SPLIT", False))
@@ -92,6 +99,8 @@ class _Bound:
     cfun: Any
     cfun_d: Any
     FUNC_POWER: int | None
+    cfun_disc: Any = None   # its disc enclosure (reference/enclose/disc.py)
+    FUNC_M2: Any = None     # its bound on |f''| over a disc, where it has one (reference/enclose/split.py)
 
 
 QUATERNION_SQR = Formula()

@@ -1,5 +1,5 @@
-"""Twin of kernels/march/: refine.cl (the certified bracket), fixed.cl and de.cl (the
-marches along one ray) and march.cl (every ray of an image, with clip planes)."""
+"""Twin of kernels/march/: refine.cl (the certified bracket), fixed.cl, de.cl and proven.cl
+(the marches along one ray) and march.cl (every ray of an image, with clip planes)."""
 from __future__ import annotations
 
 import numpy as np
@@ -97,7 +97,9 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
         t_prev = near[k] + (samples[k] - 2) * h[k]
         t[k], width[k] = refine_bracket(o[k], d[k], t_prev, t[k], post_steps, c, max_iter, bailout, itp,
                                         formula=formula)
-    return t, status, samples, np.zeros(n, np.int32), width
+    # samples prove nothing between them: all of the ray in front of the depth is unproven
+    unresolved = np.where(status == STATUS_HIT, t - near, far - near)
+    return t, status, samples, np.zeros(n, np.int32), width, unresolved
 
 
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
@@ -150,20 +152,106 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp,
                                         formula=formula)
     t[status != STATUS_HIT] = np.inf
-    return t, status, samples, flags, width
+    # the estimate is no proof for the truncated set: nothing in front is proven (march/de.cl)
+    unresolved = np.where(status == STATUS_HIT, t - near, far - near)
+    return t, status, samples, flags, width, unresolved
+
+
+# ------------------------------------------------------------------- march/proven.cl
+
+def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
+    """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
+    (reference/enclose/) outside the bailout ball at some n <= max_iter - and the largest
+    enc_margin over the iterations (march/proven.cl)."""
+    E = formula.enclose
+    b2 = bailout * bailout
+    e = E.enc_segment(o, d, t0, t1, formula)
+    cc = formula.ALG_C(np.asarray(c, np.float64))
+    proven = E.enc_outside(e, b2)
+    live = ~proven
+    best = E.enc_margin(e, bailout)
+    for _ in range(max_iter):
+        if not live.any():
+            break
+        e = E.enc_step(e, cc, formula)
+        out = live & E.enc_outside(e, b2)
+        best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
+        proven |= out
+        live &= ~out & E.enc_finite(e)
+    return proven, best
+
+
+PROVEN_FIRST = 0.125
+
+
+def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
+                 itp=True, formula: Formula = QUATERNION_SQR):
+    """Segments from near on, each proven empty or shortened (by the enclosure's margin) down
+    to the floor (far - near) / z_resolution, where the far end is tested: inside ends the
+    march with the certified bracket, outside passes the segment unproven (march/proven.cl).
+    Returns (t, status, samples, flags, width, unresolved)."""
+    n = len(o)
+    span = far - near
+    floor_w = span / z_resolution
+    h = np.maximum(span * PROVEN_FIRST, floor_w)
+    t, t_in = near.copy(), near.copy()
+    first_open, open_w = np.full(n, np.inf), np.zeros(n)
+    first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
+    active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
+    count = np.zeros(n, np.int32)
+    for _ in range(max_steps):
+        k = np.nonzero(active)[0]
+        if k.size == 0:
+            break
+        t1 = np.minimum(t[k] + h[k], far[k])
+        empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
+        count[k] += 1
+        at_floor = ~empty & (h[k] <= floor_w[k])
+        got = np.zeros(k.size, bool)
+        if at_floor.any():
+            j = np.nonzero(at_floor)[0]
+            got[j] = julia_inside(o[k[j]] + t1[j, None] * d[k[j]], c, max_iter, bailout, formula)
+        opened = at_floor & ~got
+        first_open[k] = np.where(opened, np.minimum(first_open[k], t[k]), first_open[k])
+        open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
+        hit[k] |= got
+        t_in[k] = np.where(got, t1, t_in[k])
+        passed = empty | opened
+        done = passed & (t1 >= far[k])
+        miss[k] |= done
+        mg = np.where(np.isnan(margin), 0.0, margin)
+        grow, shrink = np.clip(mg * 0.7, 1, 4), np.clip(mg * 0.7, 1 / 64, 0.5)
+        h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
+        h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_w[k]), h[k])
+        t[k] = np.where(passed & ~done, t1, t[k])
+        active[k] &= ~(got | done)
+    status = np.where(hit, STATUS_HIT, np.where(miss, STATUS_MISS, STATUS_CAPPED)).astype(np.int32)
+    width = np.full(n, np.inf)
+    width[first] = 0.0
+    depth = np.where(hit, t_in, np.inf)
+    k = np.nonzero(hit & ~first)[0]
+    if k.size:
+        depth[k], width[k] = refine_bracket(o[k], d[k], t[k], t_in[k], post_steps, c, max_iter, bailout, itp,
+                                            formula=formula)
+    with np.errstate(invalid="ignore"):
+        front = np.where(first_open < depth, depth - first_open, 0.0)
+    left = np.where(active, open_w + (far - t), open_w)
+    return depth, status, count, np.zeros(n, np.int32), width, np.where(hit, front, left)
 
 
 # --------------------------------------------------------------------- march/march.cl
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
           z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
-          formula: Formula = QUATERNION_SQR, clip=None):
+          formula: Formula = QUATERNION_SQR, clip=None, unresolved=None):
     """Clip each ray to the bounding 4-ball (and the ``clip`` half-spaces m . x <= e, world
     space: camera.clip_planes), then march; returns (depth, point, status, samples).  A hit
     at the first point of an interval a plane started is on its cut face: flags get
     FLAG_CUT_FACE | k << 5.
     ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
-    ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere)."""
+    ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere),
+    ``unresolved`` (float array, optional) the width in front of each depth (the whole ray
+    on a miss) the march did not prove empty (0 off the bounding ball)."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = dot4(o, d)
@@ -195,8 +283,8 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     samples = np.zeros(n, np.int32)
     k = np.nonzero(live)[0]
     if k.size:
-        fn = march_fixed if method == "fixed" else march_de
-        depth[k], status[k], samples[k], fl, wd = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
+        fn = {"fixed": march_fixed, "proven": march_proven}.get(method, march_de)
+        depth[k], status[k], samples[k], fl, wd, un = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
                                                      epsilon, z_resolution, post_steps, max_steps,
                                                      refine == "itp", formula)
         if flags is not None:
@@ -206,6 +294,9 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
         if bracket is not None:
             bracket[:] = np.inf
             bracket[k] = np.where(status[k] == STATUS_HIT, wd, np.inf)
+        if unresolved is not None:
+            unresolved[:] = 0.0
+            unresolved[k] = un
     depth[status != STATUS_HIT] = np.inf
     point = np.where((status == STATUS_HIT)[:, None], o + np.where(np.isfinite(depth), depth, 0)[:, None] * d, np.nan)
     return depth, point, status, samples

@@ -273,7 +273,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
     },
     "march": {
         "quality": Choice(*QUALITIES),
-        "method": Choice("auto", "fixed", "de"),
+        "method": Choice("auto", "fixed", "de", "proven"),
         # the kernel's int loop counter: from 2^31 - 2 on refused at render time (workload.py)
         "z_resolution": Integer(1, INT_MAX),
         "post_steps": Integer(0, 1000),

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from pyjulia4d.fractal.registry import FUNCTIONS_OF, MANDELBROT_START, has_distance_estimate, locus_escape_radius
+from pyjulia4d.fractal.registry import FUNCTIONS_OF, MANDELBROT_START, can_prove, has_distance_estimate, locus_escape_radius
 from pyjulia4d.geometry.vec4 import Degenerate, norm, orthonormalise, unit
 from pyjulia4d.scene.checks import SceneError
 
@@ -125,6 +125,10 @@ def check_fractal(scene: Any) -> None:
     if m.quality != "custom" and f.algebra != "quaternion":
         raise SceneError("march.quality", f"the presets were measured on quaternion sets; for {pair} set the "
                          f"march keys (march.quality=custom), measured in README's algebras section")
+    if m.method == "proven" and not can_prove(f):
+        raise SceneError("march.method", f"proven needs orbit enclosures, which exist for the Julia sets of "
+                         f"every algebra and function without fractal.theta; for a {f.kind} set"
+                         f"{' with theta' if f.theta else ''} use fixed, de or auto")
     if has_distance_estimate(f):
         return
     if m.method == "de" and f.kind != "julia_stack":   # the stack's "de": its empirical estimate

@@ -224,7 +224,7 @@ return a;
 }
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
 int z_resolution, int post_steps, int max_steps, lmask *status,
-lmask *samples, lmask *flags, lreal *width)
+lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
 lreal t = near, t_prev = near;
 lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
@@ -255,7 +255,9 @@ t = ((active) ? (next) : (t));
 lreal w;
 lreal a = refine_bracket(o, d, t_prev, t, hit & !first, post_steps, jp, &w);
 *width = ((hit) ? (((hit & !first) ? (w) : ((lreal)0))) : (*width));
-return ((hit) ? (((hit & !first) ? (a) : (t))) : ((lreal)INFINITY));
+lreal depth = ((hit) ? (((hit & !first) ? (a) : (t))) : ((lreal)INFINITY));
+*unresolved = ((live) ? (((hit) ? (depth - near) : (far - near))) : (*unresolved));
+return depth;
 }
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {

@@ -12,3 +12,4 @@ julia_f, julia_f_jvp = power.maps(alg_mul)
 
 
 ALG_HAS_DE = False
+ALG_ENCLOSE_K, ALG_LBOUND, ALG_LBOUND_SQR = power.enclose_bounds(alg_mul)   # reference/enclose/ball.py

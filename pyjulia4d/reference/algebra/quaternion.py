@@ -84,3 +84,15 @@ def JULIA_DF2(m2, power):
 
 
 ALG_HAS_DE = True
+
+
+# reference/enclose/ball.py (kernels/algebra/quaternion.cl): |a b| = |a| |b|
+ALG_ENCLOSE_K = 1.0
+
+
+def ALG_LBOUND(m):
+    return np.sqrt(np.sum(m * m, axis=-1))
+
+
+def ALG_LBOUND_SQR(m):
+    return np.sum(m * m, axis=-1)

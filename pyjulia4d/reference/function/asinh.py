@@ -1,6 +1,8 @@
 """float64 twin of kernels/function/asinh.cl: f(z) = asinh z (seed 003_8ca5f9108f52d3d6.txt,
 "asinh"), numpy's complex function (its branch cuts)."""
-import numpy as np  # noqa: F401
+import numpy as np
+
+from pyjulia4d.reference.enclose import disc as D
 
 
 def cfun(z):
@@ -9,3 +11,9 @@ def cfun(z):
 
 def cfun_d(z):
     return 1 / np.sqrt(z * z + 1)
+
+
+def cfun_disc(z):
+    """The disc enclosure of f (kernels/function/asinh.cl, under -D ENCLOSE)."""
+    with np.errstate(all="ignore"):
+        return D.d_asinh(z)

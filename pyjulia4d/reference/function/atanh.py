@@ -1,6 +1,8 @@
 """float64 twin of kernels/function/atanh.cl: f(z) = atanh z (seed 003_8ca5f9108f52d3d6.txt,
 "atanh"), numpy's complex function (its branch cuts)."""
-import numpy as np  # noqa: F401
+import numpy as np
+
+from pyjulia4d.reference.enclose import disc as D
 
 
 def cfun(z):
@@ -9,3 +11,9 @@ def cfun(z):
 
 def cfun_d(z):
     return 1 / (1 - z * z)
+
+
+def cfun_disc(z):
+    """The disc enclosure of f (kernels/function/atanh.cl, under -D ENCLOSE)."""
+    with np.errstate(all="ignore"):
+        return D.d_atanh(z)

@@ -2,6 +2,8 @@
 scene's fractal.exponent (seed 003_8ca5f9108f52d3d6.txt, "pwr(x, y)"); 0^p = 0, as the kernel."""
 import numpy as np
 
+from pyjulia4d.reference.enclose import disc as D
+
 
 def cfun(z, p):
     with np.errstate(all="ignore"):
@@ -13,3 +15,19 @@ def cfun_d(z, p):
     with np.errstate(all="ignore"):
         r = p * np.exp((p - 1) * np.log(z))
     return np.where(z == 0, 0, r)
+
+
+def cfun_disc(z, p):
+    """The disc enclosure of z^p = exp(p log z), both sides of log's cut (kernels/function/pwr.cl)."""
+    return D.d_pwr(z, p)
+
+
+def FUNC_M2(m, rho, p):
+    """|p (p - 1) z^(p - 2)| <= |p (p - 1)| e^(max(Re q ln|z|) + |Im q| pi), q = p - 2, over the
+    disc; none (inf) where it meets log's cut or 0 (kernels/function/pwr.cl)."""
+    qr, qi = p.real - 2, p.imag
+    with np.errstate(all="ignore"):
+        lo, hi = np.log(np.abs(m) - rho), np.log(np.abs(m) + rho)
+        e = np.maximum(qr * lo, qr * hi) + abs(qi) * D.ENC_PI
+        bad = D.d_meets_cut((m, rho)) | ~(np.abs(m) > rho)
+        return np.where(bad, np.inf, abs(p) * abs(p - 1) * np.exp(e) * D.ENC_UP)

@@ -1,0 +1,70 @@
+/* enclose/ball.cl: orbit enclosures of a ray segment for the algebras whose iterate is the
+ * point itself (algebra/quaternion.cl, cquat.cl, commutative.cl), for march/proven.cl.
+ *
+ * The segment's points are p(s) = m + s v, s in [-1, 1] (m its midpoint, v half its
+ * extent).  The enclosure is an affine form with one noise symbol, the segment's own s:
+ *     q_n(s) in m_n + s v_n + B(r_n),
+ * a centre, a tangent and a remainder ball (affine arithmetic with one symbol: Knoll,
+ * Hijazi, Kensler, Schott, Hansen and Hagen 2009 enclose implicit surfaces along rays
+ * this way).  The spread along the orbit's tangent is carried exactly to first order, so
+ * only second-order terms and the part of the remainder that the map stretches go into the
+ * ball; a ball alone would grow by the map's largest stretch in every direction at every
+ * step (the wrapping that makes plain interval proofs fail near the surface).
+ *
+ * With q = m + d, d = s v + e, |e| <= r, rho = |v| + r >= |d|, and the algebra's bounds on
+ * its product - ALG_ENCLOSE_K, a K with |a b| <= K |a| |b| (1 for quaternions, whose
+ * norm is multiplicative; 2 for the multiplication tables: each coordinate of a b is
+ * a^T P b with P a signed permutation) and ALG_LBOUND(m), a bound on the norm of h ->
+ * m h (|m|; the tables' |m|_1):
+ *     f(q) = f(m) + J[s v] + J[e] + R,  J = julia_f_jvp at m,
+ *     D = 2:  |J[e]| <= 2 L(m) r,                    |R| = |d d| <= K rho^2;
+ *     D = 3:  |J[e]| <= (L(m m) + 2 L(m)^2) r,       |R| <= 3 K L(m) rho^2 + K^2 rho^3
+ * ((m + d)^3 with the cube's bracketing, algebra/power.cl; the quaternions' the same by
+ * associativity).  Every radius is raised for the rounding of the centre and tangent
+ * (enclose/disc.cl enc_radius). */
+
+typedef struct { quat m, v; lreal r; } enclosure;
+
+inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
+{
+    lreal tm = (real)0.5 * (t0 + t1), hw = (real)0.5 * (t1 - t0);
+    enclosure e = {QRAY(o, d, tm), QSCALE(hw, d), enc_radius((lreal)0, QLEN(o) + fabs(tm) * QLEN(d), ENC_ROUND)};
+    return e;
+}
+
+inline enclosure enc_step(enclosure e, real4 c)
+{
+    lreal s = QLEN(e.m), lm = ALG_LBOUND(e.m), sv = QLEN(e.v);
+    lreal rho = sv + e.r;
+    real K = (real)ALG_ENCLOSE_K;
+#if FUNC_POWER == 2
+    lreal r = (real)2 * lm * e.r + K * rho * rho;
+    lreal size = K * s * s;
+#else
+    lreal r = (ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm) * e.r + ((real)3 * K * lm + K * K * rho) * rho * rho;
+    lreal size = K * K * s * s * s;
+#endif
+    quat v = julia_f_jvp(e.m, e.v);
+    enclosure out = {julia_f(e.m, c), v, enc_radius(r, (real)2 * size + length(c) + (real)4 * QLEN(v), ENC_ROUND)};
+    return out;
+}
+
+/* the least |m + s v| over s in [-1, 1]: the distance from 0 to the segment */
+inline lreal enc_least_norm(quat m, quat v)
+{
+    lreal vv = QNORM2(v);
+    lreal s = clamp(L_SEL(-QDOT(m, v) / vv, (lreal)0, vv == (real)0), (lreal)-1, (lreal)1);
+    return QLEN(QADD(m, QSCALE(s, v)));
+}
+
+inline lmask enc_outside(enclosure e, real bailout2)
+{
+    lreal l = enc_least_norm(e.m, e.v) * ((real)1 - ENC_ROUND) - e.r;
+    return (l > (real)0) & (l * l > bailout2);
+}
+
+/* how many times its extent the centre lies beyond the bailout (<= 0: inside): the march
+ * sizes its next segment by it */
+inline lreal enc_margin(enclosure e, real bailout) { return (QLEN(e.m) - bailout) / (QLEN(e.v) + e.r); }
+
+inline lmask enc_finite(enclosure e) { return e.r < (lreal)INFINITY; }

@@ -1,0 +1,80 @@
+/* enclose/split.cl: orbit enclosures of a ray segment in a split algebra
+ * (algebra/hypercomplex.cl), for march/proven.cl.  The iterate is kept as its two idempotent
+ * components a, b, each a complex number iterated on its own by f, so each gets an affine
+ * form in the segment's s in [-1, 1] (enclose/ball.cl says why):
+ *     a_n(s) in m + s v + B(r)   (complex m, v),
+ * pushed through f by Taylor's theorem: with d = s v + e, |e| <= r, rho = |v| + r,
+ *     f(m + d) = f(m) + s f'(m) v + f'(m) e + R,   |R| <= rho^2 / 2 sup|f''|,
+ * the sup over the disc of radius rho around m, which the function piece bounds
+ * (FUNC_M2(m, rho), function/<name>.cl).  Where it gives no bound (a pole or a branch cut
+ * in the disc) or the piece has none, the form is widened to its disc {m, |v| + r} and
+ * pushed through the piece's cfun_disc (enclose/disc.cl) instead, tangent 0.  All points
+ * are outside the bailout ball when |h|^2 = (|a|^2 + |b|^2) / 2 > bailout^2 at the least
+ * |(a, b)| the forms allow. */
+
+typedef struct { cplx m, v; lreal r; } caff;
+typedef struct { caff a, b; } enclosure;
+
+inline caff A(cplx m, cplx v, lreal r) { caff z = {m, v, r}; return z; }
+
+inline caff caff_f(caff z)
+{
+    lreal rho = c_abs(z.v) + z.r;
+    caff out = z;
+#ifdef FUNC_M2
+    cplx fm = cfun(z.m), d1 = cfun_d(z.m);
+    cplx v = c_mul(d1, z.v);
+    lreal da = c_abs(d1);
+    lreal r = da * z.r * ENC_UP + (real)0.5 * rho * rho * FUNC_M2(z.m, rho) * ENC_UP;
+    r = enc_radius(L_SEL(r, (lreal)INFINITY, isnan(r)), c_abs(fm) + (real)4 * c_abs(v), ENC_ROUND_FN);
+    out = A(fm, v, r);
+    lmask bad = !(r < (lreal)INFINITY);
+    if (!L_ANY(bad))
+        return out;
+#else
+    lmask bad = L_TRUE;
+#endif
+    cdisc w = cfun_disc(D(z.m, enc_radius(rho, (lreal)0, ENC_ROUND)));
+    return A(C(L_SEL(out.m.re, w.m.re, bad), L_SEL(out.m.im, w.m.im, bad)),
+             C(L_SEL(out.v.re, (lreal)0, bad), L_SEL(out.v.im, (lreal)0, bad)), L_SEL(out.r, w.r, bad));
+}
+
+/* the points o + t d, t in [t0, t1]: centre, tangent and the rounding of o + t d and ALG_IN */
+inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
+{
+    lreal tm = (real)0.5 * (t0 + t1), hw = (real)0.5 * (t1 - t0);
+    quat q = ALG_IN(QRAY(o, d, tm)), v = ALG_IN(QSCALE(hw, d));
+    lreal r = enc_radius((lreal)0, (real)2 * (QLEN(o) + fabs(tm) * QLEN(d)), ENC_ROUND);
+    enclosure e = {A(C(q.x, q.y), C(v.x, v.y), r), A(C(q.z, q.w), C(v.z, v.w), r)};
+    return e;
+}
+
+inline enclosure enc_step(enclosure e, real4 c)
+{
+    caff a = caff_f(e.a), b = caff_f(e.b);
+    cplx ca = C((lreal)c.x, (lreal)c.y), cb = C((lreal)c.z, (lreal)c.w);
+    enclosure out = {A(c_add(a.m, ca), a.v, enc_radius(a.r, c_abs(a.m) + c_abs(ca), ENC_ROUND)),
+                     A(c_add(b.m, cb), b.v, enc_radius(b.r, c_abs(b.m) + c_abs(cb), ENC_ROUND))};
+    return out;
+}
+
+/* every point has |h|^2 > bailout2: |(a, b)| >= |(ma + s va, mb + s vb)| - |(ra, rb)|, the
+ * first least over s in [-1, 1] (the distance from 0 to a segment in R^4) */
+inline lmask enc_outside(enclosure e, real bailout2)
+{
+    quat m = QUAT(e.a.m.re, e.a.m.im, e.b.m.re, e.b.m.im), v = QUAT(e.a.v.re, e.a.v.im, e.b.v.re, e.b.v.im);
+    lreal vv = QNORM2(v);
+    lreal s = clamp(L_SEL(-QDOT(m, v) / vv, (lreal)0, vv == (real)0), (lreal)-1, (lreal)1);
+    lreal l = QLEN(QADD(m, QSCALE(s, v))) * ((real)1 - ENC_ROUND) - hypot(e.a.r, e.b.r);
+    return (l > (real)0) & ((real)0.5 * l * l > bailout2);
+}
+
+/* how many times its extent the centre lies beyond the bailout (<= 0: inside) */
+inline lreal enc_margin(enclosure e, real bailout)
+{
+    lreal hm = sqrt((real)0.5 * (e.a.m.re * e.a.m.re + e.a.m.im * e.a.m.im + e.b.m.re * e.b.m.re + e.b.m.im * e.b.m.im));
+    lreal ext = hypot(c_abs(e.a.v) + e.a.r, c_abs(e.b.v) + e.b.r) * (real)0.70710678118654752;
+    return (hm - bailout) / ext;
+}
+
+inline lmask enc_finite(enclosure e) { return (e.a.r < (lreal)INFINITY) | (e.b.r < (lreal)INFINITY); }

@@ -1,0 +1,121 @@
+/* march/proven.cl: a march that steps over nothing it has not proven empty, on a lane type
+ * (common/lanes.cl).
+ *
+ * A segment [t0, t1] of the ray holds no point of the truncated set when an enclosure of
+ * the orbits of all its points (enclose/ball.cl, enclose/split.cl: enc_segment, enc_step)
+ * lies outside the bailout ball at some iteration n <= max_iter: every point then has
+ * |q_n| > bailout, so none is inside (seed 003_8ca5f9108f52d3d6.txt: inside when |q_n| <=
+ * bailout for n = 0 .. max_iter).  This is the interval ray tracing of Knoll, Hijazi,
+ * Kensler, Schott, Hansen and Hagen (2009) with circular arithmetic for the enclosure.
+ *
+ * The march takes segments from near on: a proven one is passed, one that is not proven
+ * is shortened, down to the floor width (far - near) / z_resolution.  The next length
+ * comes from the enclosure's margin (enc_prove): the radius scales with the length to
+ * first order, so a failed proof shrinks the segment by about its margin (at least 2x,
+ * at most 64x) and a proof with margin to spare lengthens the next (at most 4x); the
+ * lengths only steer the march, the proofs alone decide what is passed.  A floor segment that is not proven has its far end tested: inside ends the
+ * march, with [t0, t1] the certified bracket (t0 is the end of proven-empty space, so
+ * outside) refined by march/refine.cl; outside, the segment is passed unproven, and the
+ * pixel's ``unresolved`` width grows.  So the first crossing lies in
+ * [depth - unresolved, depth + bracket]: unresolved is how far in front of the depth the
+ * march could not prove the ray empty (0: the bracket is the whole error); on a miss it
+ * is the summed width of the ray left unproven, where a thin part may hide.
+ * At most max_steps enclosures per ray (STATUS_CAPPED after); ``samples`` counts them. */
+
+/* Whether [t0, t1] is proven empty, for the lanes in ``todo``; *margin gets the largest
+ * enc_margin over the iterations: about how many times longer the segment could have been
+ * (> 1, proven) or must be shorter (< 1) to be proven, to first order in its length. */
+inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, lreal *margin)
+{
+    enclosure e = enc_segment(o, d, t0, t1);
+    real4 c = ALG_C(jp.c);
+    real bailout = sqrt(jp.bailout2);
+    lmask proven = todo & enc_outside(e, jp.bailout2);
+    lmask live = todo & !proven;
+    lreal best = enc_margin(e, bailout);
+    int n = 0;
+    for (; n < jp.max_iter && L_ANY(live); ++n) {
+        e = enc_step(e, c);
+        lmask out = live & enc_outside(e, jp.bailout2);
+        best = L_SEL(best, fmax(best, enc_margin(e, bailout)), live);
+        proven |= out;
+        live &= (!out) & enc_finite(e);
+    }
+    COUNT_ITER(jp, n);
+    *margin = best;
+    return proven;
+}
+
+/* the first segment: an eighth of the ray, or the floor if that is longer */
+#define PROVEN_FIRST ((real)0.125)
+
+inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
+                       int z_resolution, int post_steps, int max_steps, lmask *status,
+                       lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
+{
+    lreal span = far - near;
+    lreal floor_w = span / (real)z_resolution;
+    lreal h = fmax(span * PROVEN_FIRST, floor_w);
+    lreal t = near, t_in = near, first_open = INFINITY, open_w = 0;
+    lmask first = live & julia_inside(QRAY(o, d, near), jp);
+    lmask active = live & !first, hit = first, miss = 0, n = 0;
+    for (int i = 0; i < max_steps && L_ANY(active); ++i) {
+        lreal t1 = fmin(t + h, far);
+        lreal margin;
+        lmask empty = enc_prove(o, d, t, t1, active, jp, &margin);
+        n = L_SEL(n, n + 1, active);
+        lmask at_floor = active & !empty & (h <= floor_w);
+        lmask got = 0;
+        if (L_ANY(at_floor))
+            got = at_floor & julia_inside(QRAY(o, d, t1), jp);
+        lmask open = at_floor & !got;
+        first_open = L_SEL(first_open, fmin(first_open, t), open);
+        open_w = L_SEL(open_w, open_w + (t1 - t), open);
+        hit |= got;
+        t_in = L_SEL(t_in, t1, got);
+        lmask pass = empty | open;
+        lmask done = pass & (t1 >= far);
+        miss |= done;
+        lreal m = L_SEL((lreal)0, margin, margin == margin);   /* NaN: no guidance */
+        lreal grow = clamp(m * (real)0.7, (lreal)1, (lreal)4);
+        lreal shrink = clamp(m * (real)0.7, (lreal)(1.0 / 64), (lreal)0.5);
+        h = L_SEL(h, fmin(h * grow, span), empty);
+        h = L_SEL(h, fmax(h * shrink, floor_w), active & !empty & !at_floor);
+        t = L_SEL(t, t1, pass & !done);
+        active &= !(got | done);
+    }
+    *samples = L_SEL(*samples, n, live);
+    *status = L_SEL(*status, L_SEL(L_SEL((lmask)STATUS_CAPPED, (lmask)STATUS_MISS, miss),
+                                   (lmask)STATUS_HIT, hit), live);
+    lreal w;
+    lmask bracketed = hit & !first;
+    lreal a = refine_bracket(o, d, t, t_in, bracketed, post_steps, jp, &w);
+    *width = L_SEL(*width, L_SEL((lreal)0, w, bracketed), hit);
+    lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_in, a, bracketed), hit);
+    /* in front of a hit: from the first unproven segment to the depth; a miss: the width
+     * left unproven; a capped ray: that and all it did not reach */
+    lreal front = L_SEL((lreal)0, depth - first_open, first_open < depth);
+    lreal left = L_SEL(open_w, open_w + (far - t), active);
+    *unresolved = L_SEL(*unresolved, L_SEL(left, front, hit), live);
+    return depth;
+}
+
+#ifdef RAYS_FROM_BUFFERS
+/* The proof alone on given segments [t0, t1] of rays o + t d, one per work-item (the tests'
+ * and benchmarks' handle on enc_prove): proven 1 / 0 and the margin. */
+__kernel void prove_segments(const int n_items, __global const real4 *origins, __global const real4 *dirs,
+                             __global const real *t0s, __global const real *t1s, const real4 c,
+                             const int max_iter, const real bailout, __global int *proven,
+                             __global real *margins)
+{
+#if LANES == 1
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_INIT(i) };
+    lreal m;
+    proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &m) ? 1 : 0;
+    margins[i] = m;
+#endif
+}
+#endif

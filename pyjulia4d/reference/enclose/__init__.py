@@ -1,0 +1,1 @@
+"""float64 twins of kernels/enclose/: orbit enclosures for the proven march (march/proven.cl)."""

@@ -1,0 +1,64 @@
+"""float64 twin of kernels/enclose/ball.cl: orbit enclosures of a ray segment p(s) = m + s v,
+s in [-1, 1], as affine forms q_n(s) in m_n + s v_n + B(r_n), for the algebras iterated in
+the point's own coordinates (quaternions, CQuats, the commutative rules).  With rho = |v| + r,
+K, L(m), L(m m) the algebra's product bounds (ALG_ENCLOSE_K, ALG_LBOUND, ALG_LBOUND_SQR):
+    D = 2:  r' = 2 L(m) r + K rho^2,
+    D = 3:  r' = (L(m m) + 2 L(m)^2) r + 3 K L(m) rho^2 + K^2 rho^3,
+centre julia_f(m, c), tangent julia_f_jvp(m, v)."""
+from __future__ import annotations
+
+import numpy as np
+
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius
+
+
+def _norm(q):
+    return np.sqrt(np.sum(q * q, axis=-1))
+
+
+def enc_segment(o, d, t0, t1, F):
+    """The affine form of the points o + t d, t in [t0, t1] (per ray)."""
+    tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    m = o + tm[:, None] * d
+    return m, hw[:, None] * d, enc_radius(0.0, _norm(o) + np.abs(tm) * _norm(d), ENC_ROUND)
+
+
+def enc_step(e, c, F):
+    m, v, r = e
+    alg = F.alg
+    K = alg.ALG_ENCLOSE_K
+    with np.errstate(all="ignore"):
+        s, lm = _norm(m), alg.ALG_LBOUND(m)
+        rho = _norm(v) + r
+        if F.fn.FUNC_POWER == 2:
+            rn, size = 2 * lm * r + K * rho * rho, K * s * s
+        else:
+            rn = (alg.ALG_LBOUND_SQR(m) + 2 * lm * lm) * r + (3 * K * lm + K * K * rho) * rho * rho
+            size = K * K * s ** 3
+        vn = F.julia_f_jvp(m, v)
+        return F.julia_f(m, c), vn, enc_radius(rn, 2 * size + np.linalg.norm(c) + 4 * _norm(vn), ENC_ROUND)
+
+
+def least_norm(m, v):
+    """min |m + s v| over s in [-1, 1]."""
+    vv = np.sum(v * v, axis=-1)
+    with np.errstate(all="ignore"):
+        s = np.clip(np.where(vv == 0, 0.0, -np.sum(m * v, axis=-1) / vv), -1, 1)
+    return _norm(m + s[..., None] * v)
+
+
+def enc_outside(e, bailout2):
+    m, v, r = e
+    with np.errstate(all="ignore"):
+        lo = least_norm(m, v) * (1 - ENC_ROUND) - r
+        return (lo > 0) & (lo * lo > bailout2)
+
+
+def enc_margin(e, bailout):
+    m, v, r = e
+    with np.errstate(all="ignore"):
+        return (_norm(m) - bailout) / (_norm(v) + r)
+
+
+def enc_finite(e):
+    return e[2] < np.inf

@@ -1,0 +1,74 @@
+"""float64 twin of kernels/enclose/split.cl: orbit enclosures of a ray segment in a split
+algebra (the hypercomplex numbers), an affine form m + s v + B(r) (complex m, v; s in
+[-1, 1]) for each idempotent component, pushed through f by Taylor's theorem,
+    f(m + d) = f(m) + s f'(m) v + f'(m) e + R,  |R| <= rho^2 / 2 sup|f''|  (rho = |v| + r),
+with the function's FUNC_M2 bound on |f''| over the disc of radius rho; where there is none
+(the piece has no bound, or a pole or cut is in the disc), through cfun_disc on the
+form's disc, tangent 0."""
+from __future__ import annotations
+
+import numpy as np
+
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius
+from pyjulia4d.reference.enclose.ball import least_norm
+
+
+def caff_f(z, fn):
+    m, v, r = z
+    with np.errstate(all="ignore"):
+        rho = np.abs(v) + r
+        if fn.FUNC_M2 is not None:
+            fm, d1 = fn.cfun(m), fn.cfun_d(m)
+            vn = d1 * v
+            rn = np.abs(d1) * r * ENC_UP + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * ENC_UP
+            rn = enc_radius(np.where(np.isnan(rn), np.inf, rn), np.abs(fm) + 4 * np.abs(vn), ENC_ROUND_FN)
+            bad = ~(rn < np.inf)
+        else:
+            fm, vn, rn = m, v, r
+            bad = np.ones(np.shape(m), bool)
+        if not bad.any():
+            return fm, vn, rn
+        wm, wr = fn.cfun_disc((m, enc_radius(rho, 0.0, ENC_ROUND)))
+    return np.where(bad, wm, fm), np.where(bad, 0j, vn), np.where(bad, wr, rn)
+
+
+def enc_segment(o, d, t0, t1, F):
+    tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    q = F.ALG_IN(o + tm[:, None] * d)
+    v = F.ALG_IN(hw[:, None] * d)
+    r = enc_radius(0.0, 2 * (np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1)), ENC_ROUND)
+    return ((q[:, 0] + 1j * q[:, 1], v[:, 0] + 1j * v[:, 1], r), (q[:, 2] + 1j * q[:, 3], v[:, 2] + 1j * v[:, 3], r))
+
+
+def enc_step(e, c, F):
+    out = []
+    for z, ck in zip(e, (complex(c[0], c[1]), complex(c[2], c[3]))):
+        m, v, r = caff_f(z, F.fn)
+        out.append((m + ck, v, enc_radius(r, np.abs(m) + abs(ck), ENC_ROUND)))
+    return tuple(out)
+
+
+def _joined(e):
+    (am, av, ar), (bm, bv, br) = e
+    m = np.stack([am.real, am.imag, bm.real, bm.imag], axis=-1)
+    v = np.stack([av.real, av.imag, bv.real, bv.imag], axis=-1)
+    return m, v, ar, br
+
+
+def enc_outside(e, bailout2):
+    m, v, ar, br = _joined(e)
+    with np.errstate(all="ignore"):
+        lo = least_norm(m, v) * (1 - ENC_ROUND) - np.hypot(ar, br)
+        return (lo > 0) & (0.5 * lo * lo > bailout2)
+
+
+def enc_margin(e, bailout):
+    (am, av, ar), (bm, bv, br) = e
+    with np.errstate(all="ignore"):
+        hm = np.sqrt(0.5 * (np.abs(am) ** 2 + np.abs(bm) ** 2))
+        ext = np.hypot(np.abs(av) + ar, np.abs(bv) + br) * 0.70710678118654752
+        return (hm - bailout) / ext
+
+
+def enc_finite(e):
+    return (e[0][2] < np.inf) | (e[1][2] < np.inf)

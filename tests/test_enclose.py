@@ -1,0 +1,194 @@
+"""Proofs of empty space (kernels/enclose/, kernels/march/proven.cl, and their twins in
+reference/enclose/ and reference/march.py), held to the mathematics:
+
+- every function's disc enclosure (cfun_disc) holds the float64 images of points sampled in
+  its disc, near poles and across branch cuts included;
+- every pair's orbit enclosure (enc_segment, enc_step) holds the float64 orbits of points
+  sampled along its segment, step after step;
+- no segment proven empty holds an inside point (the set test at 201 samples);
+- the kernel's proofs match the twin's, and the proven march's kernel matches its twin;
+- a render's stated interval [depth - unresolved, depth + bracket] holds the float64 brute
+  force's first crossing.
+
+Tolerances: the enclosures are checked exactly (float64 samples against float64 radii, with
+a relative 1e-12 for the samples' own rounding); kernel against twin with the float32
+classification slack of test_march.py."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from harness import Runner
+from pyjulia4d import Scene, reference as ref
+from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF
+from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.measure.truth import brute_force_depth
+from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.reference.formula import Formula, formula_of
+from pyjulia4d.reference.march import enc_prove
+
+PAIRS = [(a, f) for a, fs in FUNCTIONS_OF.items() for f in fs]
+# centres where each function is hard: poles of tan / tanh / 1/z, the cuts of ln, sqrt and
+# the inverse functions, large imaginary parts for sin and cos
+HARD = {"tan": [np.pi / 2, -np.pi / 2 + 0.01j], "tanh": [1j * np.pi / 2, 0.01 - 1.5707j],
+        "reciprocal": [0.0, 1e-3j], "ln": [-1.0, -0.5 + 1e-3j, 0.0], "pwr": [-1.0 + 1e-4j, -2.0, 0.0],
+        "asin": [1.5, -1.2 + 1e-3j], "acos": [-1.5, 1.01], "acosh": [0.5, -2.0 - 1e-4j],
+        "atanh": [1.0, -1.3], "atan": [1j, -1.5j], "asinh": [2j, -1.1j], "sin": [3 + 4j], "cos": [-2 - 5j]}
+
+
+def _sample_disc(m, r, rng, k=64):
+    """Points of the disc {|z - m| <= r}: its boundary and interior."""
+    ang = rng.uniform(0, 2 * np.pi, (len(m), k))
+    rad = np.concatenate([np.ones((len(m), k // 2)), np.sqrt(rng.uniform(0, 1, (len(m), k - k // 2)))], axis=1)
+    return m[:, None] + r[:, None] * rad * np.exp(1j * ang)
+
+
+@pytest.mark.parametrize("name", FUNCTIONS)
+@pytest.mark.parametrize("exponent", [(2.0, 0.0), (2.5, 0.7)], ids=["p2", "p2.5+0.7i"])
+def test_disc_enclosures_hold_the_images(name, exponent):
+    if name != "pwr" and exponent != (2.0, 0.0):
+        pytest.skip("the exponent is pwr's")
+    fn = Formula("hypercomplex", name, exponent).fn
+    rng = np.random.default_rng(abs(hash((name, exponent))) % 2**32)
+    m = np.concatenate([rng.uniform(-3, 3, 300) + 1j * rng.uniform(-3, 3, 300), np.repeat(HARD.get(name, [0.3]), 40)])
+    r = np.exp(rng.uniform(np.log(1e-6), np.log(1.0), len(m)))
+    fm, fr = fn.cfun_disc((m.astype(np.complex128), r))
+    z = _sample_disc(m, r, rng)
+    with np.errstate(all="ignore"):
+        w = fn.cfun(z)
+    ok = np.isfinite(w) & (fr[:, None] < np.inf)   # an infinite radius: no bound given, none claimed
+    dist = np.abs(w - fm[:, None])
+    bound = fr[:, None] * (1 + 1e-12) + 1e-300
+    assert not (ok & ~(dist <= bound)).any(), (name, np.argwhere(ok & ~(dist <= bound))[:3])
+    assert np.isfinite(fr).mean() > 0.5   # the enclosures are not all given up
+
+
+def _scene(algebra, function, **fractal):
+    return Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "max_iter": 8, **fractal},
+                            "image": {"width": 16, "height": 12}})
+
+
+def _segments(s, n, rng, lengths=(0.5, 0.05, 0.005, 5e-4)):
+    R = march_radius(s)
+    o = rng.uniform(-R, R, (n, 4)) * 0.8
+    d = rng.normal(size=(n, 4))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return o, d, np.zeros(n), rng.choice(lengths, n)
+
+
+@pytest.mark.parametrize("algebra,function", PAIRS)
+def test_orbit_enclosures_hold_the_orbits(algebra, function):
+    s = _scene(algebra, function)
+    F = formula_of(s.fractal)
+    E = F.enclose
+    rng = np.random.default_rng(len(algebra) * 31 + len(function))
+    n, k = 120, 33
+    o, d, t0, t1 = _segments(s, n, rng)
+    e = E.enc_segment(o, d, t0, t1, F)
+    sk = np.linspace(-1, 1, k)
+    tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    q = F.ALG_IN(o[:, None] + (tm[:, None] + sk[None] * hw[:, None])[..., None] * d[:, None])
+    c = F.ALG_C(np.asarray(s.fractal.c, np.float64))
+    alive = np.ones((n, k), bool)
+    checked = 0
+    for step in range(s.fractal.max_iter + 1):
+        with np.errstate(all="ignore"):
+            for comp, (m, v, r) in (_components(e, algebra)):
+                pts = q[..., comp]
+                if len(comp) == 2:
+                    pts = pts[..., 0] + 1j * pts[..., 1]
+                    dist = np.abs(pts - (m[:, None] + sk[None] * v[:, None]))
+                else:
+                    dist = np.linalg.norm(pts - (m[:, None] + sk[None, :, None] * v[:, None]), axis=-1)
+                live = alive & np.isfinite(dist) & (r[:, None] < np.inf)
+                bad = live & ~(dist <= r[:, None] * (1 + 1e-9) + 1e-12 * (1 + np.abs(dist)))
+                assert not bad.any(), (step, np.argwhere(bad)[:3], dist[bad][:3], np.broadcast_to(r[:, None], bad.shape)[bad][:3])
+                checked += live.sum()
+            qn = F.julia_f(q.reshape(-1, 4), c).reshape(n, k, 4)
+            alive &= np.all(np.isfinite(qn), axis=-1) & (F.ALG_NORM2(q) < 1e6)
+            q = qn
+            e = E.enc_step(e, c, F)
+    assert checked > n * k   # the enclosures were finite and checked beyond the first step
+
+
+def _components(e, algebra):
+    """(coordinates, (centre, tangent, radius)) of each part of an enclosure."""
+    if algebra == "hypercomplex":
+        return [([0, 1], e[0]), ([2, 3], e[1])]
+    return [([0, 1, 2, 3], e)]
+
+
+@pytest.mark.parametrize("algebra,function", PAIRS)
+def test_proven_segments_hold_no_inside_point(algebra, function):
+    s = _scene(algebra, function)
+    f, F = s.fractal, formula_of(s.fractal)
+    rng = np.random.default_rng(len(algebra) * 7 + len(function))
+    n = 400
+    o, d, t0, t1 = _segments(s, n, rng)
+    proven, _ = enc_prove(o, d, t0, t1, f.c, f.max_iter, f.bailout, F)
+    ts = np.linspace(0.0, 1.0, 201)
+    p = o[:, None, :] + (ts[None, :] * t1[:, None])[..., None] * d[:, None, :]
+    inside = ref.julia_inside(p.reshape(-1, 4), f.c, f.max_iter, f.bailout, F).reshape(n, -1).any(axis=1)
+    assert not (proven & inside).any()
+
+
+KERNEL_PAIRS = [("quaternion", "sqr"), ("quaternion", "cube"), ("hypercomplex", "sin"), ("hypercomplex", "pwr"),
+                ("hypercomplex", "tan"), ("hypercomplex", "ln"), ("hypercomplex", "asinh"), ("cquat", "cube"),
+                ("commutative", "sqr")]
+
+
+@pytest.mark.parametrize("algebra,function", KERNEL_PAIRS)
+def test_kernel_proofs_match_the_twin(algebra, function):
+    s = _scene(algebra, function).with_overrides(["march.method=proven"])
+    f, F = s.fractal, formula_of(s.fractal)
+    R = Runner(kernel_config.scene_config(s, ray_buffers=True))
+    rng = np.random.default_rng(5)
+    n = 600
+    o, d, t0, t1 = _segments(s, n, rng)
+    o, d = o.astype(np.float32).astype(float), d.astype(np.float32).astype(float)
+    t1 = t1.astype(np.float32).astype(float)
+    proven, margin = R.out(n, np.int32), R.out(n)
+    R("prove_segments", (n,), R.buf4(o), R.buf4(d), R.buf(t0), R.buf(t1), R.vec(f.c), np.int32(f.max_iter),
+      R.scalar(f.bailout), proven, margin)
+    kp = proven.get().astype(bool)
+    rp, rm = enc_prove(o, d, t0, t1, f.c, f.max_iter, f.bailout, F)
+    # float32 against float64: a proof decided by a hair may go either way, on few segments
+    assert np.mean(kp != rp) <= 0.02
+    assert kp.sum() > 0.2 * n
+
+
+@pytest.mark.parametrize("algebra,function", KERNEL_PAIRS)
+def test_proven_march_matches_its_twin(algebra, function):
+    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
+                         "march": {"method": "proven", "z_resolution": 2000}, "image": {"width": 32, "height": 24}})
+    k = ref_render = None
+    from pyjulia4d import render
+    k = render(s)
+    ref_render = ref.render(k.scene)
+    both = (k.status == 1) & (ref_render.status == 1)
+    assert np.mean(k.status != ref_render.status) <= 0.01
+    assert both.sum() > 20
+    # the two stated intervals overlap where both hit (each holds the crossing it proved)
+    lo_k, hi_k = k.depth - k.unresolved, k.depth + k.bracket
+    lo_r, hi_r = ref_render.depth - ref_render.unresolved, ref_render.depth + ref_render.bracket
+    slack = 1e-5 * (1 + k.depth)
+    assert np.mean((lo_k <= hi_r + slack) & (lo_r <= hi_k + slack)) >= 0.99
+
+
+@pytest.mark.parametrize("algebra,function", [("quaternion", "cube"), ("hypercomplex", "sin"),
+                                              ("hypercomplex", "cosh"), ("cquat", "sqr"), ("commutative", "cube")])
+def test_stated_interval_holds_the_brute_force(algebra, function):
+    from pyjulia4d import render
+    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
+                         "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": 20, "height": 15}})
+    r = render(s)
+    o, d = ref.generate_rays(camera_frame(r.scene), 20, 15)
+    truth = brute_force_depth(r.scene, o, d).reshape(15, 20)
+    hit = (r.status == 1) & np.isfinite(truth)
+    slack = 4 * np.spacing(np.float32(np.maximum(r.depth, 1))) + 1e-6
+    lo = r.depth - r.unresolved - slack
+    # nothing in front of what the render admits to, except where float32's set test differs
+    assert np.mean(truth[hit] < lo[hit]) <= 0.01
+    # a miss with nothing unresolved is a miss of the truth
+    sure_miss = (r.status != 1) & (r.unresolved == 0)
+    assert np.mean(np.isfinite(truth[sure_miss])) <= 0.01
