@@ -131,13 +131,16 @@ SLACK_ULPS = 8    # float32 slack of the bracket check, in spacings of float32 a
 NORMAL_METHODS = ("jacobian", "gradient", "zbuffer")
 
 
+
+# the tables' split: scenes up to max_iter 20 and the deeper ones, reported apart
+BOUND_MAX_ITER = 20
+
 def scene_max_iter(name: str) -> int:
     return Scene.default().with_overrides(SCENES[name][0]).fractal.max_iter
 
 
 def bounded(name: str) -> bool:
-    """Scenes the presets state a p99 bound for (quality.BOUND_MAX_ITER)."""
-    from pyjulia4d.scene.quality import BOUND_MAX_ITER
+    """Scenes up to max_iter BOUND_MAX_ITER (the tables report the deeper ones apart)."""
     return scene_max_iter(name) <= BOUND_MAX_ITER
 
 
@@ -511,7 +514,7 @@ def write_csv(path: Path, rows: list[dict], columns=None) -> None:
 
 def preset_table(rows: list[dict]) -> list[dict]:
     """Each quality.py preset's measured worst case over the scenes of ``rows``: over the
-    scenes it states a bound for (max_iter <= quality.BOUND_MAX_ITER) and over the rest."""
+    scenes it states a bound for (max_iter <= BOUND_MAX_ITER) and over the rest."""
     from pyjulia4d.scene.quality import PRESETS
     out = []
     for q, pr in PRESETS.items():
@@ -576,9 +579,8 @@ def write_markdown(path: Path, rows: list[dict], meta: dict, truths: dict, prese
     L.append("")
     ptab = preset_table(rows) if meta["mode"] == "full" else []
     if ptab:
-        from pyjulia4d.scene.quality import BOUND_MAX_ITER
         L += ["## The presets (pyjulia4d/quality.py) on every scene", "",
-              f"Stated bounds apply to scenes with max_iter <= {BOUND_MAX_ITER} (quality.BOUND_MAX_ITER); the "
+              f"Stated bounds apply to scenes with max_iter <= {BOUND_MAX_ITER}; the "
               "max_iter 50 scenes are reported beside them (no float32 bound is stated there).", "",
               f"| quality | setting | stated p99 | worst p99, max_iter <= {BOUND_MAX_ITER} (scene) | worst p99, max_iter 50 "
               "(scene) | median p99, all | worst max | stated silhouette | worst silhouette (scene) | worst bracket p99 | "
@@ -891,7 +893,7 @@ def candidates(rows: list[dict]) -> list[dict]:
 
 def choose_presets(rows: list[dict], bounds=PRESET_BOUNDS) -> dict:
     """For each bound, the setting with the least total kernel time over all scenes whose
-    worst-case p99 depth error over the scenes with max_iter <= quality.BOUND_MAX_ITER is
+    worst-case p99 depth error over the scenes with max_iter <= BOUND_MAX_ITER is
     <= bound and whose worst silhouette error over all scenes is <= SIL_MAX."""
     cands = candidates(rows)
     out = {}

@@ -46,7 +46,7 @@ def test_depth_only_gives_the_same_depth(normals):
     assert part.bracket_stats() == full.bracket_stats()
     for k in ("ulp_step", "shell_miss", "eye_hit"):
         assert part.guards[k] == full.guards[k], k
-    assert set(part.exr_channels()) == {"Z", "Z.bracket"}
+    assert set(part.exr_channels()) == {"Z", "Z.bracket", "Z.unresolved"}
     # counts streamed per tile agree with the full status image
     assert full.counts["hit"] == int(np.sum(full.status == 1))
     assert full.capped == int(np.sum(full.status == 2))
@@ -104,7 +104,7 @@ def test_cli_depth_only_exr(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "-o", str(out), "--width", "40",
                         "--height", "30", "--channels", "Z"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    assert sorted(OpenEXR.File(str(out)).channels()) == ["Z", "Z.bracket"]
+    assert sorted(OpenEXR.File(str(out)).channels()) == ["Z", "Z.bracket", "Z.unresolved"]
 
 
 @pytest.mark.parametrize("overrides", [[], ["normals.method=zbuffer"], ["image.samples=2"],

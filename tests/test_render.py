@@ -49,7 +49,7 @@ def test_cli_renders_exr_with_all_channels(tmp_path):
     assert p.stdout.count("\n") == 1 and "% of pixels hit" in p.stdout
     f = OpenEXR.File(str(tmp_path / "out.exr"), separate_channels=True)
     ch = {k: v.pixels for k, v in f.channels().items()}
-    assert set(ch) == {"R", "G", "B", "A", "Z", "Z.bracket", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"}
+    assert set(ch) == {"R", "G", "B", "A", "Z", "Z.bracket", "Z.unresolved", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"}
     hit = ch["A"] == 1
     assert np.all(np.isfinite(ch["Z.bracket"][hit])) and np.all(ch["Z.bracket"][hit] >= 0)
     assert np.all(np.isposinf(ch["Z.bracket"][~hit]))
@@ -80,12 +80,20 @@ def test_cli_reports_guards_that_fired(tmp_path):
 def test_cli_reports_the_bracket_and_the_preset_bound(tmp_path):
     p = cli("--width", "32", "--height", "24", "--set", "march.quality=final", "-o", "f.exr", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert "; depth bracket p50 " in p.stdout and "preset's stated" in p.stdout
+    assert "; depth error p50 " in p.stdout and "preset's stated" in p.stdout
     hdr = OpenEXR.File(str(tmp_path / "f.exr")).header()
-    stats = dict(kv.split("=") for kv in str(hdr["pyjulia4d.depth_bracket"]).split())
-    assert set(stats) == {"p50", "p99", "max"}
-    assert 0 <= float(stats["p50"]) <= float(stats["p99"]) <= float(stats["max"])
+    for key in ("pyjulia4d.depth_bracket", "pyjulia4d.depth_error"):
+        stats = dict(kv.split("=") for kv in str(hdr[key]).split())
+        assert set(stats) == {"p50", "p99", "max"}
+        assert 0 <= float(stats["p50"]) <= float(stats["p99"]) <= float(stats["max"])
     assert str(hdr["pyjulia4d.preset_bound_met"]) in ("yes", "no")
+    assert str(hdr["pyjulia4d.space_proven"]) == "yes"
+    un = dict(kv.split("=") for kv in str(hdr["pyjulia4d.unresolved_pixels"]).split())
+    assert set(un) == {"hit", "miss"} and all(int(v) >= 0 for v in un.values())
+    ch = OpenEXR.File(str(tmp_path / "f.exr")).channels()
+    z, zu, zb = (np.asarray(ch[k].pixels) for k in ("Z", "Z.unresolved", "Z.bracket"))
+    hit = np.isfinite(z)
+    assert np.all(zu >= 0) and np.all(np.isfinite(zu)) and np.all(zb[hit] >= 0)
 
 
 def test_cli_default_scene_png(tmp_path):
@@ -119,14 +127,15 @@ def test_image_too_large_for_memory_refused_before_rendering():
             workload.check(s, force=True)
 
 
-def test_cli_claims_no_bound_beyond_the_measured_max_iter(tmp_path):
-    from pyjulia4d.scene.quality import BOUND_MAX_ITER
-
-    p = cli("--width", "16", "--height", "12", "--set", "march.quality=normal",
-            "--set", f"fractal.max_iter={BOUND_MAX_ITER + 10}", "-o", "n.png", cwd=tmp_path)
+def test_cli_says_whether_the_preset_target_was_met(tmp_path):
+    # a proven preset: the closing line gives the error the render proves and compares it
+    # with the preset's target; a march that proves nothing says so
+    p = cli("--width", "16", "--height", "12", "--set", "march.quality=draft", "-o", "n.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert "states no depth-error bound beyond fractal.max_iter" in p.stdout
-    assert "within the preset's stated" not in p.stdout
+    assert "depth error p50" in p.stdout and "the preset's stated" in p.stdout
+    p = cli("--width", "16", "--height", "12", "--set", "march.method=fixed", "-o", "f.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "not proven empty" in p.stdout
 
 
 def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):

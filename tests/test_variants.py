@@ -57,13 +57,18 @@ def test_packets_give_the_same_pixels(over, lanes):
     assert pk.lanes == lanes and one.lanes == 1
     same = one.status == pk.status
     assert np.mean(same) >= 0.998
-    assert np.mean(one.samples[same] == pk.samples[same]) >= 0.99
+    if not one.proven:   # the proven march sizes its segments by margins, which rounding moves
+        assert np.mean(one.samples[same] == pk.samples[same]) >= 0.99
     assert one.guards == pytest.approx(pk.guards, abs=max(2, 0.002 * s.image.width * s.image.height))
     hit = (one.status == STATUS_HIT) & (pk.status == STATUS_HIT)
     a, wa = one.depth[hit].astype(float), one.bracket[hit].astype(float)
     b, wb = pk.depth[hit].astype(float), pk.bracket[hit].astype(float)
+    # each states the crossing in [depth - unresolved, depth + bracket] (kernels/march/proven.cl;
+    # the fixed scan and the estimate are compared on their brackets)
+    ua = one.unresolved[hit].astype(float) if one.proven else 0.0
+    ub = pk.unresolved[hit].astype(float) if pk.proven else 0.0
     slack = 1e-6 * (1 + np.maximum(a, b))
-    overlap = np.maximum(a, b) <= np.minimum(a + wa, b + wb) + slack
+    overlap = np.maximum(a - ua, b - ub) <= np.minimum(a + wa, b + wb) + slack
     assert np.mean(overlap) >= 0.995
     # the same depth gives the same normal up to the rounding of the Jacobian's sums, which
     # packets add as products where one ray calls dot() (where the depths differ by a few

@@ -37,15 +37,18 @@ inline enclosure enc_step(enclosure e, real4 c)
     lreal s = QLEN(e.m), lm = ALG_LBOUND(e.m), sv = QLEN(e.v);
     lreal rho = sv + e.r;
     real K = (real)ALG_ENCLOSE_K;
+    /* the terms' sizes: of the centre's products and of the tangent's (J's bound times |v|:
+     * the tangent may cancel to far less than its terms) */
 #if FUNC_POWER == 2
     lreal r = (real)2 * lm * e.r + K * rho * rho;
-    lreal size = K * s * s;
+    lreal size = K * s * s + (real)2 * lm * sv;
 #else
-    lreal r = (ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm) * e.r + ((real)3 * K * lm + K * K * rho) * rho * rho;
-    lreal size = K * K * s * s * s;
+    lreal jn = ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm;
+    lreal r = jn * e.r + ((real)3 * K * lm + K * K * rho) * rho * rho;
+    lreal size = K * K * s * s * s + jn * sv;
 #endif
     quat v = julia_f_jvp(e.m, e.v);
-    enclosure out = {julia_f(e.m, c), v, enc_radius(r, (real)2 * size + length(c) + (real)4 * QLEN(v), ENC_ROUND)};
+    enclosure out = {julia_f(e.m, c), v, enc_radius(r, (real)4 * size + (real)2 * length(c), ENC_ROUND)};
     return out;
 }
 

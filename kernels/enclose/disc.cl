@@ -5,13 +5,13 @@
  * orbits of all the points it started from.
  *
  * Rounding: the centre is computed in the working precision, so every radius is raised by
- * a bound on that rounding, ENC_ROUND (polynomial operations, 2^-20: 16 ulps of float32,
- * against the 2-3 ulps that a sum of products can lose relative to the sum of its terms'
- * sizes, which is what the callers pass) or ENC_ROUND_FN (the elementary functions and
- * the complex formulas made of two or three of them, 2^-18: 64 ulps, where OpenCL's full
- * profile allows each function 3-6 ulps - and no -cl-fast-relaxed-math or native_
- * functions are used) times the size of the terms, plus ENC_TINY for results that flush
- * to zero.  Radii are multiplied by ENC_UP after each operation, so
+ * a bound on that rounding: ENC_ROUND (sums of products, 2^-22: 4 ulps of float32 times
+ * the size the callers pass, which is at least twice the sum of the terms' sizes, against
+ * the 0.5 ulp per operation - 3.5 ulps for a sum of four products - that they can lose)
+ * or ENC_ROUND_FN (the elementary functions and the complex formulas made of two or three
+ * of them, 2^-20: 16 ulps of the result, where OpenCL's full profile allows each function
+ * 3-6 ulps, so a product of two 8.5; no -cl-fast-relaxed-math or native_ functions are
+ * used), plus ENC_TINY for results that flush to zero.  Radii are multiplied by ENC_UP after each operation, so
  * rounding in the radius itself cannot shrink it.  Double precision runs the same code:
  * the bounds are then only looser than they need be.
  *
@@ -19,8 +19,8 @@
  * a disc that meets a branch cut where no better bound is known, overflow) gives an
  * infinite radius, and comparisons with NaN are false, so such a disc proves nothing. */
 
-#define ENC_ROUND ((real)9.5367431640625e-7)    /* 2^-20 */
-#define ENC_ROUND_FN ((real)3.814697265625e-6)  /* 2^-18 */
+#define ENC_ROUND ((real)2.384185791015625e-7)  /* 2^-22 */
+#define ENC_ROUND_FN ((real)9.5367431640625e-7) /* 2^-20 */
 #define ENC_UP ((real)1.0000038146972656)       /* 1 + 2^-18 */
 #define ENC_TINY ((real)1e-30)
 #define ENC_PI ((real)3.14159274101257324)      /* float32 pi rounded up */

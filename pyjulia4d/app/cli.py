@@ -188,17 +188,11 @@ def _render(args: argparse.Namespace) -> int:
         from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
 
         result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
-    from pyjulia4d.scene.quality import BOUND_MAX_ITER, stated_p99
+    from pyjulia4d.scene.quality import stated_p99
 
-    # capped rays, the guards that fired and the certified depth bracket are part of the
-    # result: said in the header and the closing line, never hidden
-    q = scene.march.quality
-    stated = stated_p99(q, scene.fractal.max_iter)
-    report, tail = result.report(stated)
-    if q != "custom" and stated is None:  # never claim a bound that was not measured
-        tail += (f"; march.quality={q} states no depth-error bound beyond fractal.max_iter "
-                 f"{BOUND_MAX_ITER}: the bracket above is this render's own")
-        report["pyjulia4d.preset_bound_met"] = "no bound stated"
+    # capped rays, the guards that fired, the certified depth bracket and the unresolved
+    # space are part of the result: said in the header and the closing line, never hidden
+    report, tail = result.report(stated_p99(scene.march.quality))
     # the scene as rendered: with camera.fit, the camera the framing pass chose
     rendered = getattr(result, "scene", None) or scene
     header = {"pyjulia4d.scene": rendered.to_toml(), **report}

@@ -288,7 +288,7 @@ def fitted(client: Any, scene: Scene, device: str | None = None, force: bool = F
     return client.submit(fit_unit, scene, device, force, pure=False).result()
 
 
-_SHAPED = ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket")
+_SHAPED = ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket", "unresolved")
 
 
 def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=None,

@@ -116,32 +116,57 @@ class RenderResult:
         open_ = self.unresolved > 0
         return {"hit": int(np.count_nonzero(open_ & hit)), "miss": int(np.count_nonzero(open_ & ~hit))}
 
+    @property
+    def proven(self) -> bool:
+        """Whether the march proved the space it skipped empty (march.method "proven"); the
+        fixed scan and the distance estimate prove nothing in front of their hits."""
+        from pyjulia4d.fractal.registry import march_method
+        return self.scene is not None and march_method(self.scene) == "proven"
+
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
         """What a render says about itself: (header entries for PNG/EXR, the tail of the
-        closing line).  Capped rays, the guards that fired and the certified depth bracket
-        (p50/p99/max) are never hidden; with ``stated_p99`` (the bound a quality preset
-        states) the line says whether this render's bracket p99 is within it."""
+        closing line).  Capped rays, the guards that fired, the certified depth bracket and
+        the error each pixel states (bracket plus the unresolved width in front,
+        kernels/march/proven.cl; p50/p99/max) and the pixels left unresolved are never
+        hidden; with ``stated_p99`` (the bound a quality preset states) the line says whether
+        this render's stated p99 error is within it."""
         b = self.bracket_stats()
-        bracket = " ".join(f"{k}={v:.3g}" for k, v in b.items())
+        e = self.error_stats()
+        un = self.unresolved_counts()
         header = {
             "pyjulia4d.device": self.device_name,
             "pyjulia4d.rays_per_work_item": str(self.lanes),
             "pyjulia4d.render_seconds": "%.6f" % self.seconds,
             "pyjulia4d.capped_pixels": str(self.capped),
             "pyjulia4d.guards": " ".join(f"{k}={v}" for k, v in self.guards.items()),
-            "pyjulia4d.depth_bracket": bracket,
+            "pyjulia4d.depth_bracket": " ".join(f"{k}={v:.3g}" for k, v in b.items()),
+            "pyjulia4d.depth_error": " ".join(f"{k}={v:.3g}" for k, v in e.items()),
+            "pyjulia4d.space_proven": "yes" if self.proven else "no",
+            "pyjulia4d.unresolved_pixels": f"hit={un['hit']} miss={un['miss']}",
         }
         fired = [f"{k} {v}" for k, v in self.guards.items() if v]
         tail = f", {self.capped} capped" if self.capped else ""
         tail += f"; guards fired: {', '.join(fired)}" if fired else ""
-        if not math.isnan(b["p99"]):
-            tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}"
-            if stated_p99 is not None:
-                ok = b["p99"] <= stated_p99
-                tail += (f" (within the preset's stated {stated_p99:.0e})" if ok else
-                         f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer "
-                         f"preset or more march.post_steps)")
-                header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
+        if self.proven:
+            if not math.isnan(e["p99"]):
+                tail += (f"; depth error p50 {e['p50']:.2g} p99 {e['p99']:.2g} max {e['max']:.2g}: the "
+                         f"bracket (p99 {b['p99']:.2g}) plus the space left unproven in front of "
+                         f"{un['hit']} hits")
+            tail += (f"; {un['miss']} misses with unproven space, where a thin part may hide" if un["miss"]
+                     else "; every miss proven empty")
+            ok_value = e["p99"]
+        else:
+            if not math.isnan(b["p99"]):
+                tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}"
+            if un["hit"] or un["miss"]:
+                tail += ("; the space in front of the hits is not proven empty (march.method=proven proves "
+                         "it and states the whole error)")
+            ok_value = b["p99"]
+        if stated_p99 is not None and not math.isnan(ok_value):
+            ok = ok_value <= stated_p99
+            tail += (f" (within the preset's stated {stated_p99:.0e})" if ok else
+                     f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer preset)")
+            header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
         return header, tail
 
     @property
@@ -152,7 +177,7 @@ class RenderResult:
         return int(np.sum(self.status == STATUS_CAPPED))
 
     def exr_channels(self) -> dict[str, np.ndarray]:
-        """The EXR channels of the outputs kept: RGBA, Z and Z.bracket, N.XYZ, P.XYZW."""
+        """The EXR channels of the outputs kept: RGBA, Z, Z.bracket and Z.unresolved, N.XYZ, P.XYZW."""
         f = np.float32
         ch = {}
         if self.color is not None:
@@ -163,6 +188,8 @@ class RenderResult:
             ch["Z"] = self.depth
             if self.bracket is not None:
                 ch["Z.bracket"] = self.bracket
+            if self.unresolved is not None:
+                ch["Z.unresolved"] = self.unresolved
         if self.normal is not None:
             for k, name in enumerate("XYZ"):
                 ch[f"N.{name}"] = self.normal[..., k]

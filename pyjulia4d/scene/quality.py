@@ -75,19 +75,17 @@ from typing import Any
 
 QUALITIES = ("custom", "draft", "normal", "final")
 
-# From benchmarks/results/error_vs_time.md (commit c413259; the derivation above).
+# Proven marches (kernels/march/proven.cl) at three floors; the bound is what each targets
+# for the error a render states, bracket plus unresolved (RenderResult.error_stats), which
+# the render proves.  Measured in benchmarks/results/pair_accuracy.md (the derivation above).
 PRESETS: dict[str, dict] = {
-    "draft": {"method": "de", "z_resolution": 250, "post_steps": 2, "epsilon": 1e-5, "refine": "itp",
+    "draft": {"method": "proven", "z_resolution": 5000, "post_steps": 4, "epsilon": 1e-3, "refine": "itp",
               "p99_bound": 1e-2, "silhouette_bound": 0.005},
-    "normal": {"method": "de", "z_resolution": 250, "post_steps": 10, "epsilon": 1e-6, "refine": "itp",
-               "p99_bound": 1e-4, "silhouette_bound": 0.005},
-    "final": {"method": "de", "z_resolution": 250, "post_steps": 20, "epsilon": 5e-7, "refine": "itp",
-              "p99_bound": 1e-5, "silhouette_bound": 0.005},
+    "normal": {"method": "proven", "z_resolution": 20000, "post_steps": 8, "epsilon": 1e-3, "refine": "itp",
+               "p99_bound": 1e-3, "silhouette_bound": 0.005},
+    "final": {"method": "proven", "z_resolution": 200000, "post_steps": 12, "epsilon": 1e-3, "refine": "itp",
+              "p99_bound": 1e-4, "silhouette_bound": 0.005},
 }
-
-# The bounds are stated for scenes with fractal.max_iter up to this; beyond it (measured at
-# 30 and 50) no float32 setting has one: see the module docstring.
-BOUND_MAX_ITER = 20
 
 MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon", "refine")
 
@@ -101,13 +99,13 @@ def preset_values(quality: str) -> dict:
     return {k: PRESETS[quality][k] for k in MARCH_KEYS}
 
 
-def stated_p99(quality: str, max_iter: int) -> float | None:
-    """The p99 depth error (scene units) ``quality`` states for a scene of ``max_iter``
-    iterations: its ``p99_bound`` up to BOUND_MAX_ITER, None (no bound) beyond."""
+def stated_p99(quality: str) -> float | None:
+    """The p99 depth error (scene units) ``quality`` targets; None for "custom".  A render
+    states (and proves) its own error; the closing line says whether it is within this."""
     preset_values(quality)
     if quality == "custom":
         return None
-    return PRESETS[quality]["p99_bound"] if int(max_iter) <= BOUND_MAX_ITER else None
+    return PRESETS[quality]["p99_bound"]
 
 
 def preset_overrides(quality: str) -> list[str]:

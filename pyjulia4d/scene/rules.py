@@ -119,12 +119,10 @@ def check_fractal(scene: Any) -> None:
     if f.theta != 0 and f.algebra != "quaternion":
         raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
                          f"section 2.3), not {f.algebra}: set 0")
-    if m.quality != "custom" and f.kind != "julia":
-        raise SceneError("march.quality", f"the presets were measured on Julia sets; for a {f.kind} set the "
-                         f"march keys (march.quality=custom)")
-    if m.quality != "custom" and f.algebra != "quaternion":
-        raise SceneError("march.quality", f"the presets were measured on quaternion sets; for {pair} set the "
-                         f"march keys (march.quality=custom), measured in README's algebras section")
+    if m.quality != "custom" and not can_prove(f):
+        raise SceneError("march.quality", f"the presets are proven marches, which exist for the Julia sets of "
+                         f"every algebra and function without fractal.theta; for a {f.kind} set"
+                         f"{' with theta' if f.theta else ''} set the march keys (march.quality=custom)")
     if m.method == "proven" and not can_prove(f):
         raise SceneError("march.method", f"proven needs orbit enclosures, which exist for the Julia sets of "
                          f"every algebra and function without fractal.theta; for a {f.kind} set"

@@ -30,13 +30,15 @@ def enc_step(e, c, F):
     with np.errstate(all="ignore"):
         s, lm = _norm(m), alg.ALG_LBOUND(m)
         rho = _norm(v) + r
+        sv = _norm(v)
         if F.fn.FUNC_POWER == 2:
-            rn, size = 2 * lm * r + K * rho * rho, K * s * s
+            rn, size = 2 * lm * r + K * rho * rho, K * s * s + 2 * lm * sv
         else:
-            rn = (alg.ALG_LBOUND_SQR(m) + 2 * lm * lm) * r + (3 * K * lm + K * K * rho) * rho * rho
-            size = K * K * s ** 3
+            jn = alg.ALG_LBOUND_SQR(m) + 2 * lm * lm
+            rn = jn * r + (3 * K * lm + K * K * rho) * rho * rho
+            size = K * K * s ** 3 + jn * sv
         vn = F.julia_f_jvp(m, v)
-        return F.julia_f(m, c), vn, enc_radius(rn, 2 * size + np.linalg.norm(c) + 4 * _norm(vn), ENC_ROUND)
+        return F.julia_f(m, c), vn, enc_radius(rn, 4 * size + 2 * np.linalg.norm(c), ENC_ROUND)
 
 
 def least_norm(m, v):

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-ENC_ROUND = 2.0 ** -20
-ENC_ROUND_FN = 2.0 ** -18
+ENC_ROUND = 2.0 ** -22
+ENC_ROUND_FN = 2.0 ** -20
 ENC_UP = 1.0 + 2.0 ** -18
 ENC_TINY = 1e-30
 ENC_PI = 3.14159274101257324
