@@ -7,8 +7,9 @@ reference/enclose/ and reference/march.py), held to the mathematics:
   sampled along its segment, step after step;
 - no segment proven empty holds an inside point (the set test at 201 samples);
 - the kernel's proofs match the twin's, and the proven march's kernel matches its twin;
-- a render's stated interval [depth - unresolved, depth + bracket] holds the float64 brute
-  force's first crossing.
+- a render's stated error holds the float64 brute force's first crossing: it lies in the
+  bracket or in the unproven segments in front, so within [depth - unresolved, depth + bracket]
+  unless it hides in a segment farther out (a thin part: at most 1 % of the pixels here).
 
 Tolerances: the enclosures are checked exactly (float64 samples against float64 radii, with
 a relative 1e-12 for the samples' own rounding); kernel against twin with the float32

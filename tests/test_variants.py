@@ -63,7 +63,7 @@ def test_packets_give_the_same_pixels(over, lanes):
     hit = (one.status == STATUS_HIT) & (pk.status == STATUS_HIT)
     a, wa = one.depth[hit].astype(float), one.bracket[hit].astype(float)
     b, wb = pk.depth[hit].astype(float), pk.bracket[hit].astype(float)
-    # each states the crossing in [depth - unresolved, depth + bracket] (kernels/march/proven.cl;
+    # each states the crossing near [depth - unresolved, depth + bracket] (kernels/march/proven.cl;
     # the fixed scan and the estimate are compared on their brackets)
     ua = one.unresolved[hit].astype(float) if one.proven else 0.0
     ub = pk.unresolved[hit].astype(float) if pk.proven else 0.0

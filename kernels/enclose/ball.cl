@@ -70,4 +70,10 @@ inline lmask enc_outside(enclosure e, real bailout2)
  * sizes its next segment by it */
 inline lreal enc_margin(enclosure e, real bailout) { return (QLEN(e.m) - bailout) / (QLEN(e.v) + e.r); }
 
-inline lmask enc_finite(enclosure e) { return e.r < (lreal)INFINITY; }
+/* whether the form may still prove the segment: an extent past twice the centre's distance
+ * plus the bailout grows faster than the centre from here on (the proof only gives up) */
+inline lmask enc_hopeful(enclosure e, real bailout)
+{
+    return QLEN(e.v) + e.r < (real)2 * (QLEN(e.m) + bailout);
+}
+

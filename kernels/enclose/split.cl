@@ -70,11 +70,20 @@ inline lmask enc_outside(enclosure e, real bailout2)
 }
 
 /* how many times its extent the centre lies beyond the bailout (<= 0: inside) */
-inline lreal enc_margin(enclosure e, real bailout)
+inline lreal enc_centre_norm(enclosure e)
 {
-    lreal hm = sqrt((real)0.5 * (e.a.m.re * e.a.m.re + e.a.m.im * e.a.m.im + e.b.m.re * e.b.m.re + e.b.m.im * e.b.m.im));
-    lreal ext = hypot(c_abs(e.a.v) + e.a.r, c_abs(e.b.v) + e.b.r) * (real)0.70710678118654752;
-    return (hm - bailout) / ext;
+    return sqrt((real)0.5 * (e.a.m.re * e.a.m.re + e.a.m.im * e.a.m.im + e.b.m.re * e.b.m.re + e.b.m.im * e.b.m.im));
 }
 
-inline lmask enc_finite(enclosure e) { return (e.a.r < (lreal)INFINITY) | (e.b.r < (lreal)INFINITY); }
+inline lreal enc_extent(enclosure e)
+{
+    return hypot(c_abs(e.a.v) + e.a.r, c_abs(e.b.v) + e.b.r) * (real)0.70710678118654752;
+}
+
+inline lreal enc_margin(enclosure e, real bailout) { return (enc_centre_norm(e) - bailout) / enc_extent(e); }
+
+/* whether the forms may still prove the segment (enclose/ball.cl enc_hopeful; NaN: no) */
+inline lmask enc_hopeful(enclosure e, real bailout)
+{
+    return enc_extent(e) < (real)2 * (enc_centre_norm(e) + bailout);
+}

@@ -16,10 +16,12 @@
  * lengths only steer the march, the proofs alone decide what is passed.  A floor segment that is not proven has its far end tested: inside ends the
  * march, with [t0, t1] the certified bracket (t0 is the end of proven-empty space, so
  * outside) refined by march/refine.cl; outside, the segment is passed unproven, and the
- * pixel's ``unresolved`` width grows.  So the first crossing lies in
- * [depth - unresolved, depth + bracket]: unresolved is how far in front of the depth the
- * march could not prove the ray empty (0: the bracket is the whole error); on a miss it
- * is the summed width of the ray left unproven, where a thin part may hide.
+ * pixel's ``unresolved`` width grows by it.  So the first crossing lies in the bracket
+ * behind the depth or in one of the unproven segments in front of it, whose widths sum to
+ * ``unresolved`` (0: the bracket is certified); these lie just in front of the surface
+ * (where the enclosures are too wide to prove the last floor segments) or where the ray
+ * passes the set closely, and a part of the set thinner than the floor could hide in
+ * them.  On a miss, unresolved is the ray's unproven width.
  * At most max_steps enclosures per ray (STATUS_CAPPED after); ``samples`` counts them. */
 
 /* Whether [t0, t1] is proven empty, for the lanes in ``todo``; *margin gets the largest
@@ -39,7 +41,7 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
         lmask out = live & enc_outside(e, jp.bailout2);
         best = L_SEL(best, fmax(best, enc_margin(e, bailout)), live);
         proven |= out;
-        live &= (!out) & enc_finite(e);
+        live &= (!out) & enc_hopeful(e, bailout);
     }
     COUNT_ITER(jp, n);
     *margin = best;
@@ -56,7 +58,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal span = far - near;
     lreal floor_w = span / (real)z_resolution;
     lreal h = fmax(span * PROVEN_FIRST, floor_w);
-    lreal t = near, t_in = near, first_open = INFINITY, open_w = 0;
+    lreal t = near, t_in = near, open_w = 0;
     lmask first = live & julia_inside(QRAY(o, d, near), jp);
     lmask active = live & !first, hit = first, miss = 0, n = 0;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
@@ -69,7 +71,6 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         if (L_ANY(at_floor))
             got = at_floor & julia_inside(QRAY(o, d, t1), jp);
         lmask open = at_floor & !got;
-        first_open = L_SEL(first_open, fmin(first_open, t), open);
         open_w = L_SEL(open_w, open_w + (t1 - t), open);
         hit |= got;
         t_in = L_SEL(t_in, t1, got);
@@ -92,11 +93,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal a = refine_bracket(o, d, t, t_in, bracketed, post_steps, jp, &w);
     *width = L_SEL(*width, L_SEL((lreal)0, w, bracketed), hit);
     lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_in, a, bracketed), hit);
-    /* in front of a hit: from the first unproven segment to the depth; a miss: the width
-     * left unproven; a capped ray: that and all it did not reach */
-    lreal front = L_SEL((lreal)0, depth - first_open, first_open < depth);
-    lreal left = L_SEL(open_w, open_w + (far - t), active);
-    *unresolved = L_SEL(*unresolved, L_SEL(left, front, hit), live);
+    /* the unproven width in front of a hit or on a miss; a capped ray adds all it did not reach */
+    *unresolved = L_SEL(*unresolved, L_SEL(open_w, open_w + (far - t), active), live);
     return depth;
 }
 

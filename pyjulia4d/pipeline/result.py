@@ -30,9 +30,9 @@ class RenderResult:
     status: np.ndarray | None    # (H, W) int32, STATUS_* per pixel
     samples: np.ndarray | None   # (H, W) int32, set tests (fixed) or estimates (de) before the hit
     bracket: np.ndarray = None   # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
-    # (H, W) float32: how far in front of the depth (on a miss: how much of the ray) the march
-    # did not prove empty (kernels/march/proven.cl); the first crossing lies in
-    # [depth - unresolved, depth + bracket].  The fixed and de marches prove nothing: all of it.
+    # (H, W) float32: the summed width of the segments in front of the depth (on a miss: of
+    # the ray) the march did not prove empty (kernels/march/proven.cl): the first crossing lies
+    # in the bracket or in one of them.  The fixed and de marches prove nothing: all of it.
     unresolved: np.ndarray = None
     counts: dict = field(default_factory=dict)  # pixels by status: "miss", "hit", "capped" (all tiles)
     device_name: str = ""

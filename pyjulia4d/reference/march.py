@@ -177,7 +177,7 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
         out = live & E.enc_outside(e, b2)
         best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
         proven |= out
-        live &= ~out & E.enc_finite(e)
+        live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best
 
 
@@ -195,7 +195,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     floor_w = span / z_resolution
     h = np.maximum(span * PROVEN_FIRST, floor_w)
     t, t_in = near.copy(), near.copy()
-    first_open, open_w = np.full(n, np.inf), np.zeros(n)
+    open_w = np.zeros(n)
     first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
     active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
     count = np.zeros(n, np.int32)
@@ -212,7 +212,6 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
             j = np.nonzero(at_floor)[0]
             got[j] = julia_inside(o[k[j]] + t1[j, None] * d[k[j]], c, max_iter, bailout, formula)
         opened = at_floor & ~got
-        first_open[k] = np.where(opened, np.minimum(first_open[k], t[k]), first_open[k])
         open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
         hit[k] |= got
         t_in[k] = np.where(got, t1, t_in[k])
@@ -233,10 +232,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     if k.size:
         depth[k], width[k] = refine_bracket(o[k], d[k], t[k], t_in[k], post_steps, c, max_iter, bailout, itp,
                                             formula=formula)
-    with np.errstate(invalid="ignore"):
-        front = np.where(first_open < depth, depth - first_open, 0.0)
-    left = np.where(active, open_w + (far - t), open_w)
-    return depth, status, count, np.zeros(n, np.int32), width, np.where(hit, front, left)
+    # the unproven width in front of a hit or on a miss; a capped ray adds all it did not reach
+    return depth, status, count, np.zeros(n, np.int32), width, np.where(active, open_w + (far - t), open_w)
 
 
 # --------------------------------------------------------------------- march/march.cl

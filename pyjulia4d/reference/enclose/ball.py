@@ -62,5 +62,9 @@ def enc_margin(e, bailout):
         return (_norm(m) - bailout) / (_norm(v) + r)
 
 
-def enc_finite(e):
-    return e[2] < np.inf
+def enc_hopeful(e, bailout):
+    """Whether the form may still prove the segment: an extent past twice the centre's
+    distance plus the bailout only grows faster than the centre (kernels/enclose/ball.cl)."""
+    m, v, r = e
+    with np.errstate(all="ignore"):
+        return _norm(v) + r < 2 * (_norm(m) + bailout)

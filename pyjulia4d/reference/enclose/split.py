@@ -62,13 +62,21 @@ def enc_outside(e, bailout2):
         return (lo > 0) & (0.5 * lo * lo > bailout2)
 
 
-def enc_margin(e, bailout):
+def _centre_norm_extent(e):
     (am, av, ar), (bm, bv, br) = e
     with np.errstate(all="ignore"):
         hm = np.sqrt(0.5 * (np.abs(am) ** 2 + np.abs(bm) ** 2))
         ext = np.hypot(np.abs(av) + ar, np.abs(bv) + br) * 0.70710678118654752
+    return hm, ext
+
+
+def enc_margin(e, bailout):
+    hm, ext = _centre_norm_extent(e)
+    with np.errstate(all="ignore"):
         return (hm - bailout) / ext
 
 
-def enc_finite(e):
-    return (e[0][2] < np.inf) | (e[1][2] < np.inf)
+def enc_hopeful(e, bailout):
+    hm, ext = _centre_norm_extent(e)
+    with np.errstate(all="ignore"):
+        return ext < 2 * (hm + bailout)
