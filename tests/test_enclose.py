@@ -176,20 +176,41 @@ def test_proven_march_matches_its_twin(algebra, function):
     assert np.mean((lo_k <= hi_r + slack) & (lo_r <= hi_k + slack)) >= 0.99
 
 
+def march_on_rays(s, o, d):
+    """The scene's march kernel on the given rays (kernels/march/march.cl, RAYS_FROM_BUFFERS):
+    depth, status, bracket, unresolved."""
+    R = Runner(kernel_config.scene_config(s, ray_buffers=True))
+    f, m = s.fractal, s.march
+    n = len(o)
+    depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
+    flags, bracket, unresolved = R.out(n, np.int32), R.out(n), R.out(n)
+    R("march", (n,), np.int32(n), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
+      R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(-1.0), R.scalar(-1.0),
+      np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
+      depth, point, status, samples, flags, bracket, unresolved)
+    return (depth.get().astype(float), status.get(), bracket.get().astype(float), unresolved.get().astype(float))
+
+
 @pytest.mark.parametrize("algebra,function", [("quaternion", "cube"), ("hypercomplex", "sin"),
                                               ("hypercomplex", "cosh"), ("cquat", "sqr"), ("commutative", "cube")])
 def test_stated_interval_holds_the_brute_force(algebra, function):
-    from pyjulia4d import render
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
                          "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": 20, "height": 15}})
-    r = render(s)
-    o, d = ref.generate_rays(camera_frame(r.scene), 20, 15)
-    truth = brute_force_depth(r.scene, o, d).reshape(15, 20)
-    hit = (r.status == 1) & np.isfinite(truth)
-    slack = 4 * np.spacing(np.float32(np.maximum(r.depth, 1))) + 1e-6
-    lo = r.depth - r.unresolved - slack
-    # nothing in front of what the render admits to, except where float32's set test differs
+    from pyjulia4d import render
+    s = render(s.with_overrides(["image.width=4", "image.height=3"])).scene   # camera.fit's camera
+    o, d = ref.generate_rays(camera_frame(s), 20, 15)
+    # the kernel and the brute force on the same rays: float32's, exactly (a grazing ray moved by
+    # its rounding crosses the surface elsewhere)
+    o, d = o.astype(np.float32).astype(float), d.astype(np.float32).astype(float)
+    depth, status, bracket, unresolved = march_on_rays(s, o, d)
+    truth = brute_force_depth(s, o, d)
+    hit = (status == 1) & np.isfinite(truth)
+    assert hit.sum() > 10
+    slack = 16 * np.spacing(np.float32(np.maximum(depth, 1))) + 1e-6
+    lo = depth - unresolved - slack
+    # nothing in front of what the render admits to, but on the odd pixel where float32's
+    # set test and float64's differ or a part hides in an unproven segment farther out
     assert np.mean(truth[hit] < lo[hit]) <= 0.01
     # a miss with nothing unresolved is a miss of the truth
-    sure_miss = (r.status != 1) & (r.unresolved == 0)
+    sure_miss = (status != 1) & (unresolved == 0)
     assert np.mean(np.isfinite(truth[sure_miss])) <= 0.01

@@ -15,7 +15,9 @@
  * at most 64x) and a proof with margin to spare lengthens the next (at most 4x); the
  * lengths only steer the march, the proofs alone decide what is passed.  A floor segment that is not proven has its far end tested: inside ends the
  * march, with [t0, t1] the certified bracket (t0 is the end of proven-empty space, so
- * outside) refined by march/refine.cl; outside, the segment is passed unproven, and the
+ * outside) refined by march/refine.cl, whose part in front of the refined bracket is
+ * proven or counted unproven too (refinement finds a crossing, not the first); outside,
+ * the segment is passed unproven, and the
  * pixel's ``unresolved`` width grows by it.  So the first crossing lies in the bracket
  * behind the depth or in one of the unproven segments in front of it, whose widths sum to
  * ``unresolved`` (0: the bracket is certified); these lie just in front of the surface
@@ -93,6 +95,12 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal a = refine_bracket(o, d, t, t_in, bracketed, post_steps, jp, &w);
     *width = L_SEL(*width, L_SEL((lreal)0, w, bracketed), hit);
     lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_in, a, bracketed), hit);
+    /* refinement finds a crossing in [t, t_in], not the first: the floor segment's part in
+     * front of the refined bracket, [t, a], is unproven unless a proof says otherwise */
+    lreal tail_margin;
+    lmask tail = bracketed & (a > t);
+    lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &tail_margin) : (lmask)0;
+    open_w = L_SEL(open_w, open_w + (a - t), tail & !tail_empty);
     /* the unproven width in front of a hit or on a miss; a capped ray adds all it did not reach */
     *unresolved = L_SEL(*unresolved, L_SEL(open_w, open_w + (far - t), active), live);
     return depth;

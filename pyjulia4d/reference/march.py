@@ -232,6 +232,11 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     if k.size:
         depth[k], width[k] = refine_bracket(o[k], d[k], t[k], t_in[k], post_steps, c, max_iter, bailout, itp,
                                             formula=formula)
+        # the hit segment's part in front of the refined bracket: proven, or unproven
+        j = k[depth[k] > t[k]]
+        if j.size:
+            tail_empty, _ = enc_prove(o[j], d[j], t[j], depth[j], c, max_iter, bailout, formula)
+            open_w[j] += np.where(tail_empty, 0.0, depth[j] - t[j])
     # the unproven width in front of a hit or on a miss; a capped ray adds all it did not reach
     return depth, status, count, np.zeros(n, np.int32), width, np.where(active, open_w + (far - t), open_w)
 
