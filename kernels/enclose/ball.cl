@@ -32,7 +32,7 @@ inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
     return e;
 }
 
-inline enclosure enc_step(enclosure e, real4 c)
+inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unused here */
 {
     lreal s = QLEN(e.m), lm = ALG_LBOUND(e.m), sv = QLEN(e.v);
     lreal rho = sv + e.r;

@@ -17,7 +17,9 @@ typedef struct { caff a, b; } enclosure;
 
 inline caff A(cplx m, cplx v, lreal r) { caff z = {m, v, r}; return z; }
 
-inline caff caff_f(caff z)
+/* ``live``: the lanes whose result counts (a finished lane's garbage must not send the
+ * whole packet down the disc path) */
+inline caff caff_f(caff z, lmask live)
 {
     lreal rho = c_abs(z.v) + z.r;
     caff out = z;
@@ -26,9 +28,14 @@ inline caff caff_f(caff z)
     cplx v = c_mul(d1, z.v);
     lreal da = c_abs(d1);
     lreal r = da * z.r * ENC_UP + (real)0.5 * rho * rho * FUNC_M2(z.m, rho) * ENC_UP;
-    r = enc_radius(L_SEL(r, (lreal)INFINITY, isnan(r)), c_abs(fm) + (real)4 * c_abs(v), ENC_ROUND_FN);
+#ifdef FUNC_ROUND_GAIN   /* a function whose value loses more than a few ulps (function/pwr.cl) */
+    lreal size = (c_abs(fm) + (real)4 * c_abs(v)) * FUNC_ROUND_GAIN(z.m);
+#else
+    lreal size = c_abs(fm) + (real)4 * c_abs(v);
+#endif
+    r = enc_radius(L_SEL(r, (lreal)INFINITY, isnan(r) | isnan(size)), size, ENC_ROUND_FN);
     out = A(fm, v, r);
-    lmask bad = !(r < (lreal)INFINITY);
+    lmask bad = live & !(r < (lreal)INFINITY);
     if (!L_ANY(bad))
         return out;
 #else
@@ -49,9 +56,9 @@ inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
     return e;
 }
 
-inline enclosure enc_step(enclosure e, real4 c)
+inline enclosure enc_step(enclosure e, real4 c, lmask live)
 {
-    caff a = caff_f(e.a), b = caff_f(e.b);
+    caff a = caff_f(e.a, live), b = caff_f(e.b, live);
     cplx ca = C((lreal)c.x, (lreal)c.y), cb = C((lreal)c.z, (lreal)c.w);
     enclosure out = {A(c_add(a.m, ca), a.v, enc_radius(a.r, c_abs(a.m) + c_abs(ca), ENC_ROUND)),
                      A(c_add(b.m, cb), b.v, enc_radius(b.r, c_abs(b.m) + c_abs(cb), ENC_ROUND))};

@@ -18,10 +18,17 @@ inline lreal func_m2(cplx m, lreal rho)
     real pp = hypot((real)(FUNC_EXPONENT_RE), qi) * hypot((real)(FUNC_EXPONENT_RE) - (real)1, qi);
     lreal lo = log(c_abs(m) - rho), hi = log(c_abs(m) + rho);
     lreal e = fmax(qr * lo, qr * hi) + fabs(qi) * ENC_PI;
+#ifdef PWR_INTEGER   /* an integer exponent: z^p is analytic across log's cut, z^(p-2) too for p >= 2 */
+    e = L_SEL(e, (lreal)0, (lmask)(qr == (real)0));
+    lmask bad = (qr < (real)0) & !(c_abs(m) > rho);
+#else
     lmask bad = d_meets_cut(D(m, rho)) | !(c_abs(m) > rho);
+#endif
     return L_SEL(pp * exp(e) * ENC_UP, (lreal)INFINITY, bad);
 }
 #define FUNC_M2(m, rho) func_m2((m), (rho))
+/* exp(p log z) loses |p log z| ulps of its value to the rounding of p log z */
+#define FUNC_ROUND_GAIN(m) ((real)1 + hypot((real)(FUNC_EXPONENT_RE), (real)(FUNC_EXPONENT_IM)) * (fabs(log(c_abs(m))) + ENC_PI))
 /* its disc enclosure */
 inline cdisc cfun_disc(cdisc z) { return d_pwr(z, FUNC_EXPONENT); }
 #endif

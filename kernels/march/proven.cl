@@ -39,7 +39,7 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
     lreal best = enc_margin(e, bailout);
     int n = 0;
     for (; n < jp.max_iter && L_ANY(live); ++n) {
-        e = enc_step(e, c);
+        e = enc_step(e, c, live);
         lmask out = live & enc_outside(e, jp.bailout2);
         best = L_SEL(best, fmax(best, enc_margin(e, bailout)), live);
         proven |= out;
@@ -69,13 +69,16 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lmask empty = enc_prove(o, d, t, t1, active, jp, &margin);
         n = L_SEL(n, n + 1, active);
         lmask at_floor = active & !empty & (h <= floor_w);
-        lmask got = 0;
-        if (L_ANY(at_floor))
-            got = at_floor & julia_inside(QRAY(o, d, t1), jp);
+        lmask got = 0, mid = 0;
+        lreal tm = (real)0.5 * (t + t1);
+        if (L_ANY(at_floor)) {   /* its midpoint, then its far end: a thin part may hold the first */
+            mid = at_floor & julia_inside(QRAY(o, d, tm), jp);
+            got = mid | (at_floor & julia_inside(QRAY(o, d, t1), jp));
+        }
         lmask open = at_floor & !got;
         open_w = L_SEL(open_w, open_w + (t1 - t), open);
         hit |= got;
-        t_in = L_SEL(t_in, t1, got);
+        t_in = L_SEL(t_in, L_SEL(t1, tm, mid), got);
         lmask pass = empty | open;
         lmask done = pass & (t1 >= far);
         miss |= done;

@@ -49,6 +49,8 @@ def fractal_defines(scene: Scene) -> tuple[str, ...]:
     out = ()
     if f.function == "pwr":
         out += (f"FUNC_EXPONENT_RE={f.exponent[0]!r}", f"FUNC_EXPONENT_IM={f.exponent[1]!r}")
+        if f.exponent[1] == 0 and float(f.exponent[0]).is_integer():   # analytic across log's cut
+            out += ("PWR_INTEGER",)
     if f.theta != 0:
         t = math.radians(f.theta)
         out += (f"ROTATE_COS={math.cos(t)!r}", f"ROTATE_SIN={math.sin(t)!r}")

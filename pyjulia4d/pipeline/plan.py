@@ -19,7 +19,7 @@ from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
-from pyjulia4d.fractal.registry import march_method
+from pyjulia4d.fractal.registry import has_distance_estimate, march_method
 
 # Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
 # which difference neighbours): device memory stays under ~20 MB single / ~36 MB double
@@ -320,15 +320,25 @@ def fog_start(eye, radius: float) -> float:
     return max(float(np.linalg.norm(eye)) - radius, 0.0)
 
 
+SHADOW_SAMPLES = 1000   # the shadow scan of a proven march without a distance estimate
+
+
 def light_parameters(sc: Scene, radius: float) -> dict:
     """shade/light.cl's numbers: the shadow rays' step (the march's epsilon, or the fixed
-    scan's spacing across the bounding ball) and cap, the offset of their start off the
+    scan's spacing across the bounding ball; a proven march's shadows step like the estimate
+    where there is one, else like a 1000-sample scan) and cap, the offset of their start off the
     surface along the normal (two steps, at least 1e-3 of the ball's radius: the hit is
     the outside end of its bracket, so this starts clear of the surface), the penumbra,
     occlusion and trap settings."""
     m, sh = sc.march, sc.shading
-    if march_method(sc) == "de":
+    method = march_method(sc)
+    if method == "de" or (method == "proven" and has_distance_estimate(sc.fractal)):
         step, cap = m.epsilon, m.max_steps
+    elif method == "proven":
+        # shadows and occlusion are a look, not a proof: the proven march's floor would make
+        # its shadow rays take z_resolution (20000 for "normal") samples; a 1000-sample scan
+        # is the fixed scan's look at z_resolution 1000
+        step, cap = 2.0 * radius / SHADOW_SAMPLES, SHADOW_SAMPLES + 1
     else:
         step, cap = 2.0 * radius / m.z_resolution, m.z_resolution + 1
     return dict(step=step, max_steps=cap, bias=max(2.0 * step, 1e-3 * radius),

@@ -38,7 +38,8 @@ class Formula:
         if self.function == "pwr":
             p = complex(*self.exponent)
             fn = _Bound(functools.partial(mod.cfun, p=p), functools.partial(mod.cfun_d, p=p), None,
-                        functools.partial(mod.cfun_disc, p=p), functools.partial(mod.FUNC_M2, p=p))
+                        functools.partial(mod.cfun_disc, p=p), functools.partial(mod.FUNC_M2, p=p),
+                        functools.partial(mod.FUNC_ROUND_GAIN, p=p))
         else:
             fn = _Bound(mod.cfun, mod.cfun_d, entry.degree, mod.cfun_disc, getattr(mod, "FUNC_M2", None))
         object.__setattr__(self, "alg", alg)
@@ -101,6 +102,7 @@ class _Bound:
     FUNC_POWER: int | None
     cfun_disc: Any = None   # its disc enclosure (reference/enclose/disc.py)
     FUNC_M2: Any = None     # its bound on |f''| over a disc, where it has one (reference/enclose/split.py)
+    FUNC_ROUND_GAIN: Any = None   # how many times more than a few ulps its value loses, where it does
 
 
 QUATERNION_SQR = Formula()

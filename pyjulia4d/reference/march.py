@@ -187,7 +187,7 @@ PROVEN_FIRST = 0.125
 def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
                  itp=True, formula: Formula = QUATERNION_SQR):
     """Segments from near on, each proven empty or shortened (by the enclosure's margin) down
-    to the floor (far - near) / z_resolution, where the far end is tested: inside ends the
+    to the floor (far - near) / z_resolution, where the midpoint and far end are tested: inside ends the
     march with the certified bracket, outside passes the segment unproven (march/proven.cl).
     Returns (t, status, samples, flags, width, unresolved)."""
     n = len(o)
@@ -207,14 +207,16 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
         count[k] += 1
         at_floor = ~empty & (h[k] <= floor_w[k])
-        got = np.zeros(k.size, bool)
-        if at_floor.any():
+        got, mid = np.zeros(k.size, bool), np.zeros(k.size, bool)
+        tm = 0.5 * (t[k] + t1)
+        if at_floor.any():   # its midpoint, then its far end
             j = np.nonzero(at_floor)[0]
-            got[j] = julia_inside(o[k[j]] + t1[j, None] * d[k[j]], c, max_iter, bailout, formula)
+            mid[j] = julia_inside(o[k[j]] + tm[j, None] * d[k[j]], c, max_iter, bailout, formula)
+            got[j] = mid[j] | julia_inside(o[k[j]] + t1[j, None] * d[k[j]], c, max_iter, bailout, formula)
         opened = at_floor & ~got
         open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
         hit[k] |= got
-        t_in[k] = np.where(got, t1, t_in[k])
+        t_in[k] = np.where(got, np.where(mid, tm, t1), t_in[k])
         passed = empty | opened
         done = passed & (t1 >= far[k])
         miss[k] |= done

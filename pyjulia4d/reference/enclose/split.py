@@ -21,7 +21,10 @@ def caff_f(z, fn):
             fm, d1 = fn.cfun(m), fn.cfun_d(m)
             vn = d1 * v
             rn = np.abs(d1) * r * ENC_UP + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * ENC_UP
-            rn = enc_radius(np.where(np.isnan(rn), np.inf, rn), np.abs(fm) + 4 * np.abs(vn), ENC_ROUND_FN)
+            size = np.abs(fm) + 4 * np.abs(vn)
+            if fn.FUNC_ROUND_GAIN is not None:
+                size = size * fn.FUNC_ROUND_GAIN(m)
+            rn = enc_radius(np.where(np.isnan(rn) | np.isnan(size), np.inf, rn), size, ENC_ROUND_FN)
             bad = ~(rn < np.inf)
         else:
             fm, vn, rn = m, v, r

@@ -29,5 +29,15 @@ def FUNC_M2(m, rho, p):
     with np.errstate(all="ignore"):
         lo, hi = np.log(np.abs(m) - rho), np.log(np.abs(m) + rho)
         e = np.maximum(qr * lo, qr * hi) + abs(qi) * D.ENC_PI
-        bad = D.d_meets_cut((m, rho)) | ~(np.abs(m) > rho)
+        if qi == 0 and float(p.real).is_integer():   # analytic across the cut (PWR_INTEGER)
+            e = np.where(qr == 0, 0.0, e)
+            bad = (qr < 0) & ~(np.abs(m) > rho)
+        else:
+            bad = D.d_meets_cut((m, rho)) | ~(np.abs(m) > rho)
         return np.where(bad, np.inf, abs(p) * abs(p - 1) * np.exp(e) * D.ENC_UP)
+
+
+def FUNC_ROUND_GAIN(m, p):
+    """exp(p log z) loses |p log z| ulps of its value (kernels/function/pwr.cl)."""
+    with np.errstate(all="ignore"):
+        return 1 + abs(p) * (np.abs(np.log(np.abs(m))) + D.ENC_PI)
