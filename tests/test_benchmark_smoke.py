@@ -149,3 +149,19 @@ def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[1] == "de" and cells[4] == "0.00 %" and cells[5] == "0.00 %" and cells[6] == "yes"
     assert "commit" in (tmp_path / "pair_accuracy.md").read_text()
+
+
+def test_proven_speed_benchmark_runs(tmp_path, capsys):
+    """benchmarks/proven_speed.py on the quaternion default, tiny: a row per march, the fixed
+    scan its own unit, the proven march's share of proofs given."""
+    spec = importlib.util.spec_from_file_location("proven_speed", ROOT / "benchmarks" / "proven_speed.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--only", "quaternion sqr (default)", "--size", "24x18", "--repeats", "1",
+                       "--out", str(tmp_path)]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| quaternion sqr")]
+    assert len(rows) == 3
+    cells = {r.split("|")[2].strip(): [c.strip() for c in r.strip("|").split("|")] for r in rows}
+    assert cells["fixed, z_resolution 1000"][3] == "1.00"
+    assert cells["proven, quality normal"][7].endswith("%") and cells["fixed, z_resolution 1000"][7] == ""
+    assert "commit" in (tmp_path / "proven_speed.md").read_text()
