@@ -147,26 +147,28 @@ class RenderResult:
         fired = [f"{k} {v}" for k, v in self.guards.items() if v]
         tail = f", {self.capped} capped" if self.capped else ""
         tail += f"; guards fired: {', '.join(fired)}" if fired else ""
+        def target(value: float) -> str:
+            """Whether ``value`` is within the preset's target (nothing without one)."""
+            if stated_p99 is None or math.isnan(value):
+                return ""
+            ok = value <= stated_p99
+            header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
+            return (f" (within the preset's stated {stated_p99:.0e})" if ok else
+                    f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer preset)")
+
         if self.proven:
             if not math.isnan(e["p99"]):
-                tail += (f"; depth error p50 {e['p50']:.2g} p99 {e['p99']:.2g} max {e['max']:.2g}: the "
-                         f"bracket (p99 {b['p99']:.2g}) plus the space left unproven in front of "
-                         f"{un['hit']} hits")
+                tail += (f"; depth error p50 {e['p50']:.2g} p99 {e['p99']:.2g} max {e['max']:.2g}"
+                         f"{target(e['p99'])}: the bracket (p99 {b['p99']:.2g}) plus the space left "
+                         f"unproven in front of {un['hit']} hits")
             tail += (f"; {un['miss']} misses with unproven space, where a thin part may hide" if un["miss"]
                      else "; every miss proven empty")
-            ok_value = e["p99"]
         else:
             if not math.isnan(b["p99"]):
-                tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}"
+                tail += f"; depth bracket p50 {b['p50']:.2g} p99 {b['p99']:.2g} max {b['max']:.2g}{target(b['p99'])}"
             if un["hit"] or un["miss"]:
                 tail += ("; the space in front of the hits is not proven empty (march.method=proven proves "
                          "it and states the whole error)")
-            ok_value = b["p99"]
-        if stated_p99 is not None and not math.isnan(ok_value):
-            ok = ok_value <= stated_p99
-            tail += (f" (within the preset's stated {stated_p99:.0e})" if ok else
-                     f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer preset)")
-            header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
         return header, tail
 
     @property
