@@ -133,9 +133,12 @@ def test_proven_segments_hold_no_inside_point(algebra, function):
     assert not (proven & inside).any()
 
 
-KERNEL_PAIRS = [("quaternion", "sqr"), ("quaternion", "cube"), ("hypercomplex", "sin"), ("hypercomplex", "pwr"),
-                ("hypercomplex", "tan"), ("hypercomplex", "ln"), ("hypercomplex", "asinh"), ("cquat", "cube"),
-                ("commutative", "sqr")]
+# each builds its own programs (seconds from cold): a sample by default, the rest marked slow
+_SLOW = pytest.mark.slow
+KERNEL_PAIRS = [("quaternion", "sqr"), pytest.param("quaternion", "cube", marks=_SLOW), ("hypercomplex", "sin"),
+                ("hypercomplex", "pwr"), pytest.param("hypercomplex", "tan", marks=_SLOW), ("hypercomplex", "ln"),
+                pytest.param("hypercomplex", "asinh", marks=_SLOW), ("cquat", "cube"),
+                pytest.param("commutative", "sqr", marks=_SLOW)]
 
 
 @pytest.mark.parametrize("algebra,function", KERNEL_PAIRS)
@@ -192,7 +195,8 @@ def march_on_rays(s, o, d):
 
 
 @pytest.mark.parametrize("algebra,function", [("quaternion", "cube"), ("hypercomplex", "sin"),
-                                              ("hypercomplex", "cosh"), ("cquat", "sqr"), ("commutative", "cube")])
+                                              pytest.param("hypercomplex", "cosh", marks=_SLOW), ("cquat", "sqr"),
+                                              pytest.param("commutative", "cube", marks=_SLOW)])
 def test_stated_interval_holds_the_brute_force(algebra, function):
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
                          "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": 20, "height": 15}})
