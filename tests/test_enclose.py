@@ -161,7 +161,13 @@ def test_kernel_proofs_match_the_twin(algebra, function):
     assert kp.sum() > 0.2 * n
 
 
-@pytest.mark.parametrize("algebra,function", KERNEL_PAIRS)
+MARCH_PAIRS = [("quaternion", "sqr"), ("hypercomplex", "sin")] + [
+    pytest.param(*p, marks=_SLOW) for p in (("quaternion", "cube"), ("hypercomplex", "pwr"), ("hypercomplex", "tan"),
+                                            ("hypercomplex", "ln"), ("hypercomplex", "asinh"), ("cquat", "cube"),
+                                            ("commutative", "sqr"))]
+
+
+@pytest.mark.parametrize("algebra,function", MARCH_PAIRS)
 def test_proven_march_matches_its_twin(algebra, function):
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
                          "march": {"method": "proven", "z_resolution": 2000}, "image": {"width": 32, "height": 24}})
@@ -195,7 +201,8 @@ def march_on_rays(s, o, d):
 
 
 @pytest.mark.parametrize("algebra,function", [("quaternion", "cube"), ("hypercomplex", "sin"),
-                                              pytest.param("hypercomplex", "cosh", marks=_SLOW), ("cquat", "sqr"),
+                                              pytest.param("hypercomplex", "cosh", marks=_SLOW),
+                                              pytest.param("cquat", "sqr", marks=_SLOW),
                                               pytest.param("commutative", "cube", marks=_SLOW)])
 def test_stated_interval_holds_the_brute_force(algebra, function):
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},

@@ -66,8 +66,9 @@ def test_presets_differ_where_they_say(truths):
     assert zs == sorted(zs) and posts == sorted(posts)
 
 
-@pytest.mark.parametrize("algebra,function", [("hypercomplex", "sin"), ("hypercomplex", "ln"), ("cquat", "cube"),
-                                              ("commutative", "sqr"), ("quaternion", "cube")])
+@pytest.mark.parametrize("algebra,function", [("hypercomplex", "sin"), pytest.param("hypercomplex", "ln", marks=pytest.mark.slow),
+                                              ("cquat", "cube"), pytest.param("commutative", "sqr", marks=pytest.mark.slow),
+                                              pytest.param("quaternion", "cube", marks=pytest.mark.slow)])
 def test_every_pair_takes_the_presets(algebra, function):
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function}, "march": {"quality": "draft"},
                          "image": {"width": 24, "height": 18}})
