@@ -52,17 +52,9 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     return out;
 }
 
-/* the least |m + s v| over s in [-1, 1]: the distance from 0 to the segment */
-inline lreal enc_least_norm(quat m, quat v)
-{
-    lreal vv = QNORM2(v);
-    lreal s = clamp(L_SEL(-QDOT(m, v) / vv, (lreal)0, vv == (real)0), (lreal)-1, (lreal)1);
-    return QLEN(QADD(m, QSCALE(s, v)));
-}
-
 inline lmask enc_outside(enclosure e, real bailout2)
 {
-    lreal l = enc_least_norm(e.m, e.v) * ((real)1 - ENC_ROUND) - e.r;
+    lreal l = enc_least_norm(e.m, e.v) * ((real)1 - ENC_ROUND) - e.r;   /* enclose/disc.cl */
     return (l > (real)0) & (l * l > bailout2);
 }
 

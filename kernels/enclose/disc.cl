@@ -91,6 +91,19 @@ inline cdisc d_taylor(cplx fm, lreal d1, lreal r, lreal m2)
     return d_mean_value(fm, r, d1 * ((real)1 + ENC_ROUND_FN) + ENC_TINY + r * m2 * ENC_UP);
 }
 
+/* the least |m + s v| over s in [-1, 1] (an affine form's centre and tangent, enclose/ball.cl
+ * and enclose/split.cl): the distance from 0 to the segment */
+inline lreal enc_least_norm(quat m, quat v)
+{
+    lreal vv = QNORM2(v);
+    lreal s = clamp(L_SEL(-QDOT(m, v) / vv, (lreal)0, vv == (real)0), (lreal)-1, (lreal)1);
+    return QLEN(QADD(m, QSCALE(s, v)));
+}
+
+/* The disc of a function piece that states FUNC_M2 (its bound on |f''|): d_taylor with its
+ * own cfun, cfun_d and that bound, expanded where the piece uses it */
+#define D_TAYLOR_OF(z) d_taylor(cfun((z).m), c_abs(cfun_d((z).m)), (z).r, FUNC_M2((z).m, (z).r))
+
 /* exp: |exp'| = e^Re z <= e^(Re m + r) */
 inline cdisc d_exp(cdisc z) { return d_mean_value(c_exp(z.m), z.r, exp(z.m.re + z.r) * ENC_UP); }
 

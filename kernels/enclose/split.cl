@@ -70,9 +70,7 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)
 inline lmask enc_outside(enclosure e, real bailout2)
 {
     quat m = QUAT(e.a.m.re, e.a.m.im, e.b.m.re, e.b.m.im), v = QUAT(e.a.v.re, e.a.v.im, e.b.v.re, e.b.v.im);
-    lreal vv = QNORM2(v);
-    lreal s = clamp(L_SEL(-QDOT(m, v) / vv, (lreal)0, vv == (real)0), (lreal)-1, (lreal)1);
-    lreal l = QLEN(QADD(m, QSCALE(s, v))) * ((real)1 - ENC_ROUND) - hypot(e.a.r, e.b.r);
+    lreal l = enc_least_norm(m, v) * ((real)1 - ENC_ROUND) - hypot(e.a.r, e.b.r);   /* enclose/disc.cl */
     return (l > (real)0) & ((real)0.5 * l * l > bailout2);
 }
 

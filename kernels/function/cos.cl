@@ -8,6 +8,6 @@ inline cplx cfun_d(cplx z) { return c_neg(c_sin(z)); }
 #ifdef ENCLOSE   /* march/proven.cl: |cos'| <= |sin m| + r sup|cos| and |cos z| <= cosh(Im z) (enclose/disc.cl d_taylor) */
 /* enclose/split.cl's Taylor bound: |f''| = |cos z| <= cosh(Im z) */
 #define FUNC_M2(m, rho) cosh(fabs((m).im) + (rho))
-/* its disc enclosure */
-inline cdisc cfun_disc(cdisc z) { return d_taylor(c_cos(z.m), c_abs(c_sin(z.m)), z.r, cosh(fabs(z.m.im) + z.r)); }
+/* its disc enclosure: second order with that bound (enclose/disc.cl D_TAYLOR_OF) */
+inline cdisc cfun_disc(cdisc z) { return D_TAYLOR_OF(z); }
 #endif

@@ -8,6 +8,6 @@ inline cplx cfun_d(cplx z) { return c_sinh(z); }
 #ifdef ENCLOSE   /* march/proven.cl: |cosh'| <= |sinh m| + r sup|cosh| and |cosh z| <= cosh(Re z) (enclose/disc.cl d_taylor) */
 /* enclose/split.cl's Taylor bound: |f''| = |cosh z| <= cosh(Re z) */
 #define FUNC_M2(m, rho) cosh(fabs((m).re) + (rho))
-/* its disc enclosure */
-inline cdisc cfun_disc(cdisc z) { return d_taylor(c_cosh(z.m), c_abs(c_sinh(z.m)), z.r, cosh(fabs(z.m.re) + z.r)); }
+/* its disc enclosure: second order with that bound (enclose/disc.cl D_TAYLOR_OF) */
+inline cdisc cfun_disc(cdisc z) { return D_TAYLOR_OF(z); }
 #endif

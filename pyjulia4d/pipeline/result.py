@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.pipeline.codes import GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, \
     STATUS_HIT
 from pyjulia4d.scene.model import Scene
@@ -85,13 +86,9 @@ class RenderResult:
         each hit's surface crossing lies within its width behind its depth.  NaN when
         nothing was hit."""
         if self.bracket is None:
-            b = np.empty(0, np.float32)
-        else:  # finite exactly on hits (march/march.cl), so this needs no status array
-            b = self.bracket[np.isfinite(self.bracket)]
-        if b.size == 0:
-            return {"p50": math.nan, "p99": math.nan, "max": math.nan}
-        p50, p99 = np.percentile(b, [50, 99])
-        return {"p50": float(p50), "p99": float(p99), "max": float(b.max())}
+            return _percentiles(np.empty(0))
+        # finite exactly on hits (march/march.cl), so this needs no status array
+        return _percentiles(self.bracket[np.isfinite(self.bracket)])
 
     def error_stats(self) -> dict[str, float]:
         """p50 / p99 / max over the pixels hit of the depth error each states: its bracket
@@ -100,11 +97,7 @@ class RenderResult:
         if self.bracket is None or self.unresolved is None:
             return self.bracket_stats()
         hit = np.isfinite(self.bracket)
-        e = (self.bracket[hit] + self.unresolved[hit]).astype(np.float64)
-        if e.size == 0:
-            return {"p50": math.nan, "p99": math.nan, "max": math.nan}
-        p50, p99 = np.percentile(e, [50, 99])
-        return {"p50": float(p50), "p99": float(p99), "max": float(e.max())}
+        return _percentiles((self.bracket[hit] + self.unresolved[hit]).astype(np.float64))
 
     def unresolved_counts(self) -> dict[str, int]:
         """Pixels whose ray the march left partly unproven: hits with space in front of the
@@ -120,7 +113,6 @@ class RenderResult:
     def proven(self) -> bool:
         """Whether the march proved the space it skipped empty (march.method "proven"); the
         fixed scan and the distance estimate prove nothing in front of their hits."""
-        from pyjulia4d.fractal.registry import march_method
         return self.scene is not None and march_method(self.scene) == "proven"
 
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
@@ -199,6 +191,14 @@ class RenderResult:
             for k, name in enumerate("XYZW"):
                 ch[f"P.{name}"] = self.position[..., k]
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
+
+
+def _percentiles(values: np.ndarray) -> dict[str, float]:
+    """p50 / p99 / max of ``values``; NaN for none."""
+    if values.size == 0:
+        return {"p50": math.nan, "p99": math.nan, "max": math.nan}
+    p50, p99 = np.percentile(values, [50, 99])
+    return {"p50": float(p50), "p99": float(p99), "max": float(values.max())}
 
 
 def add_counts(total: dict[str, int], more: dict[str, int]) -> dict[str, int]:

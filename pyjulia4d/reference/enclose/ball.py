@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius, least_norm
 
 
 def _norm(q):
@@ -39,14 +39,6 @@ def enc_step(e, c, F):
             size = K * K * s ** 3 + jn * sv
         vn = F.julia_f_jvp(m, v)
         return F.julia_f(m, c), vn, enc_radius(rn, 4 * size + 2 * np.linalg.norm(c), ENC_ROUND)
-
-
-def least_norm(m, v):
-    """min |m + s v| over s in [-1, 1]."""
-    vv = np.sum(v * v, axis=-1)
-    with np.errstate(all="ignore"):
-        s = np.clip(np.where(vv == 0, 0.0, -np.sum(m * v, axis=-1) / vv), -1, 1)
-    return _norm(m + s[..., None] * v)
 
 
 def enc_outside(e, bailout2):

@@ -84,6 +84,23 @@ def d_taylor(fm, d1, r, m2):
     return d_mean_value(fm, r, lip)
 
 
+def least_norm(m, v):
+    """min |m + s v| over s in [-1, 1]."""
+    vv = np.sum(v * v, axis=-1)
+    with np.errstate(all="ignore"):
+        s = np.clip(np.where(vv == 0, 0.0, -np.sum(m * v, axis=-1) / vv), -1, 1)
+    return np.sqrt(np.sum((m + s[..., None] * v) ** 2, axis=-1))
+
+
+def taylor_disc(cfun, cfun_d, m2):
+    """The disc enclosure of a function with a bound ``m2(m, rho)`` on |f''| over a disc:
+    d_taylor with its own f and f' (kernels/enclose/disc.cl D_TAYLOR_OF)."""
+    def cfun_disc(z):
+        with _err():
+            return d_taylor(cfun(z[0]), np.abs(cfun_d(z[0])), z[1], m2(z[0], z[1]))
+    return cfun_disc
+
+
 def d_exp(z):
     m, r = z
     with _err():

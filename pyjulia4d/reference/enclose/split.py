@@ -9,8 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius
-from pyjulia4d.reference.enclose.ball import least_norm
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius, least_norm
 
 
 def caff_f(z, fn):

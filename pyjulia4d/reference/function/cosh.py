@@ -13,13 +13,10 @@ def cfun_d(z):
     return np.sinh(z)
 
 
-def cfun_disc(z):
-    """The disc enclosure of f (kernels/function/cosh.cl, under -D ENCLOSE)."""
-    with np.errstate(all="ignore"):
-        return D.d_taylor(np.cosh(z[0]), np.abs(np.sinh(z[0])), z[1], np.cosh(np.abs(z[0].real) + z[1]))
-
-
 def FUNC_M2(m, rho):
     """A bound on |f''| over the disc of radius rho around m (kernels/function/cosh.cl)."""
     with np.errstate(all="ignore"):
         return np.cosh(np.abs(m.real) + rho)
+
+
+cfun_disc = D.taylor_disc(cfun, cfun_d, FUNC_M2)   # kernels/function/cosh.cl, under -D ENCLOSE

@@ -13,13 +13,10 @@ def cfun_d(z):
     return np.cos(z)
 
 
-def cfun_disc(z):
-    """The disc enclosure of f (kernels/function/sin.cl, under -D ENCLOSE)."""
-    with np.errstate(all="ignore"):
-        return D.d_taylor(np.sin(z[0]), np.abs(np.cos(z[0])), z[1], np.cosh(np.abs(z[0].imag) + z[1]))
-
-
 def FUNC_M2(m, rho):
     """A bound on |f''| over the disc of radius rho around m (kernels/function/sin.cl)."""
     with np.errstate(all="ignore"):
         return np.cosh(np.abs(m.imag) + rho)
+
+
+cfun_disc = D.taylor_disc(cfun, cfun_d, FUNC_M2)   # kernels/function/sin.cl, under -D ENCLOSE
