@@ -182,19 +182,22 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
 
 
 PROVEN_FIRST = 0.125
+PROVEN_GAIN = 0.8
+FLOOR_POINTS = 8   # the points an unproven floor segment is tested at (march/proven.cl)
 
 
 def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
                  itp=True, formula: Formula = QUATERNION_SQR):
     """Segments from near on, each proven empty or shortened (by the enclosure's margin) down
-    to the floor (far - near) / z_resolution, where the midpoint and far end are tested: inside ends the
-    march with the certified bracket, outside passes the segment unproven (march/proven.cl).
+    to the floor (far - near) / z_resolution, where FLOOR_POINTS points to its far end are tested in
+    order: the first inside ends the march with the certified bracket from the point before, none
+    passes the segment unproven (march/proven.cl).
     Returns (t, status, samples, flags, width, unresolved)."""
     n = len(o)
     span = far - near
     floor_w = span / z_resolution
     h = np.maximum(span * PROVEN_FIRST, floor_w)
-    t, t_in = near.copy(), near.copy()
+    t, t_in, t_out = near.copy(), near.copy(), near.copy()
     open_w = np.zeros(n)
     first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
     active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
@@ -207,21 +210,29 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
         count[k] += 1
         at_floor = ~empty & (h[k] <= floor_w[k])
-        got, mid = np.zeros(k.size, bool), np.zeros(k.size, bool)
-        tm = 0.5 * (t[k] + t1)
-        if at_floor.any():   # its midpoint, then its far end
-            j = np.nonzero(at_floor)[0]
-            mid[j] = julia_inside(o[k[j]] + tm[j, None] * d[k[j]], c, max_iter, bailout, formula)
-            got[j] = mid[j] | julia_inside(o[k[j]] + t1[j, None] * d[k[j]], c, max_iter, bailout, formula)
+        got = np.zeros(k.size, bool)
+        look = at_floor.copy()
+        before = t[k].copy()
+        for jj in range(1, FLOOR_POINTS + 1):   # FLOOR_POINTS points to its far end, in order
+            j = np.nonzero(look)[0]
+            if j.size == 0:
+                break
+            tj = t1[j] if jj == FLOOR_POINTS else t[k[j]] + (t1[j] - t[k[j]]) * (jj / FLOOR_POINTS)
+            inside = julia_inside(o[k[j]] + tj[:, None] * d[k[j]], c, max_iter, bailout, formula)
+            g = j[inside]
+            t_in[k[g]], t_out[k[g]] = tj[inside], before[g]
+            got[g] = True
+            look[g] = False
+            before[j] = tj
         opened = at_floor & ~got
         open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
         hit[k] |= got
-        t_in[k] = np.where(got, np.where(mid, tm, t1), t_in[k])
         passed = empty | opened
         done = passed & (t1 >= far[k])
         miss[k] |= done
         mg = np.where(np.isnan(margin), 0.0, margin)
-        grow, shrink = np.clip(mg * 0.7, 1, 4), np.clip(mg * 0.7, 1 / 64, 0.5)
+        fac = np.sqrt(np.maximum(mg * PROVEN_GAIN, 0.0))   # the margin falls about as h^-2 (march/proven.cl)
+        grow, shrink = np.clip(fac, 1, 4), np.clip(fac, 1 / 64, 0.5)
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
         h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_w[k]), h[k])
         t[k] = np.where(passed & ~done, t1, t[k])
@@ -232,7 +243,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     depth = np.where(hit, t_in, np.inf)
     k = np.nonzero(hit & ~first)[0]
     if k.size:
-        depth[k], width[k] = refine_bracket(o[k], d[k], t[k], t_in[k], post_steps, c, max_iter, bailout, itp,
+        depth[k], width[k] = refine_bracket(o[k], d[k], t_out[k], t_in[k], post_steps, c, max_iter, bailout, itp,
                                             formula=formula)
         # the hit segment's part in front of the refined bracket: proven, or unproven
         j = k[depth[k] > t[k]]
