@@ -165,3 +165,25 @@ def test_proven_speed_benchmark_runs(tmp_path, capsys):
     assert cells["fixed, z_resolution 1000"][3] == "1.00"
     assert cells["proven, quality normal"][7].endswith("%") and cells["fixed, z_resolution 1000"][7] == ""
     assert "commit" in (tmp_path / "proven_speed.md").read_text()
+
+
+def test_pair_error_vs_time_benchmark_runs(tmp_path, capsys):
+    """benchmarks/pair_error_vs_time.py on the c = 0 ball, tiny: a row per setting (the
+    estimate too, which quaternions have), the fixed scan at 1000 its own unit, the proven
+    presets stating less than the whole ray, and the csv and plot written."""
+    spec = importlib.util.spec_from_file_location("pair_error_vs_time", ROOT / "benchmarks" / "pair_error_vs_time.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.settings_for({"algebra": "hypercomplex", "function": "sin"}, bench.SETTINGS) == [
+        n for n in bench.SETTINGS if n != "de"]
+    assert bench.main(["--only", "quaternion_sqr", "--size", "16x12", "--repeats", "1",
+                       "--settings", "fixed 1000", "de", "normal", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    rows = {r.split("|")[1].strip(): [c.strip() for c in r.strip("|").split("|")]
+            for r in out.splitlines() if r.startswith("| ") and r.split("|")[2].strip() in ("fixed", "de", "proven")}
+    assert set(rows) == {"fixed 1000", "de", "normal"}
+    assert rows["fixed 1000"][3] == "1.00"
+    assert float(rows["normal"][4]) < 0.01 < float(rows["fixed 1000"][4])   # proven: less than the whole ray
+    assert "commit" in (tmp_path / "pair_error_vs_time.md").read_text()
+    assert (tmp_path / "pair_error_vs_time.png").stat().st_size > 0
+    assert len((tmp_path / "pair_error_vs_time.csv").read_text().splitlines()) == 4
