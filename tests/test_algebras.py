@@ -303,8 +303,7 @@ def test_a_scene_compiles_only_its_algebra_and_function():
     (["fractal.function=sin"], "fractal.function"),
     (["fractal.algebra=hypercomplex", "fractal.function=exp", "march.method=de"], "march.method"),
     (["fractal.algebra=hypercomplex", "fractal.function=exp", "normals.method=gradient"], "normals.method"),
-    (["fractal.theta=30", "march.quality=draft"], "march.quality"),      # no enclosures for the rotation
-    (["fractal.kind=mandelbrot", "march.method=proven"], "march.method"),  # nor for the other kinds
+    (["fractal.kind=cubic_locus", "march.method=proven"], "march.method"),  # no enclosures for the locus
 ])
 def test_pairs_refused_with_the_key(over, key):
     with pytest.raises(SceneError) as e:

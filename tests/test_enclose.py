@@ -29,6 +29,8 @@ from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.march import enc_prove
 
 PAIRS = [(a, f) for a, fs in FUNCTIONS_OF.items() for f in fs]
+# every pair, and the rotated quaternion maps (fractal.theta, kernels/kind/rotate.cl)
+CASES = [(a, f, 0.0) for a, f in PAIRS] + [("quaternion", "sqr", 30.0), ("quaternion", "cube", -75.0)]
 # centres where each function is hard: poles of tan / tanh / 1/z, the cuts of ln, sqrt and
 # the inverse functions, large imaginary parts for sin and cos
 HARD = {"tan": [np.pi / 2, -np.pi / 2 + 0.01j], "tanh": [1j * np.pi / 2, 0.01 - 1.5707j],
@@ -77,9 +79,9 @@ def _segments(s, n, rng, lengths=(0.5, 0.05, 0.005, 5e-4)):
     return o, d, np.zeros(n), rng.choice(lengths, n)
 
 
-@pytest.mark.parametrize("algebra,function", PAIRS)
-def test_orbit_enclosures_hold_the_orbits(algebra, function):
-    s = _scene(algebra, function)
+@pytest.mark.parametrize("algebra,function,theta", CASES)
+def test_orbit_enclosures_hold_the_orbits(algebra, function, theta):
+    s = _scene(algebra, function, theta=theta)
     F = formula_of(s.fractal)
     E = F.enclose
     rng = np.random.default_rng(len(algebra) * 31 + len(function))
@@ -119,9 +121,9 @@ def _components(e, algebra):
     return [([0, 1, 2, 3], e)]
 
 
-@pytest.mark.parametrize("algebra,function", PAIRS)
-def test_proven_segments_hold_no_inside_point(algebra, function):
-    s = _scene(algebra, function)
+@pytest.mark.parametrize("algebra,function,theta", CASES)
+def test_proven_segments_hold_no_inside_point(algebra, function, theta):
+    s = _scene(algebra, function, theta=theta)
     f, F = s.fractal, formula_of(s.fractal)
     rng = np.random.default_rng(len(algebra) * 7 + len(function))
     n = 400
@@ -135,15 +137,16 @@ def test_proven_segments_hold_no_inside_point(algebra, function):
 
 # each builds its own programs (seconds from cold): a sample by default, the rest marked slow
 _SLOW = pytest.mark.slow
-KERNEL_PAIRS = [("quaternion", "sqr"), pytest.param("quaternion", "cube", marks=_SLOW), ("hypercomplex", "sin"),
-                ("hypercomplex", "pwr"), pytest.param("hypercomplex", "tan", marks=_SLOW), ("hypercomplex", "ln"),
-                pytest.param("hypercomplex", "asinh", marks=_SLOW), ("cquat", "cube"),
-                pytest.param("commutative", "sqr", marks=_SLOW)]
+KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0.0, marks=_SLOW),
+                ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
+                pytest.param("hypercomplex", "tan", 0.0, marks=_SLOW), ("hypercomplex", "ln", 0.0),
+                pytest.param("hypercomplex", "asinh", 0.0, marks=_SLOW), ("cquat", "cube", 0.0),
+                pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0)]
 
 
-@pytest.mark.parametrize("algebra,function", KERNEL_PAIRS)
-def test_kernel_proofs_match_the_twin(algebra, function):
-    s = _scene(algebra, function).with_overrides(["march.method=proven"])
+@pytest.mark.parametrize("algebra,function,theta", KERNEL_PAIRS)
+def test_kernel_proofs_match_the_twin(algebra, function, theta):
+    s = _scene(algebra, function, theta=theta).with_overrides(["march.method=proven"])
     f, F = s.fractal, formula_of(s.fractal)
     R = Runner(kernel_config.scene_config(s, ray_buffers=True))
     rng = np.random.default_rng(5)

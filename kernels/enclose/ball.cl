@@ -25,6 +25,17 @@
 
 typedef struct { quat m, v; lreal r; } enclosure;
 
+/* the rounding allowance of a step, in the terms' sizes: 4 (enclose/disc.cl's ENC_ROUND
+ * times twice their sum); the rotated map (kind/rotate.cl, fractal.theta) turns the centre and
+ * the tangent into and out of the unrotated frame, two more 2-term sums each, so 8 there.
+ * Its bounds hold as they are: a left multiplication by a unit quaternion keeps norms, so
+ * |J[e]| <= 2 |m| |e| and |R| <= K rho^2 for u f(u^-1 q) + u c as for f(q) + c. */
+#ifdef ROTATE_COS
+#define ENC_STEP_GAIN ((real)8)
+#else
+#define ENC_STEP_GAIN ((real)4)
+#endif
+
 inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
 {
     lreal tm = (real)0.5 * (t0 + t1), hw = (real)0.5 * (t1 - t0);
@@ -48,7 +59,7 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     lreal size = K * K * s * s * s + jn * sv;
 #endif
     quat v = julia_f_jvp(e.m, e.v);
-    enclosure out = {julia_f(e.m, c), v, enc_radius(r, (real)4 * size + (real)2 * length(c), ENC_ROUND)};
+    enclosure out = {julia_f(e.m, c), v, enc_radius(r, ENC_STEP_GAIN * size + (real)2 * length(c), ENC_ROUND)};
     return out;
 }
 

@@ -148,8 +148,8 @@ def has_distance_estimate(f: Any) -> bool:
 
 def can_prove(f: Any) -> bool:
     """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the Julia
-    sets of every algebra and function, unrotated (kernels/enclose/)."""
-    return f.kind == "julia" and f.theta == 0
+    sets of every algebra and function, rotated or not (kernels/enclose/)."""
+    return f.kind == "julia"
 
 
 def march_method(scene: Any) -> str:

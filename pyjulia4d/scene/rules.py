@@ -121,12 +121,10 @@ def check_fractal(scene: Any) -> None:
                          f"section 2.3), not {f.algebra}: set 0")
     if m.quality != "custom" and not can_prove(f):
         raise SceneError("march.quality", f"the presets are proven marches, which exist for the Julia sets of "
-                         f"every algebra and function without fractal.theta; for a {f.kind} set"
-                         f"{' with theta' if f.theta else ''} set the march keys (march.quality=custom)")
+                         f"every algebra and function; for a {f.kind} set set the march keys (march.quality=custom)")
     if m.method == "proven" and not can_prove(f):
         raise SceneError("march.method", f"proven needs orbit enclosures, which exist for the Julia sets of "
-                         f"every algebra and function without fractal.theta; for a {f.kind} set"
-                         f"{' with theta' if f.theta else ''} use fixed, de or auto")
+                         f"every algebra and function; for a {f.kind} set use fixed, de or auto")
     if has_distance_estimate(f):
         return
     if m.method == "de" and f.kind != "julia_stack":   # the stack's "de": its empirical estimate

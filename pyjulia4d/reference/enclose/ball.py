@@ -38,7 +38,8 @@ def enc_step(e, c, F):
             rn = jn * r + (3 * K * lm + K * K * rho) * rho * rho
             size = K * K * s ** 3 + jn * sv
         vn = F.julia_f_jvp(m, v)
-        return F.julia_f(m, c), vn, enc_radius(rn, 4 * size + 2 * np.linalg.norm(c), ENC_ROUND)
+        gain = 8 if F.theta != 0 else 4   # the rotated map's two more rotations (enclose/ball.cl ENC_STEP_GAIN)
+        return F.julia_f(m, c), vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
 
 
 def enc_outside(e, bailout2):
