@@ -21,7 +21,7 @@ import pytest
 
 from harness import Runner
 from pyjulia4d import Scene, reference as ref
-from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF
+from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF, MANDELBROT_START
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.measure.truth import brute_force_depth
 from pyjulia4d.pipeline import kernel_config
@@ -29,8 +29,20 @@ from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.march import enc_prove
 
 PAIRS = [(a, f) for a, fs in FUNCTIONS_OF.items() for f in fs]
-# every pair, and the rotated quaternion maps (fractal.theta, kernels/kind/rotate.cl)
-CASES = [(a, f, 0.0) for a, f in PAIRS] + [("quaternion", "sqr", 30.0), ("quaternion", "cube", -75.0)]
+# every pair, the rotated quaternion maps (fractal.theta, kernels/kind/rotate.cl) and the
+# Mandelbrot sets (kernels/enclose/mandelbrot.cl): of the powers, and of functions whose orbit
+# starts at their critical or asymptotic value (sin, cosh: V = 1; sinh: V = i; exp: 0)
+CASES = [(a, f, 0.0) for a, f in PAIRS] + [("quaternion", "sqr", 30.0), ("quaternion", "cube", -75.0)] + [
+    (a, f, "mandelbrot") for a, f in (("quaternion", "sqr"), ("quaternion", "cube"), ("hypercomplex", "sin"),
+                                      ("hypercomplex", "sinh"), ("hypercomplex", "cosh"), ("hypercomplex", "exp"),
+                                      ("cquat", "sqr"), ("commutative", "cube"))]
+
+
+def _case(algebra, function, how):
+    """A case's scene: a rotation angle, or a kind's name."""
+    if isinstance(how, str):
+        return _scene(algebra, function, kind=how)
+    return _scene(algebra, function, theta=how)
 # centres where each function is hard: poles of tan / tanh / 1/z, the cuts of ln, sqrt and
 # the inverse functions, large imaginary parts for sin and cos
 HARD = {"tan": [np.pi / 2, -np.pi / 2 + 0.01j], "tanh": [1j * np.pi / 2, 0.01 - 1.5707j],
@@ -79,22 +91,26 @@ def _segments(s, n, rng, lengths=(0.5, 0.05, 0.005, 5e-4)):
     return o, d, np.zeros(n), rng.choice(lengths, n)
 
 
-@pytest.mark.parametrize("algebra,function,theta", CASES)
-def test_orbit_enclosures_hold_the_orbits(algebra, function, theta):
-    s = _scene(algebra, function, theta=theta)
+@pytest.mark.parametrize("algebra,function,how", CASES)
+def test_orbit_enclosures_hold_the_orbits(algebra, function, how):
+    s = _case(algebra, function, how)
     F = formula_of(s.fractal)
-    E = F.enclose
+    K = F.kind_enclose
     rng = np.random.default_rng(len(algebra) * 31 + len(function))
     n, k = 120, 33
     o, d, t0, t1 = _segments(s, n, rng)
-    e = E.enc_segment(o, d, t0, t1, F)
+    e, param = K.enc_start(o, d, t0, t1, s.fractal.c, F)
     sk = np.linspace(-1, 1, k)
     tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
     q = F.ALG_IN(o[:, None] + (tm[:, None] + sk[None] * hw[:, None])[..., None] * d[:, None])
-    c = F.ALG_C(np.asarray(s.fractal.c, np.float64))
+    if s.fractal.kind == "mandelbrot":   # the points are the parameters; q_1 = V + c (kind/mandelbrot.cl)
+        c = q.reshape(-1, 4)
+        q = q + F.ALG_C(np.asarray(MANDELBROT_START[function], np.float64))
+    else:
+        c = F.ALG_C(np.asarray(s.fractal.c, np.float64))
     alive = np.ones((n, k), bool)
     checked = 0
-    for step in range(s.fractal.max_iter + 1):
+    for step in range(K.enc_steps(s.fractal.max_iter) + 1):
         with np.errstate(all="ignore"):
             for comp, (m, v, r) in (_components(e, algebra)):
                 pts = q[..., comp]
@@ -110,7 +126,7 @@ def test_orbit_enclosures_hold_the_orbits(algebra, function, theta):
             qn = F.julia_f(q.reshape(-1, 4), c).reshape(n, k, 4)
             alive &= np.all(np.isfinite(qn), axis=-1) & (F.ALG_NORM2(q) < 1e6)
             q = qn
-            e = E.enc_step(e, c, F)
+            e = K.enc_next(e, param, F)
     assert checked > n * k   # the enclosures were finite and checked beyond the first step
 
 
@@ -121,9 +137,9 @@ def _components(e, algebra):
     return [([0, 1, 2, 3], e)]
 
 
-@pytest.mark.parametrize("algebra,function,theta", CASES)
-def test_proven_segments_hold_no_inside_point(algebra, function, theta):
-    s = _scene(algebra, function, theta=theta)
+@pytest.mark.parametrize("algebra,function,how", CASES)
+def test_proven_segments_hold_no_inside_point(algebra, function, how):
+    s = _case(algebra, function, how)
     f, F = s.fractal, formula_of(s.fractal)
     rng = np.random.default_rng(len(algebra) * 7 + len(function))
     n = 400
@@ -141,12 +157,14 @@ KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0
                 ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
                 pytest.param("hypercomplex", "tan", 0.0, marks=_SLOW), ("hypercomplex", "ln", 0.0),
                 pytest.param("hypercomplex", "asinh", 0.0, marks=_SLOW), ("cquat", "cube", 0.0),
-                pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0)]
+                pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0),
+                ("quaternion", "sqr", "mandelbrot"), ("hypercomplex", "sinh", "mandelbrot"),
+                pytest.param("cquat", "cube", "mandelbrot", marks=_SLOW)]
 
 
-@pytest.mark.parametrize("algebra,function,theta", KERNEL_PAIRS)
-def test_kernel_proofs_match_the_twin(algebra, function, theta):
-    s = _scene(algebra, function, theta=theta).with_overrides(["march.method=proven"])
+@pytest.mark.parametrize("algebra,function,how", KERNEL_PAIRS)
+def test_kernel_proofs_match_the_twin(algebra, function, how):
+    s = _case(algebra, function, how).with_overrides(["march.method=proven"])
     f, F = s.fractal, formula_of(s.fractal)
     R = Runner(kernel_config.scene_config(s, ray_buffers=True))
     rng = np.random.default_rng(5)
@@ -203,12 +221,14 @@ def march_on_rays(s, o, d):
     return (depth.get().astype(float), status.get(), bracket.get().astype(float), unresolved.get().astype(float))
 
 
-@pytest.mark.parametrize("algebra,function", [("quaternion", "cube"), ("hypercomplex", "sin"),
-                                              pytest.param("hypercomplex", "cosh", marks=_SLOW),
-                                              pytest.param("cquat", "sqr", marks=_SLOW),
-                                              pytest.param("commutative", "cube", marks=_SLOW)])
-def test_stated_interval_holds_the_brute_force(algebra, function):
-    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function},
+@pytest.mark.parametrize("algebra,function,kind", [("quaternion", "cube", "julia"), ("hypercomplex", "sin", "julia"),
+                                                   pytest.param("hypercomplex", "cosh", "julia", marks=_SLOW),
+                                                   pytest.param("cquat", "sqr", "julia", marks=_SLOW),
+                                                   pytest.param("commutative", "cube", "julia", marks=_SLOW),
+                                                   ("quaternion", "sqr", "mandelbrot"),
+                                                   pytest.param("hypercomplex", "cosh", "mandelbrot", marks=_SLOW)])
+def test_stated_interval_holds_the_brute_force(algebra, function, kind):
+    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "kind": kind},
                          "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": 20, "height": 15}})
     from pyjulia4d import render
     s = render(s.with_overrides(["image.width=4", "image.height=3"])).scene   # camera.fit's camera

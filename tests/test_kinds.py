@@ -306,7 +306,7 @@ def test_truth_uses_the_quaternion_oracles_for_plain_julia_sets_only():
     (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=pwr", "fractal.exponent=1,0.5"],
      "fractal.exponent"),
     (["fractal.kind=mandelbrot", "fractal.theta=10"], "fractal.theta"),
-    (["fractal.kind=mandelbrot", "march.quality=draft"], "march.quality"),
+    (["fractal.kind=julia_stack", "march.quality=draft"], "march.quality"),
     (["fractal.kind=mandelbrot", "fractal.algebra=cquat", "march.method=de"], "march.method"),
     (["fractal.theta=10", "fractal.algebra=hypercomplex"], "fractal.theta"),
     (["fractal.theta=361"], "fractal.theta"),

@@ -63,6 +63,22 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     return out;
 }
 
+/* the sum of two forms in the same s: the Mandelbrot kind adds the segment's own points
+ * (enclose/mandelbrot.cl) */
+inline enclosure enc_add(enclosure a, enclosure b)
+{
+    enclosure out = {QADD(a.m, b.m), QADD(a.v, b.v),
+                     enc_radius(a.r + b.r, QLEN(a.m) + QLEN(b.m) + QLEN(a.v) + QLEN(b.v), ENC_ROUND)};
+    return out;
+}
+
+/* the form plus a constant k in the algebra's coordinates */
+inline enclosure enc_shift(enclosure e, real4 k)
+{
+    enclosure out = {QADD_UNIFORM(e.m, k), e.v, enc_radius(e.r, QLEN(e.m) + length(k), ENC_ROUND)};
+    return out;
+}
+
 inline lmask enc_outside(enclosure e, real bailout2)
 {
     lreal l = enc_least_norm(e.m, e.v) * ((real)1 - ENC_ROUND) - e.r;   /* enclose/disc.cl */

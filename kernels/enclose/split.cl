@@ -65,6 +65,28 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)
     return out;
 }
 
+/* the sum of two forms in the same s, per component (enclose/mandelbrot.cl) */
+inline caff caff_add(caff a, caff b)
+{
+    return A(c_add(a.m, b.m), c_add(a.v, b.v),
+             enc_radius(a.r + b.r, c_abs(a.m) + c_abs(b.m) + c_abs(a.v) + c_abs(b.v), ENC_ROUND));
+}
+
+inline enclosure enc_add(enclosure x, enclosure y)
+{
+    enclosure out = {caff_add(x.a, y.a), caff_add(x.b, y.b)};
+    return out;
+}
+
+/* the form plus a constant k in the algebra's coordinates (the components' (x, y), (z, w)) */
+inline enclosure enc_shift(enclosure e, real4 k)
+{
+    cplx ka = C((lreal)k.x, (lreal)k.y), kb = C((lreal)k.z, (lreal)k.w);
+    enclosure out = {A(c_add(e.a.m, ka), e.a.v, enc_radius(e.a.r, c_abs(e.a.m) + c_abs(ka), ENC_ROUND)),
+                     A(c_add(e.b.m, kb), e.b.v, enc_radius(e.b.r, c_abs(e.b.m) + c_abs(kb), ENC_ROUND))};
+    return out;
+}
+
 /* every point has |h|^2 > bailout2: |(a, b)| >= |(ma + s va, mb + s vb)| - |(ra, rb)|, the
  * first least over s in [-1, 1] (the distance from 0 to a segment in R^4) */
 inline lmask enc_outside(enclosure e, real bailout2)

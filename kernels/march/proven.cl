@@ -30,17 +30,19 @@
 /* Whether [t0, t1] is proven empty, for the lanes in ``todo``; *margin gets the largest
  * enc_margin over the iterations: about how many times longer the segment could have been
  * (> 1, proven) or must be shorter (< 1) to be proven, to first order in its length. */
+/* enc_start, enc_next, ENC_STEPS and enc_param: the kind's orbits (enclose/julia.cl,
+ * enclose/mandelbrot.cl) */
 inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, lreal *margin)
 {
-    enclosure e = enc_segment(o, d, t0, t1);
-    real4 c = ALG_C(jp.c);
+    enc_param p;
+    enclosure e = enc_start(o, d, t0, t1, jp, &p);
     real bailout = sqrt(jp.bailout2);
     lmask proven = todo & enc_outside(e, jp.bailout2);
     lmask live = todo & !proven;
     lreal best = enc_margin(e, bailout);
     int n = 0;
-    for (; n < jp.max_iter && L_ANY(live); ++n) {
-        e = enc_step(e, c, live);
+    for (; n < ENC_STEPS(jp) && L_ANY(live); ++n) {
+        e = enc_next(e, p, live);
         lmask out = live & enc_outside(e, jp.bailout2);
         best = L_SEL(best, fmax(best, enc_margin(e, bailout)), live);
         proven |= out;

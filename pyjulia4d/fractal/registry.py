@@ -78,11 +78,19 @@ class Kind:
     """A kind of set a [fractal] table describes.  ``piece``: its set test after iterate.cl
     (kernels/kind/<name>.cl, with kind/level.cl), None for the Julia set itself.
     ``estimate``: whether a proven distance estimate exists for it (the stack's "de" is an
-    empirical one)."""
+    empirical one).  ``enclosure``: its orbits' enclosures (enclose/<enclosure>.cl), where
+    the proven march exists for it."""
 
     name: str
     piece: str | None = None
     estimate: bool = True
+    enclosure: str | None = None
+
+    @property
+    def enclosure_piece(self) -> str | None:
+        """Its orbits' enclosures for the proven march, after the algebra's: kernels/enclose/
+        <enclosure>.cl and its twin; None: no proven march."""
+        return f"enclose/{self.enclosure}" if self.enclosure else None
 
 
 FUNCTIONS_TABLE: dict[str, Function] = {f.name: f for f in (
@@ -118,8 +126,8 @@ ALGEBRAS_TABLE: dict[str, Algebra] = {a.name: a for a in (
 ALGEBRAS = tuple(ALGEBRAS_TABLE)
 
 KINDS_TABLE: dict[str, Kind] = {k.name: k for k in (
-    Kind("julia"),
-    Kind("mandelbrot", piece="kind/mandelbrot"),
+    Kind("julia", enclosure="julia"),
+    Kind("mandelbrot", piece="kind/mandelbrot", enclosure="mandelbrot"),
     Kind("julia_stack", piece="kind/julia_stack", estimate=False),
     Kind("cubic_locus", piece="kind/cubic_locus", estimate=False),
 )}
@@ -147,9 +155,10 @@ def has_distance_estimate(f: Any) -> bool:
 
 
 def can_prove(f: Any) -> bool:
-    """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the Julia
-    sets of every algebra and function, rotated or not (kernels/enclose/)."""
-    return f.kind == "julia"
+    """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the kinds
+    with an enclosure piece (the Julia sets of every algebra and function, rotated or not;
+    the Mandelbrot sets), kernels/enclose/."""
+    return KINDS_TABLE[f.kind].enclosure is not None
 
 
 def march_method(scene: Any) -> str:

@@ -82,9 +82,10 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     defines = list(precision_defines(scene)) + list(fractal_defines(scene))
     if march_method(scene) == "proven":
         # circular arithmetic before the function pieces, which give their enclosures under
-        # -D ENCLOSE; the algebra's orbit enclosure after the iteration (kernels/enclose/)
+        # -D ENCLOSE; the algebra's orbit enclosure after the iteration, then the kind's orbits
+        # (kernels/enclose/)
         pieces.insert(pieces.index("algebra/complex") + 1, "enclose/disc")
-        pieces.append(ALGEBRAS_TABLE[scene.fractal.algebra].enclosure_piece)
+        pieces += [ALGEBRAS_TABLE[scene.fractal.algebra].enclosure_piece, KINDS_TABLE[scene.fractal.kind].enclosure_piece]
         defines.append("ENCLOSE")
     pieces.append("march/refine")
     if m.refine == "itp":

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE
+from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, KINDS_TABLE
 
 
 @dataclass(frozen=True)
@@ -80,6 +80,12 @@ class Formula:
         """The algebra's orbit enclosures for the proven march (reference/enclose/, the twin
         of the registry's enclosure piece)."""
         return importlib.import_module("pyjulia4d.reference." + ALGEBRAS_TABLE[self.algebra].enclosure_piece.replace("/", "."))
+
+    @property
+    def kind_enclose(self):
+        """The kind's orbit enclosures (reference/enclose/julia.py, mandelbrot.py: the twin of the
+        registry's kind enclosure piece)."""
+        return importlib.import_module("pyjulia4d.reference." + KINDS_TABLE[self.kind].enclosure_piece.replace("/", "."))
 
     @property
     def split(self) -> bool:

@@ -163,17 +163,16 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
     (reference/enclose/) outside the bailout ball at some n <= max_iter - and the largest
     enc_margin over the iterations (march/proven.cl)."""
-    E = formula.enclose
+    E, K = formula.enclose, formula.kind_enclose
     b2 = bailout * bailout
-    e = E.enc_segment(o, d, t0, t1, formula)
-    cc = formula.ALG_C(np.asarray(c, np.float64))
+    e, p = K.enc_start(o, d, t0, t1, c, formula)
     proven = E.enc_outside(e, b2)
     live = ~proven
     best = E.enc_margin(e, bailout)
-    for _ in range(max_iter):
+    for _ in range(K.enc_steps(max_iter)):
         if not live.any():
             break
-        e = E.enc_step(e, cc, formula)
+        e = K.enc_next(e, p, formula)
         out = live & E.enc_outside(e, b2)
         best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
         proven |= out

@@ -42,6 +42,19 @@ def enc_step(e, c, F):
         return F.julia_f(m, c), vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
 
 
+def enc_add(a, b):
+    """The sum of two forms in the same s (enclose/ball.cl)."""
+    (ma, va, ra), (mb, vb, rb) = a, b
+    return ma + mb, va + vb, enc_radius(ra + rb, _norm(ma) + _norm(mb) + _norm(va) + _norm(vb), ENC_ROUND)
+
+
+def enc_shift(e, k):
+    """The form plus a constant k in the algebra's coordinates."""
+    m, v, r = e
+    k = np.asarray(k, np.float64)
+    return m + k, v, enc_radius(r, _norm(m) + np.linalg.norm(k), ENC_ROUND)
+
+
 def enc_outside(e, bailout2):
     m, v, r = e
     with np.errstate(all="ignore"):

@@ -34,6 +34,24 @@ def caff_f(z, fn):
     return np.where(bad, wm, fm), np.where(bad, 0j, vn), np.where(bad, wr, rn)
 
 
+def _caff_add(a, b):
+    (ma, va, ra), (mb, vb, rb) = a, b
+    return ma + mb, va + vb, enc_radius(ra + rb, np.abs(ma) + np.abs(mb) + np.abs(va) + np.abs(vb), ENC_ROUND)
+
+
+def enc_add(x, y):
+    """The sum of two forms in the same s, per component (enclose/split.cl)."""
+    return tuple(_caff_add(a, b) for a, b in zip(x, y))
+
+
+def enc_shift(e, k):
+    """The form plus a constant k in the algebra's coordinates (the components' (x, y), (z, w))."""
+    out = []
+    for (m, v, r), kk in zip(e, (complex(k[0], k[1]), complex(k[2], k[3]))):
+        out.append((m + kk, v, enc_radius(r, np.abs(m) + abs(kk), ENC_ROUND)))
+    return tuple(out)
+
+
 def enc_segment(o, d, t0, t1, F):
     tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
     q = F.ALG_IN(o + tm[:, None] * d)
