@@ -303,7 +303,6 @@ def test_a_scene_compiles_only_its_algebra_and_function():
     (["fractal.function=sin"], "fractal.function"),
     (["fractal.algebra=hypercomplex", "fractal.function=exp", "march.method=de"], "march.method"),
     (["fractal.algebra=hypercomplex", "fractal.function=exp", "normals.method=gradient"], "normals.method"),
-    (["fractal.kind=cubic_locus", "march.method=proven"], "march.method"),  # no enclosures for the locus
 ])
 def test_pairs_refused_with_the_key(over, key):
     with pytest.raises(SceneError) as e:

@@ -35,7 +35,8 @@ PAIRS = [(a, f) for a, fs in FUNCTIONS_OF.items() for f in fs]
 CASES = [(a, f, 0.0) for a, f in PAIRS] + [("quaternion", "sqr", 30.0), ("quaternion", "cube", -75.0)] + [
     (a, f, "mandelbrot") for a, f in (("quaternion", "sqr"), ("quaternion", "cube"), ("hypercomplex", "sin"),
                                       ("hypercomplex", "sinh"), ("hypercomplex", "cosh"), ("hypercomplex", "exp"),
-                                      ("cquat", "sqr"), ("commutative", "cube"))]
+                                      ("cquat", "sqr"), ("commutative", "cube"))] + [
+    ("quaternion", "sqr", "julia_stack"), ("quaternion", "sqr", "cubic_locus")]
 
 
 def _case(algebra, function, how):
@@ -91,7 +92,7 @@ def _segments(s, n, rng, lengths=(0.5, 0.05, 0.005, 5e-4)):
     return o, d, np.zeros(n), rng.choice(lengths, n)
 
 
-@pytest.mark.parametrize("algebra,function,how", CASES)
+@pytest.mark.parametrize("algebra,function,how", [c for c in CASES if c[2] not in ("julia_stack", "cubic_locus")])
 def test_orbit_enclosures_hold_the_orbits(algebra, function, how):
     s = _case(algebra, function, how)
     F = formula_of(s.fractal)
@@ -130,6 +131,45 @@ def test_orbit_enclosures_hold_the_orbits(algebra, function, how):
     assert checked > n * k   # the enclosures were finite and checked beyond the first step
 
 
+@pytest.mark.parametrize("kind", ["julia_stack", "cubic_locus"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_own_map_enclosures_hold_the_orbits(kind, seed):
+    """The kinds that iterate a complex map of their own (enclose/julia_stack.cl,
+    cubic_locus.cl): the form of z_n holds the float64 z_n of points sampled along the
+    segment, step after step (the twins' own orbits, reference/kind/)."""
+    from pyjulia4d.reference.kind import cubic_locus as locus, julia_stack as stack
+    s = _case("quaternion", "sqr", kind)
+    F = formula_of(s.fractal)
+    K = F.kind_enclose
+    rng = np.random.default_rng(seed)
+    n, k = 150, 33
+    o, d, t0, t1 = _segments(s, n, rng)
+    e, param = K.enc_start(o, d, t0, t1, s.fractal.c, F)
+    sk = np.linspace(-1, 1, k)
+    tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    p = o[:, None] + (tm[:, None] + sk[None] * hw[:, None])[..., None] * d[:, None]
+    if kind == "julia_stack":
+        z, c, _ = stack._start(p, F)
+        step = lambda z: z * z + c   # noqa: E731
+    else:
+        a, b, sign, _ = locus._start(p, F)
+        z = sign * a
+        step = lambda z: locus.locus_f(z, a, b)   # noqa: E731
+    alive, checked = np.ones((n, k), bool), 0
+    for _ in range(K.enc_steps(s.fractal.max_iter) + 1):
+        m, v, r = e[0]
+        with np.errstate(all="ignore"):
+            dist = np.abs(z - (m[:, None] + sk[None] * v[:, None]))
+            live = alive & np.isfinite(dist) & (r[:, None] < np.inf)
+            bad = live & ~(dist <= r[:, None] * (1 + 1e-9) + 1e-12 * (1 + np.abs(dist)))
+            assert not bad.any(), (np.argwhere(bad)[:3], dist[bad][:3])
+            checked += live.sum()
+            z = step(z)
+            alive &= np.isfinite(z) & (np.abs(z) < 1e6)
+        e = K.enc_next(e, param, F)
+    assert checked > n * k
+
+
 def _components(e, algebra):
     """(coordinates, (centre, tangent, radius)) of each part of an enclosure."""
     if algebra == "hypercomplex":
@@ -159,7 +199,8 @@ KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0
                 pytest.param("hypercomplex", "asinh", 0.0, marks=_SLOW), ("cquat", "cube", 0.0),
                 pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0),
                 ("quaternion", "sqr", "mandelbrot"), ("hypercomplex", "sinh", "mandelbrot"),
-                pytest.param("cquat", "cube", "mandelbrot", marks=_SLOW)]
+                pytest.param("cquat", "cube", "mandelbrot", marks=_SLOW), ("quaternion", "sqr", "julia_stack"),
+                ("quaternion", "sqr", "cubic_locus")]
 
 
 @pytest.mark.parametrize("algebra,function,how", KERNEL_PAIRS)
@@ -226,13 +267,18 @@ def march_on_rays(s, o, d):
                                                    pytest.param("cquat", "sqr", "julia", marks=_SLOW),
                                                    pytest.param("commutative", "cube", "julia", marks=_SLOW),
                                                    ("quaternion", "sqr", "mandelbrot"),
-                                                   pytest.param("hypercomplex", "cosh", "mandelbrot", marks=_SLOW)])
+                                                   pytest.param("hypercomplex", "cosh", "mandelbrot", marks=_SLOW),
+                                                   ("quaternion", "sqr", "julia_stack"),
+                                                   pytest.param("quaternion", "sqr", "cubic_locus", marks=_SLOW)])
 def test_stated_interval_holds_the_brute_force(algebra, function, kind):
+    # the cubic locus hits few pixels of a small view, and its spikes can be thinner than the
+    # floor's point spacing: one pixel of 43 is 2.3 %, so it takes a larger view
+    w, h = (40, 30) if kind == "cubic_locus" else (20, 15)
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "kind": kind},
-                         "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": 20, "height": 15}})
+                         "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": w, "height": h}})
     from pyjulia4d import render
     s = render(s.with_overrides(["image.width=4", "image.height=3"])).scene   # camera.fit's camera
-    o, d = ref.generate_rays(camera_frame(s), 20, 15)
+    o, d = ref.generate_rays(camera_frame(s), w, h)
     # the kernel and the brute force on the same rays: float32's, exactly (a grazing ray moved by
     # its rounding crosses the surface elsewhere)
     o, d = o.astype(np.float32).astype(float), d.astype(np.float32).astype(float)

@@ -306,7 +306,6 @@ def test_truth_uses_the_quaternion_oracles_for_plain_julia_sets_only():
     (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.function=pwr", "fractal.exponent=1,0.5"],
      "fractal.exponent"),
     (["fractal.kind=mandelbrot", "fractal.theta=10"], "fractal.theta"),
-    (["fractal.kind=julia_stack", "march.quality=draft"], "march.quality"),
     (["fractal.kind=mandelbrot", "fractal.algebra=cquat", "march.method=de"], "march.method"),
     (["fractal.theta=10", "fractal.algebra=hypercomplex"], "fractal.theta"),
     (["fractal.theta=361"], "fractal.theta"),
@@ -374,3 +373,11 @@ def test_transcendental_mandelbrot_kernel_matches_twin(function):
     both = (k.status == 1) & (r.status == 1)
     assert np.median(np.abs(k.depth[both] - r.depth[both])) < 1e-4
     assert np.all(np.isfinite(k.color))
+
+
+@pytest.mark.parametrize("kind", ["julia", "mandelbrot", "julia_stack", "cubic_locus"])
+def test_every_kind_takes_the_quality_presets(kind):
+    """Every kind has orbit enclosures (kernels/enclose/), so every preset is its proven march."""
+    for q in ("draft", "normal", "final"):
+        s = Scene.default().with_overrides([f"fractal.kind={kind}", f"march.quality={q}"])
+        assert s.march.method == "proven" and s.march.quality == q

@@ -144,6 +144,29 @@ def test_brute_force_depth_is_the_analytic_ball():
     assert np.max(np.abs(t[m] - ts[m])) < 1e-12
 
 
+def test_refine_depth_finds_what_a_coarse_chord_stepped_over():
+    """c = 0 with a chord as long as the ball is wide: the scan steps over the ball on many
+    rays; a point inside it (the analytic chord's midpoint) as a sample brings back the
+    analytic entry, and a point outside it (or behind the truth) changes nothing."""
+    s = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", "fractal.c=0,0,0,0",
+                                        "fractal.max_iter=3"])
+    o, d = rays(s)
+    R = truth.sphere_radius(3, 4.0)
+    ts = truth.sphere_depth(o, d, R)
+    coarse = truth.brute_force_depth(s, o, d, chord=2.2 * R)
+    m = np.isfinite(ts)
+    stepped = m & ~np.isfinite(coarse)
+    assert stepped.sum() > 20                      # the coarse scan stepped over the ball there
+    b = np.sum(o * d, -1)
+    mid = np.where(m, -b, np.inf)                  # the chord's midpoint: inside the ball
+    fixed, moved = truth.refine_depth(s, o, d, coarse, mid, chord=2.2 * R)
+    assert moved >= stepped.sum()
+    assert np.max(np.abs(fixed[m] - ts[m])) < 1e-12 and not np.isfinite(fixed[~m]).any()
+    outside = np.where(m, ts - 1e-3, np.inf)       # just in front of the ball: outside
+    same, moved = truth.refine_depth(s, o, d, coarse, outside, chord=2.2 * R)
+    assert moved == 0 and np.array_equal(same, coarse)
+
+
 @pytest.mark.parametrize("algebra,function", [("quaternion", "sqr"), ("hypercomplex", "sin"), ("cquat", "cube")])
 def test_brute_force_depth_is_a_verified_crossing(algebra, function):
     """Any pair: each crossing is inside the set (its float64 twin) with an outside point

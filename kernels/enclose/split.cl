@@ -12,10 +12,7 @@
  * are outside the bailout ball when |h|^2 = (|a|^2 + |b|^2) / 2 > bailout^2 at the least
  * |(a, b)| the forms allow. */
 
-typedef struct { cplx m, v; lreal r; } caff;
-typedef struct { caff a, b; } enclosure;
-
-inline caff A(cplx m, cplx v, lreal r) { caff z = {m, v, r}; return z; }
+typedef struct { caff a, b; } enclosure;   /* caff: enclose/caff.cl */
 
 /* ``live``: the lanes whose result counts (a finished lane's garbage must not send the
  * whole packet down the disc path) */
@@ -66,12 +63,6 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)
 }
 
 /* the sum of two forms in the same s, per component (enclose/mandelbrot.cl) */
-inline caff caff_add(caff a, caff b)
-{
-    return A(c_add(a.m, b.m), c_add(a.v, b.v),
-             enc_radius(a.r + b.r, c_abs(a.m) + c_abs(b.m) + c_abs(a.v) + c_abs(b.v), ENC_ROUND));
-}
-
 inline enclosure enc_add(enclosure x, enclosure y)
 {
     enclosure out = {caff_add(x.a, y.a), caff_add(x.b, y.b)};

@@ -79,12 +79,14 @@ class Kind:
     (kernels/kind/<name>.cl, with kind/level.cl), None for the Julia set itself.
     ``estimate``: whether a proven distance estimate exists for it (the stack's "de" is an
     empirical one).  ``enclosure``: its orbits' enclosures (enclose/<enclosure>.cl), where
-    the proven march exists for it."""
+    the proven march exists for it.  ``own_map``: it iterates a complex map of its own, not
+    the algebra's, so its enclosure piece is the whole enclosure (no algebra piece)."""
 
     name: str
     piece: str | None = None
     estimate: bool = True
     enclosure: str | None = None
+    own_map: bool = False
 
     @property
     def enclosure_piece(self) -> str | None:
@@ -128,8 +130,8 @@ ALGEBRAS = tuple(ALGEBRAS_TABLE)
 KINDS_TABLE: dict[str, Kind] = {k.name: k for k in (
     Kind("julia", enclosure="julia"),
     Kind("mandelbrot", piece="kind/mandelbrot", enclosure="mandelbrot"),
-    Kind("julia_stack", piece="kind/julia_stack", estimate=False),
-    Kind("cubic_locus", piece="kind/cubic_locus", estimate=False),
+    Kind("julia_stack", piece="kind/julia_stack", estimate=False, enclosure="julia_stack", own_map=True),
+    Kind("cubic_locus", piece="kind/cubic_locus", estimate=False, enclosure="cubic_locus", own_map=True),
 )}
 
 KINDS = tuple(KINDS_TABLE)
@@ -157,7 +159,7 @@ def has_distance_estimate(f: Any) -> bool:
 def can_prove(f: Any) -> bool:
     """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the kinds
     with an enclosure piece (the Julia sets of every algebra and function, rotated or not;
-    the Mandelbrot sets), kernels/enclose/."""
+    the Mandelbrot sets, the Julia set stacks and the cubic locus), kernels/enclose/."""
     return KINDS_TABLE[f.kind].enclosure is not None
 
 

@@ -524,14 +524,46 @@ def brute_force_depth(scene: Scene, origins, dirs, chord: float = 2e-4, fine: fl
         return out
     h = (far[k] - near[k]) / n_scan
     t_in = near[k] + first[hit] * h
-    t_lo = np.maximum(t_in - h, near[k])
-    n_fine = max(1, int(np.ceil(float(np.max(h)) / fine)))
-    j = _first_inside(inside, o[k], d[k], t_lo, t_in, n_fine)   # never -1: t_in is inside
+    out[k] = _crossing_before(inside, o[k], d[k], np.maximum(t_in - h, near[k]), t_in, fine)
+    return out
+
+
+def _crossing_before(inside, o, d, t_lo, t_in, fine):
+    """The first crossing in [t_lo, t_in], t_in inside: a scan at ``fine``, then bisection;
+    t_lo itself where it is inside already (the ray's entry, or the eye)."""
+    n_fine = max(1, int(np.ceil(float(np.max(t_in - t_lo)) / fine)))
+    j = _first_inside(inside, o, d, t_lo, t_in, n_fine)   # never -1: t_in is inside
     j = np.where(j < 0, n_fine, j)
     hf = (t_in - t_lo) / n_fine
     t_hit = t_lo + j * hf
-    at_start = j == 0   # inside already at the chord's start (the ray's entry, or the eye)
+    at_start = j == 0
     t_out = np.where(at_start, t_hit, t_hit - hf)
-    polished = _bisect(inside, o[k], d[k], t_out, t_hit)
-    out[k] = np.where(at_start, t_hit, polished)
-    return out
+    polished = _bisect(inside, o, d, t_out, t_hit)
+    return np.where(at_start, t_hit, polished)
+
+
+def refine_depth(scene: Scene, origins, dirs, truth, t_inside, chord: float = 2e-4, fine: float = 2e-6,
+                 radius: float | None = None) -> tuple[np.ndarray, int]:
+    """brute_force_depth's ``truth`` with more samples: per ray, a point ``t_inside`` (from
+    anywhere: a render's inside end) that lies in front of the truth and that the float64
+    set test finds inside proves the chord scan stepped over a part there; the crossing is
+    then found by the fine scan over the chord before it and bisection, as brute_force_depth
+    does after its own inside sample.  Returns (the earlier of the two per ray, how many rays
+    moved)."""
+    from pyjulia4d.geometry.camera import march_radius
+
+    f = scene.fractal
+    F = ref.formula_of(f)
+    o, d = np.asarray(origins, np.float64), np.asarray(dirs, np.float64)
+    t = np.asarray(t_inside, np.float64)
+    out = np.array(truth, np.float64)
+    near, far, live = _ray_interval(o, d, march_radius(scene) if radius is None else radius)
+    with np.errstate(invalid="ignore"):
+        k = np.nonzero(live & np.isfinite(t) & (t < out) & (t >= near) & (t <= far))[0]
+    if k.size:
+        k = k[ref.julia_inside(o[k] + t[k, None] * d[k], f.c, f.max_iter, f.bailout, F)]
+    if k.size == 0:
+        return out, 0
+    inside = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)  # noqa: E731
+    out[k] = np.minimum(out[k], _crossing_before(inside, o[k], d[k], np.maximum(t[k] - chord, near[k]), t[k], fine))
+    return out, int(k.size)

@@ -84,8 +84,10 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
         # circular arithmetic before the function pieces, which give their enclosures under
         # -D ENCLOSE; the algebra's orbit enclosure after the iteration, then the kind's orbits
         # (kernels/enclose/)
-        pieces.insert(pieces.index("algebra/complex") + 1, "enclose/disc")
-        pieces += [ALGEBRAS_TABLE[scene.fractal.algebra].enclosure_piece, KINDS_TABLE[scene.fractal.kind].enclosure_piece]
+        i = pieces.index("algebra/complex") + 1
+        pieces[i:i] = ["enclose/disc", "enclose/caff"]
+        kind = KINDS_TABLE[scene.fractal.kind]
+        pieces += ([] if kind.own_map else [ALGEBRAS_TABLE[scene.fractal.algebra].enclosure_piece]) + [kind.enclosure_piece]
         defines.append("ENCLOSE")
     pieces.append("march/refine")
     if m.refine == "itp":

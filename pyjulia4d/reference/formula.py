@@ -88,6 +88,11 @@ class Formula:
         return importlib.import_module("pyjulia4d.reference." + KINDS_TABLE[self.kind].enclosure_piece.replace("/", "."))
 
     @property
+    def own_map(self) -> bool:
+        """The kind iterates a complex map of its own, not the algebra's (registry Kind.own_map)."""
+        return KINDS_TABLE[self.kind].own_map
+
+    @property
     def split(self) -> bool:
         """A split algebra: the estimate is that of a product of two sets (iterate.cl)."""
         return bool(getattr(self.alg, "ALG_SPLIT", False))

@@ -163,7 +163,8 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
     (reference/enclose/) outside the bailout ball at some n <= max_iter - and the largest
     enc_margin over the iterations (march/proven.cl)."""
-    E, K = formula.enclose, formula.kind_enclose
+    K = formula.kind_enclose
+    E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
     b2 = bailout * bailout
     e, p = K.enc_start(o, d, t0, t1, c, formula)
     proven = E.enc_outside(e, b2)

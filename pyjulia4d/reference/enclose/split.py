@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pyjulia4d.reference.enclose.caff import caff_add
 from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius, least_norm
 
 
@@ -34,14 +35,9 @@ def caff_f(z, fn):
     return np.where(bad, wm, fm), np.where(bad, 0j, vn), np.where(bad, wr, rn)
 
 
-def _caff_add(a, b):
-    (ma, va, ra), (mb, vb, rb) = a, b
-    return ma + mb, va + vb, enc_radius(ra + rb, np.abs(ma) + np.abs(mb) + np.abs(va) + np.abs(vb), ENC_ROUND)
-
-
 def enc_add(x, y):
     """The sum of two forms in the same s, per component (enclose/split.cl)."""
-    return tuple(_caff_add(a, b) for a, b in zip(x, y))
+    return tuple(caff_add(a, b) for a, b in zip(x, y))
 
 
 def enc_shift(e, k):

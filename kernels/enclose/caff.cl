@@ -1,0 +1,57 @@
+/* enclose/caff.cl: complex affine forms in one real symbol s in [-1, 1], on the lane type
+ * (common/lanes.cl), for the orbit enclosures of march/proven.cl: {m, v, r} holds every
+ * m + s v + e with |e| <= r.  A ray segment's points are exactly such a form (its midpoint
+ * and half its extent), and the forms keep the part of an orbit's spread that is linear in
+ * s in the tangent v, so only what is not goes into the ball (enclose/ball.cl says why).
+ * Products: (m1 + s v1 + e1)(m2 + s v2 + e2) = m1 m2 + s (m1 v2 + v1 m2) + s^2 v1 v2 +
+ * (m1 + s v1) e2 + (m2 + s v2) e1 + e1 e2, and s^2 in [0, 1] puts v1 v2 / 2 into the centre
+ * and |v1 v2| / 2 into the radius.  Every radius is raised for the rounding of the centre
+ * and the tangent (enclose/disc.cl enc_radius, ENC_ROUND of the terms' sizes).  Used by the
+ * split algebras (enclose/split.cl) and the kinds that iterate a complex map of their own
+ * (enclose/julia_stack.cl, enclose/cubic_locus.cl). */
+
+typedef struct { cplx m, v; lreal r; } caff;
+
+inline caff A(cplx m, cplx v, lreal r) { caff z = {m, v, r}; return z; }
+
+/* two reals m + s v (the ray's coordinates x, y) as one complex form */
+inline caff caff_of(lreal mx, lreal my, lreal vx, lreal vy, lreal r) { return A(C(mx, my), C(vx, vy), r); }
+
+inline caff caff_add(caff a, caff b)
+{
+    return A(c_add(a.m, b.m), c_add(a.v, b.v),
+             enc_radius(a.r + b.r, c_abs(a.m) + c_abs(b.m) + c_abs(a.v) + c_abs(b.v), ENC_ROUND));
+}
+
+/* k a, k a complex lane value */
+inline caff caff_scale(cplx k, caff a)
+{
+    lreal sk = c_abs(k);
+    return A(c_mul(k, a.m), c_mul(k, a.v), enc_radius(sk * a.r, (real)2 * sk * (c_abs(a.m) + c_abs(a.v)), ENC_ROUND));
+}
+
+inline caff caff_mul(caff a, caff b)
+{
+    lreal ma = c_abs(a.m), mb = c_abs(b.m), va = c_abs(a.v), vb = c_abs(b.v);
+    cplx vv = c_mul(a.v, b.v);
+    cplx m = c_add(c_mul(a.m, b.m), C((real)0.5 * vv.re, (real)0.5 * vv.im));
+    cplx v = c_add(c_mul(a.m, b.v), c_mul(a.v, b.m));
+    lreal r = (real)0.5 * va * vb + (ma + va) * b.r + (mb + vb) * a.r + a.r * b.r;
+    return A(m, v, enc_radius(r, (real)4 * (ma * mb + va * vb + ma * vb + va * mb), ENC_ROUND));
+}
+
+inline caff caff_sqr(caff a) { return caff_mul(a, a); }
+
+/* how many times its extent the centre lies beyond the bailout (<= 0: inside) */
+inline lreal caff_margin(caff z, real bailout) { return (c_abs(z.m) - bailout) / (c_abs(z.v) + z.r); }
+
+/* every point has |z| > bailout: the least |m + s v| over s, less r */
+inline lmask caff_outside(caff z, real bailout2)
+{
+    lreal l = enc_least_norm(QUAT(z.m.re, z.m.im, (lreal)0, (lreal)0), QUAT(z.v.re, z.v.im, (lreal)0, (lreal)0))
+              * ((real)1 - ENC_ROUND) - z.r;
+    return (l > (real)0) & (l * l > bailout2);
+}
+
+/* whether the form may still prove the segment (enclose/ball.cl enc_hopeful) */
+inline lmask caff_hopeful(caff z, real bailout) { return c_abs(z.v) + z.r < (real)2 * (c_abs(z.m) + bailout); }

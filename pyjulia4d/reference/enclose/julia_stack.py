@@ -1,0 +1,42 @@
+"""float64 twin of kernels/enclose/julia_stack.cl: a Julia set stack's orbit enclosures, complex
+affine forms (reference/enclose/caff.py) of z_n beside c(u) = c_mid + u c_half; a segment is
+also empty where all its u lie beyond the slab |u| <= 1.  enclosure = (z form, off)."""
+from __future__ import annotations
+
+import numpy as np
+
+from pyjulia4d.reference.enclose.caff import (caff_add, caff_hopeful, caff_margin, caff_of, caff_outside, caff_sqr,
+                                              segment_parts)
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius
+from pyjulia4d.reference.kind.julia_stack import c_line
+
+
+def enc_steps(max_iter: int) -> int:
+    return max_iter
+
+
+def enc_start(o, d, t0, t1, c, F):
+    m, v, r = segment_parts(o, d, t0, t1)
+    cm, ch = c_line(F)
+    sh = abs(ch)
+    cform = (cm + m[:, 2] * ch, v[:, 2] * ch,
+             enc_radius(sh * r, abs(cm) + 2 * sh * (np.abs(m[:, 2]) + np.abs(v[:, 2])), ENC_ROUND))
+    off = (np.abs(m[:, 2]) - np.abs(v[:, 2]) - r) > 1
+    return (caff_of(m[:, 0], m[:, 1], v[:, 0], v[:, 1], r), off), cform
+
+
+def enc_next(e, c, F):
+    z, off = e
+    return caff_add(caff_sqr(z), c), off
+
+
+def enc_outside(e, bailout2):
+    return e[1] | caff_outside(e[0], bailout2)
+
+
+def enc_margin(e, bailout):
+    return caff_margin(e[0], bailout)
+
+
+def enc_hopeful(e, bailout):
+    return caff_hopeful(e[0], bailout)
