@@ -9,7 +9,9 @@ the same view:
 * the fixed z-resolution scan at z_resolution 250 (the default of a pair without a distance
   estimate), 1000 and 4000;
 * the distance estimate (the default of a pair that has one);
-* the proven march at each quality preset: draft, normal, final.
+* the proven march at floors of 1/250 and 1/1000 of the ray (z_resolution 250, 1000: the
+  scan's own resolutions, with post_steps 4) and at each quality preset: draft (1/5000),
+  normal (1/20000), final (1/200000).
 
 Per setting: the kernels' seconds (the median of --repeats renders after one that builds),
 as a ratio to the fixed scan at 1000 of the same pair (this machine is shared and noisy:
@@ -54,6 +56,8 @@ SETTINGS = {"fixed 250": ["march.method=fixed", "march.z_resolution=250"],
             "fixed 1000": ["march.method=fixed", "march.z_resolution=1000"],
             "fixed 4000": ["march.method=fixed", "march.z_resolution=4000"],
             "de": ["march.method=de"],
+            "proven 250": ["march.method=proven", "march.z_resolution=250"],
+            "proven 1000": ["march.method=proven", "march.z_resolution=1000"],
             "draft": ["march.quality=draft"],
             "normal": ["march.quality=normal"],
             "final": ["march.quality=final"]}
@@ -123,10 +127,10 @@ def plot(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fams = {"fixed scan": ("fixed 250", "fixed 1000", "fixed 4000"), "distance estimate": ("de",),
-            "proven (quality presets)": ("draft", "normal", "final")}
+            "proven (floors 1/250 .. 1/200000)": ("proven 250", "proven 1000", "draft", "normal", "final")}
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharey=True)
     for ax, (fam, names) in zip(axes, fams.items()):
-        for n, mk in zip(names, "o^s"):
+        for n, mk in zip(names, "o^sDv"):
             g = [m for m in rows if m["setting"] == n and np.isfinite(m["p99_err"])]
             ax.scatter([m["ratio"] for m in g], [max(m["p99_err"], 1e-7) for m in g], marker=mk, s=18,
                        label=n, alpha=0.7)
