@@ -3,6 +3,8 @@ fixed scan at z_resolution 1000 and the distance estimate, side by side in one r
 ratios (this machine is shared and noisy), on the scenes the proof was asked to be fast on:
 hypercomplex sin, cosh and pwr, and the quaternion default.
 
+The proven march runs in packets of at most 8 rays (opencl/lanes.py PROVEN_LANES); a row
+at 16 lanes, where the device takes them, keeps that choice measured.
 For each scene and march: the whole render's kernel seconds (median of --repeats after a
 warm-up), the march kernel alone (packets, rays from buffers), the tests per ray
 (set tests for the scan, estimates for de, enclosures for proven), and what each render
@@ -34,6 +36,7 @@ for p in (ROOT / "benchmarks", ROOT):
 from pyjulia4d import Scene, reference as ref, render  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
+from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
 from pyjulia4d.reference.formula import formula_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
@@ -42,6 +45,7 @@ SCENES = {"hypercomplex sin": {"algebra": "hypercomplex", "function": "sin"},
           "hypercomplex pwr": {"algebra": "hypercomplex", "function": "pwr"},
           "quaternion sqr (default)": {}}
 MARCHES = {"proven, quality normal": ["march.quality=normal"],
+           "proven, quality normal, 16 lanes": ["march.quality=normal"],   # opencl/lanes.py PROVEN_LANES
            "fixed, z_resolution 1000": ["march.method=fixed", "march.z_resolution=1000"],
            "auto (the pair's default)": []}
 
@@ -70,14 +74,14 @@ def proof_share(scene: Scene) -> float:
     return counts[0] / max(counts[1], 1)
 
 
-def run(scene: Scene, dev, repeats: int) -> dict:
+def run(scene: Scene, dev, repeats: int, lanes: int | None = None) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = render(scene, device=dev)            # warm-up: builds, camera.fit
+        r = render(scene, device=dev, lanes=lanes)            # warm-up: builds, camera.fit
         fixed = r.scene
         ts = []
         for _ in range(repeats):
-            r = render(fixed, device=dev)
+            r = render(fixed, device=dev, lanes=lanes)
             ts.append(r.kernel_seconds)
     hit = r.status == 1
     e = r.error_stats()
@@ -107,7 +111,8 @@ def main(argv=None) -> int:
         got = {}
         for mname, over in MARCHES.items():
             s = Scene.from_dict({"fractal": fractal} if fractal else {}, [f"image.width={w}", f"image.height={h}"] + over)
-            got[mname] = run(s, dev, a.repeats)
+            wide = "16 lanes" in mname and lanes_for(dev, s.render.variant, False) >= 16
+            got[mname] = run(s, dev, a.repeats, 16 if wide else None)
         base = got["fixed, z_resolution 1000"]["kernel_s"]
         for mname, g in got.items():
             share = f"{100 * proof_share(g['scene']):.0f} %" if g["proven"] else ""

@@ -18,8 +18,9 @@ import pyopencl.array as cla
 from pyjulia4d.pipeline import antialias, colormap
 from pyjulia4d.opencl import build
 from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.opencl.devices import has_fp64, select_device
-from pyjulia4d.opencl.lanes import lanes_for
+from pyjulia4d.opencl.lanes import lanes_for, march_lanes
 from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
 from pyjulia4d.pipeline.framing import fit_camera
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
@@ -364,7 +365,7 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
     if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     if lanes is None:
-        lanes = lanes_for(dev, scene.render.variant, double)
+        lanes = march_lanes(lanes_for(dev, scene.render.variant, double), march_method(scene))
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
         with warnings.catch_warnings():   # refuse before any pass runs; warn after it
             warnings.simplefilter("ignore")

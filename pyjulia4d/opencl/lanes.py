@@ -77,6 +77,20 @@ def probe(device: cl.Device, timeout: float = 120.0) -> int:
     return 1
 
 
+# The proven march's lanes part ways more than the scan's or the estimate's (each proves
+# segments of its own lengths, each enclosure runs to its own iteration), so narrower packets
+# idle less: at 8 lanes it took 0.74-0.88x its time at 16 on the hypercomplex sin, cosh and
+# pwr, the CQuat cube and the quaternion default (320x240, normal, interleaved renders on the
+# development machine), where the fixed scan and the estimate were within 0.84-1.19x.
+PROVEN_LANES = 8
+
+
+def march_lanes(width: int, method: str) -> int:
+    """The packet width of a march: the probed ``width``, at most PROVEN_LANES for the
+    proven march (march.method resolved)."""
+    return min(width, PROVEN_LANES) if method == "proven" else width
+
+
 def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     """Rays per work-item of the march for ``render.variant`` on ``device``: 1 for
     "scalar", for double precision (packets are float) and for GPUs under "auto"; for
