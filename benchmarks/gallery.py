@@ -41,8 +41,11 @@ if str(ROOT) not in sys.path:
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 # Keys every scene shares (a scene's own keys come after and win); the shading keys are
-# pinned so that a change of the scene defaults does not change the gallery.
-COMMON = ["march.z_resolution=250", "march.post_steps=10", "shading.coloring=flat", "shading.ambient=0.04",
+# pinned so that a change of the scene defaults does not change the gallery.  The march is
+# the normal preset, the proven march: the fixed scan at 250 stepped over the thin parts of
+# the hypercomplex sin, cos and cosh and of the CQuats and the commutative rules
+# (benchmarks/results/pair_accuracy.md).
+COMMON = ["march.quality=normal", "shading.coloring=flat", "shading.ambient=0.04",
           "shading.diffuse=0.92", "shading.specular=0.35", "shading.shininess=40", "shading.shadow=none",
           "shading.ao=0"]
 

@@ -124,11 +124,12 @@ def summary(rows: list[dict], names) -> str:
 
 def plot(rows: list[dict], path: Path) -> None:
     import matplotlib
+    import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fams = {"fixed scan": ("fixed 250", "fixed 1000", "fixed 4000"), "distance estimate": ("de",),
             "proven (floors 1/250 .. 1/200000)": ("proven 250", "proven 1000", "draft", "normal", "final")}
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharex=True, sharey=True)
     for ax, (fam, names) in zip(axes, fams.items()):
         for n, mk in zip(names, "o^sDv"):
             g = [m for m in rows if m["setting"] == n and np.isfinite(m["p99_err"])]
@@ -136,6 +137,7 @@ def plot(rows: list[dict], path: Path) -> None:
                        label=n, alpha=0.7)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_title(fam)
         ax.set_xlabel("kernel time / fixed scan at 1000 (same pair)")
         ax.grid(True, which="both", alpha=0.3)

@@ -47,7 +47,7 @@ SCENES = {"hypercomplex sin": {"algebra": "hypercomplex", "function": "sin"},
 MARCHES = {"proven, quality normal": ["march.quality=normal"],
            "proven, quality normal, 16 lanes": ["march.quality=normal"],   # opencl/lanes.py PROVEN_LANES
            "fixed, z_resolution 1000": ["march.method=fixed", "march.z_resolution=1000"],
-           "auto (the pair's default)": []}
+           "custom (the estimate, else the scan at 250)": ["march.quality=custom"]}
 
 
 def proof_share(scene: Scene) -> float:

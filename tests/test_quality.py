@@ -105,8 +105,8 @@ def test_quality_key_sets_the_march_and_explicit_keys_win():
 def test_presets_are_valid_overrides_and_ordered():
     bounds = [PRESETS[q]["p99_bound"] for q in ("draft", "normal", "final")]
     assert bounds == sorted(bounds, reverse=True) and len(set(bounds)) == 3
-    assert "refine" in MARCH_KEYS and set(QUALITIES) == {"custom"} | set(PRESETS)
-    assert preset_values("custom") == {} and set(preset_values("normal")) == set(MARCH_KEYS)
+    assert "refine" in MARCH_KEYS and set(QUALITIES) == {"auto", "custom"} | set(PRESETS)
+    assert preset_values("custom") == {} == preset_values("auto") and set(preset_values("normal")) == set(MARCH_KEYS)
     assert stated_p99("final") == PRESETS["final"]["p99_bound"] and stated_p99("custom") is None
     for q in PRESETS:
         Scene.default().with_overrides(preset_overrides(q))

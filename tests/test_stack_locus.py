@@ -172,7 +172,8 @@ def test_stack_packets_give_the_same_pixels(lanes):
 def test_stack_radius_holds_the_stack(over):
     # no point just outside the ball (in the view's hyperplane w = w0) is inside
     s = stack(*over)
-    assert march_method(s) == "fixed" and "STACK_DE" not in kernel_config.fractal_defines(s)
+    # no estimate: by default the proven march (march.quality "auto")
+    assert march_method(s) == "proven" and "STACK_DE" not in kernel_config.fractal_defines(s)
     r = march_radius(s)
     w0 = s.slice.distance
     u = np.random.default_rng(6).normal(size=(20000, 3))
@@ -355,4 +356,4 @@ def test_locus_keys_refused_with_the_key(over, key):
 
 def test_locus_radius_with_bailout_raised_is_accepted():
     s = locus("fractal.locus_radius=3", "fractal.bailout=6")
-    assert march_method(s) == "fixed" and "LOCUS_SIGN=1" in kernel_config.fractal_defines(s)
+    assert march_method(s) == "proven" and "LOCUS_SIGN=1" in kernel_config.fractal_defines(s)

@@ -188,11 +188,11 @@ def _render(args: argparse.Namespace) -> int:
         from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
 
         result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
-    from pyjulia4d.scene.quality import stated_p99
+    from pyjulia4d.scene.quality import resolved_quality, stated_p99
 
     # capped rays, the guards that fired, the certified depth bracket and the unresolved
     # space are part of the result: said in the header and the closing line, never hidden
-    report, tail = result.report(stated_p99(scene.march.quality))
+    report, tail = result.report(stated_p99(resolved_quality(scene)))
     # the scene as rendered: with camera.fit, the camera the framing pass chose
     rendered = getattr(result, "scene", None) or scene
     header = {"pyjulia4d.scene": rendered.to_toml(), **report}

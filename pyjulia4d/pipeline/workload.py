@@ -137,9 +137,7 @@ def check_numerics(scene: Scene) -> None:
                             f"reaches ~1e{4 * math.log10(f.bailout):.0f} one squaring past the "
                             f"bailout, above {REAL_MAX[scene.render.float]:.1e}); use at most "
                             f"{lim:.2g}{alt}")
-    # a preset's epsilon (final: 5e-7) is below the spacing of t for cameras ~8 units away;
-    # its stated bound was measured with that, and the ulp_step guard counts it: no warning
-    if march_method(scene) == "de" and scene.render.float == "single" and m.quality == "custom":
+    if march_method(scene) == "de" and scene.render.float == "single":
         t_far = float(sum(x * x for x in camera_frame(scene).position)) ** 0.5 + march_radius(scene)
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:

@@ -20,7 +20,7 @@ from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS, KINDS
 from pyjulia4d.scene import rules
 from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, Integer, Lights, OrWord, Planes,  # noqa: F401
                                     Real, SceneError, Vector, show, show_key)
-from pyjulia4d.scene.quality import QUALITIES, preset_values
+from pyjulia4d.scene.quality import MARCH_KEYS, QUALITIES, auto_values, preset_values
 from pyjulia4d.scene.text import parse_override, read_scene_table, toml_value
 
 Vec3 = tuple[float, float, float]
@@ -96,9 +96,12 @@ class Slice:
 @dataclass(frozen=True)
 class March:
     """[march]: how rays find the surface.  ``quality`` other than "custom" sets
-    method, z_resolution, post_steps and epsilon from a measured preset (quality.py)."""
+    method, z_resolution, post_steps, epsilon and refine from a measured preset (quality.py);
+    "auto", the default, takes them from the set (quality.auto_values: the proven march's
+    normal preset where the set has no distance estimate, the estimate where it has one), so
+    they are not given with it: a scene that gives any of them is "custom"."""
 
-    quality: str = "custom"
+    quality: str = "auto"
     method: str = "auto"
     z_resolution: int = 250
     post_steps: int = 4
@@ -364,10 +367,14 @@ def check_light(light: "Light") -> None:
 
 
 def fill_preset(march: dict[str, Any], keep: set[str]) -> None:
-    """Set the preset's march values for ``march["quality"]``, except the keys in ``keep``."""
+    """Set the preset's march values for ``march["quality"]``, except the keys in ``keep``;
+    for "auto", drop the others (they follow the set)."""
     if "quality" not in march:
         return
     quality = CHECKS["march"]["quality"]("march.quality", march["quality"])
+    if quality == "auto":
+        for k in set(MARCH_KEYS) - keep:
+            march.pop(k, None)
     for k, v in preset_values(quality).items():
         if k not in keep:
             march[k] = v
@@ -395,6 +402,8 @@ class Scene:
             if not isinstance(getattr(self, name), kind):
                 raise SceneError(name, f"expected a pyjulia4d.scene.{kind.__name__}, got "
                                        f"{show(getattr(self, name))}")
+        if self.march.quality == "auto":   # the march keys follow the set, however it was built
+            object.__setattr__(self, "march", dataclasses.replace(self.march, **auto_values(self.fractal)))
         rules.check_camera(self.camera)
         rules.check_fractal(self)
         if self.shading.reflection > 0 and self.normals.method == "zbuffer":
@@ -441,6 +450,10 @@ class Scene:
             raw[section][key] = value
             if (section, key) == ("march", "quality"):
                 fill_preset(raw["march"], keep=set())
+        # "auto" (given or by default) takes its march keys from the set: a scene that gives
+        # any of them chose them, so it is "custom" (its other keys take custom's defaults)
+        if raw["march"].get("quality", "auto") == "auto" and set(raw["march"]) & set(MARCH_KEYS):
+            raw["march"]["quality"] = "custom"
         # No camera position given: nothing says where the set is, so frame it (a default
         # camera cuts off or shrinks to a speck many sets); a given position is kept as is.
         if "position" not in raw["camera"] and "fit" not in raw["camera"]:
@@ -492,6 +505,9 @@ class Scene:
                 for f in fields(part)
             }
         out["shading"]["lights"] = [light.to_dict() for light in self.shading.lights]
+        if self.march.quality == "auto":   # its march keys follow the set: given, they would fix them
+            for k in MARCH_KEYS:
+                del out["march"][k]
         return out
 
     def to_toml(self) -> str:

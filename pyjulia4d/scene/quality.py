@@ -32,7 +32,13 @@ from __future__ import annotations
 
 from typing import Any
 
-QUALITIES = ("custom", "draft", "normal", "final")
+from pyjulia4d.fractal.registry import has_distance_estimate
+
+QUALITIES = ("auto", "custom", "draft", "normal", "final")
+
+# "custom"'s march keys where none is given: the estimate where the set has one, else the
+# fixed scan (march.method "auto", fractal/registry.march_method), at z_resolution 250
+CUSTOM = {"method": "auto", "z_resolution": 250, "post_steps": 4, "epsilon": 1e-3, "refine": "itp"}
 
 # Proven marches (kernels/march/proven.cl) at three floors; the bound is what each targets
 # for the error a render states, bracket plus unresolved (RenderResult.error_stats), which
@@ -49,9 +55,31 @@ PRESETS: dict[str, dict] = {
 MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon", "refine")
 
 
+def auto_quality(fractal: Any) -> str:
+    """What "auto" (the default) is for a [fractal]: "custom" - the distance estimate - where
+    the set has one (its march was measured as accurate as it states on the quaternion and
+    hypercomplex squares; its error statement is the whole ray in front, which it does not
+    prove), "normal" - the proven march - where it has none: there the fixed scan stepped over
+    thin parts on up to 12 % of the pixels (benchmarks/results/pair_accuracy.md)."""
+    return "custom" if has_distance_estimate(fractal) else "normal"
+
+
+def resolved_quality(scene: Any) -> str:
+    """The scene's march.quality with "auto" resolved for its set."""
+    q = scene.march.quality
+    return auto_quality(scene.fractal) if q == "auto" else q
+
+
+def auto_values(fractal: Any) -> dict:
+    """The march keys "auto" takes for a [fractal]: the normal preset's or custom's defaults."""
+    q = auto_quality(fractal)
+    return dict(CUSTOM) if q == "custom" else preset_values(q)
+
+
 def preset_values(quality: str) -> dict:
-    """The march keys a preset sets ({} for "custom")."""
-    if quality == "custom":
+    """The march keys a preset sets ({} for "custom" and for "auto", which depends on the set:
+    auto_values)."""
+    if quality in ("custom", "auto"):
         return {}
     if quality not in PRESETS:
         raise ValueError(f"march.quality: expected one of {', '.join(map(repr, QUALITIES))}, got {quality!r}")
@@ -59,10 +87,11 @@ def preset_values(quality: str) -> dict:
 
 
 def stated_p99(quality: str) -> float | None:
-    """The p99 depth error (scene units) ``quality`` targets; None for "custom".  A render
-    states (and proves) its own error; the closing line says whether it is within this."""
+    """The p99 depth error (scene units) ``quality`` targets (resolved: resolved_quality);
+    None for "custom".  A render states (and proves) its own error; the closing line says
+    whether it is within this."""
     preset_values(quality)
-    if quality == "custom":
+    if quality in ("custom", "auto"):
         return None
     return PRESETS[quality]["p99_bound"]
 

@@ -119,7 +119,7 @@ def check_fractal(scene: Any) -> None:
     if f.theta != 0 and f.algebra != "quaternion":
         raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
                          f"section 2.3), not {f.algebra}: set 0")
-    if m.quality != "custom" and not can_prove(f):
+    if m.quality not in ("custom", "auto") and not can_prove(f):
         raise SceneError("march.quality", f"the presets are proven marches, which exist for the Julia sets of "
                          f"every algebra and function; for a {f.kind} set set the march keys (march.quality=custom)")
     if m.method == "proven" and not can_prove(f):
