@@ -55,3 +55,13 @@ inline lmask caff_outside(caff z, real bailout2)
 
 /* whether the form may still prove the segment (enclose/ball.cl enc_hopeful) */
 inline lmask caff_hopeful(caff z, real bailout) { return c_abs(z.v) + z.r < (real)2 * (c_abs(z.m) + bailout); }
+
+/* The enclosure of a kind that iterates a complex map of its own (enclose/julia_stack.cl,
+ * enclose/cubic_locus.cl): the orbit's form, and whether every point of the segment lies
+ * outside the kind's own domain (the stack's slab, the locus's ball), which proves it empty
+ * by itself.  Those pieces name these enclosure, enc_outside, enc_margin, enc_hopeful. */
+typedef struct { caff z; lmask off; } caff_orbit;
+
+inline lmask orbit_outside(caff_orbit e, real bailout2) { return e.off | caff_outside(e.z, bailout2); }
+inline lreal orbit_margin(caff_orbit e, real bailout) { return caff_margin(e.z, bailout); }
+inline lmask orbit_hopeful(caff_orbit e, real bailout) { return caff_hopeful(e.z, bailout); }

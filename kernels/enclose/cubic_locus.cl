@@ -8,7 +8,10 @@
  * own, so this piece is the whole enclosure (no algebra piece before it). */
 #define ENC_STEPS(jp) ((jp).max_iter)
 
-typedef struct { caff z; lmask off; } enclosure;   /* off: every point is outside the ball */
+typedef caff_orbit enclosure;   /* off: every point is outside the ball (enclose/caff.cl) */
+#define enc_outside orbit_outside
+#define enc_margin orbit_margin
+#define enc_hopeful orbit_hopeful
 typedef struct { caff a3, b; } enc_param;          /* 3 a^2 and b */
 
 inline enclosure enc_start(quat o, quat d, lreal t0, lreal t1, julia_params jp, enc_param *p)
@@ -31,7 +34,3 @@ inline enclosure enc_next(enclosure e, enc_param p, lmask live)
     enclosure out = {caff_add(caff_mul(e.z, w), p.b), e.off};
     return out;
 }
-
-inline lmask enc_outside(enclosure e, real bailout2) { return e.off | caff_outside(e.z, bailout2); }
-inline lreal enc_margin(enclosure e, real bailout) { return caff_margin(e.z, bailout); }
-inline lmask enc_hopeful(enclosure e, real bailout) { return caff_hopeful(e.z, bailout); }

@@ -65,3 +65,17 @@ def segment_parts(o, d, t0, t1):
     m, v = o + tm[:, None] * d, hw[:, None] * d
     r = enc_radius(0.0, np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1), ENC_ROUND)
     return m, v, r
+
+
+# The enclosure (z form, off) of a kind that iterates a complex map of its own
+# (reference/enclose/julia_stack.py, cubic_locus.py): off proves the segment empty by itself.
+def orbit_outside(e, bailout2):
+    return e[1] | caff_outside(e[0], bailout2)
+
+
+def orbit_margin(e, bailout):
+    return caff_margin(e[0], bailout)
+
+
+def orbit_hopeful(e, bailout):
+    return caff_hopeful(e[0], bailout)

@@ -6,13 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.caff import (caff_add, caff_hopeful, caff_margin, caff_mul, caff_of, caff_outside,
-                                              caff_scale, caff_sqr, segment_parts)
+from pyjulia4d.reference.enclose.caff import (caff_add, caff_mul, caff_of, caff_scale, caff_sqr, segment_parts,
+                                              orbit_hopeful as enc_hopeful, orbit_margin as enc_margin,
+                                              orbit_outside as enc_outside)
+from pyjulia4d.reference.enclose.julia import enc_steps  # noqa: F401 (z_0 .. z_max_iter, as the Julia set's)
 from pyjulia4d.reference.enclose.disc import ENC_ROUND, least_norm
-
-
-def enc_steps(max_iter: int) -> int:
-    return max_iter
 
 
 def enc_start(o, d, t0, t1, c, F):
@@ -32,14 +30,3 @@ def enc_next(e, p, F):
     w = caff_add(caff_sqr(z), caff_scale(-1.0, a3))
     return caff_add(caff_mul(z, w), b), off
 
-
-def enc_outside(e, bailout2):
-    return e[1] | caff_outside(e[0], bailout2)
-
-
-def enc_margin(e, bailout):
-    return caff_margin(e[0], bailout)
-
-
-def enc_hopeful(e, bailout):
-    return caff_hopeful(e[0], bailout)
