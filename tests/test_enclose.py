@@ -294,3 +294,47 @@ def test_stated_interval_holds_the_brute_force(algebra, function, kind):
     # a miss with nothing unresolved is a miss of the truth
     sure_miss = (status != 1) & (unresolved == 0)
     assert np.mean(np.isfinite(truth[sure_miss])) <= 0.01
+
+
+def test_caff_kernel_matches_the_twin_and_holds_the_products():
+    """kernels/enclose/caff.cl against reference/enclose/caff.py on random forms (its
+    caff_ops kernel): products, sums and scalings agree in centre and tangent to float32's
+    rounding of the terms (1e-5 of their sizes); the kernel's radius is at least the twin's
+    less that rounding, and at most twice it plus it (both bound the same terms); and the
+    kernel's product form holds the float64 products of points sampled from the two forms
+    (its radius raised by float32's own slack).  Whether a form is outside the bailout disc
+    agrees but for the odd form decided by a hair."""
+    from pyjulia4d.reference.enclose import caff as T
+    s = _case("quaternion", "sqr", "julia_stack").with_overrides(["march.method=proven"])
+    R = Runner(kernel_config.scene_config(s, ray_buffers=True))
+    rng = np.random.default_rng(11)
+    n = 500
+    scale = rng.choice([1e-3, 0.1, 1.0, 3.0], (n, 1))
+    a_mv, b_mv = rng.normal(size=(n, 4)) * scale, rng.normal(size=(n, 4)) * scale
+    a_mv, b_mv = a_mv.astype(np.float32).astype(float), b_mv.astype(np.float32).astype(float)
+    a_r = (np.abs(rng.normal(size=n)) * 0.1 * scale[:, 0]).astype(np.float32).astype(float)
+    b_r = (np.abs(rng.normal(size=n)) * 0.1 * scale[:, 0]).astype(np.float32).astype(float)
+    k, bailout = (0.7, -1.3), 2.0
+    outs = [R.out4(n), R.out(n), R.out4(n), R.out(n), R.out4(n), R.out(n), R.out(n, np.int32)]
+    R("caff_ops", (n,), R.buf4(a_mv), R.buf(a_r), R.buf4(b_mv), R.buf(b_r), R.vec((*k, 0, 0)),
+      R.scalar(bailout), *outs)
+    form = lambda mv, r: (mv[:, 0] + 1j * mv[:, 1], mv[:, 2] + 1j * mv[:, 3], r)   # noqa: E731
+    a, b = form(a_mv, a_r), form(b_mv, b_r)
+    twins = [T.caff_mul(a, b), T.caff_add(a, b), T.caff_scale(complex(*k), a)]
+    for j, (tm, tv, tr) in enumerate(twins):
+        mv, r = R.get4(outs[2 * j]), outs[2 * j + 1].get().astype(float)
+        km, kv = mv[:, 0] + 1j * mv[:, 1], mv[:, 2] + 1j * mv[:, 3]
+        size = (np.abs(a[0]) + np.abs(a[1]) + a[2]) * (np.abs(b[0]) + np.abs(b[1]) + b[2] + 2) + 1e-30
+        assert np.all(np.abs(km - tm) <= 1e-5 * size) and np.all(np.abs(kv - tv) <= 1e-5 * size), j
+        assert np.all(r >= tr - 1e-5 * size) and np.all(r <= 2 * tr + 1e-5 * size), j
+    # the kernel's product holds the products of sampled points
+    sk = rng.uniform(-1, 1, (n, 64))
+    ea = a[2][:, None] * np.sqrt(rng.uniform(0, 1, (n, 64))) * np.exp(2j * np.pi * rng.uniform(0, 1, (n, 64)))
+    eb = b[2][:, None] * np.sqrt(rng.uniform(0, 1, (n, 64))) * np.exp(2j * np.pi * rng.uniform(0, 1, (n, 64)))
+    za, zb = a[0][:, None] + sk * a[1][:, None] + ea, b[0][:, None] + sk * b[1][:, None] + eb
+    mv, r = R.get4(outs[0]), outs[1].get().astype(float)
+    centre = (mv[:, 0] + 1j * mv[:, 1])[:, None] + sk * (mv[:, 2] + 1j * mv[:, 3])[:, None]
+    slack = 1e-6 * (np.abs(za) * np.abs(zb) + np.abs(centre))
+    assert np.all(np.abs(za * zb - centre) <= r[:, None] + slack)
+    ko = outs[6].get().astype(bool)
+    assert np.mean(ko != T.caff_outside(a, bailout * bailout)) <= 0.02 and 0 < ko.sum() < n

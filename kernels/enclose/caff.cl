@@ -65,3 +65,31 @@ typedef struct { caff z; lmask off; } caff_orbit;
 inline lmask orbit_outside(caff_orbit e, real bailout2) { return e.off | caff_outside(e.z, bailout2); }
 inline lreal orbit_margin(caff_orbit e, real bailout) { return caff_margin(e.z, bailout); }
 inline lmask orbit_hopeful(caff_orbit e, real bailout) { return caff_hopeful(e.z, bailout); }
+
+#ifdef RAYS_FROM_BUFFERS
+/* The form arithmetic alone, one form pair per work-item (the tests' handle, as
+ * march/proven.cl's prove_segments): for forms a and b (centre and tangent as (m.re, m.im,
+ * v.re, v.im), and the radius), a b, a + b, k a, and whether a lies outside the disc of
+ * radius ``bailout``. */
+__kernel void caff_ops(const int n_items, __global const real4 *a_mv, __global const real *a_r,
+                       __global const real4 *b_mv, __global const real *b_r, const real4 k, const real bailout,
+                       __global real4 *mul_mv, __global real *mul_r, __global real4 *add_mv, __global real *add_r,
+                       __global real4 *scale_mv, __global real *scale_r, __global int *outside)
+{
+#if LANES == 1
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    caff a = A(C(a_mv[i].x, a_mv[i].y), C(a_mv[i].z, a_mv[i].w), a_r[i]);
+    caff b = A(C(b_mv[i].x, b_mv[i].y), C(b_mv[i].z, b_mv[i].w), b_r[i]);
+    caff p = caff_mul(a, b), s = caff_add(a, b), q = caff_scale(C(k.x, k.y), a);
+    mul_mv[i] = (real4)(p.m.re, p.m.im, p.v.re, p.v.im);
+    mul_r[i] = p.r;
+    add_mv[i] = (real4)(s.m.re, s.m.im, s.v.re, s.v.im);
+    add_r[i] = s.r;
+    scale_mv[i] = (real4)(q.m.re, q.m.im, q.v.re, q.v.im);
+    scale_r[i] = q.r;
+    outside[i] = caff_outside(a, bailout * bailout) ? 1 : 0;
+#endif
+}
+#endif
