@@ -78,21 +78,21 @@ class Kind:
     """A kind of set a [fractal] table describes.  ``piece``: its set test after iterate.cl
     (kernels/kind/<name>.cl, with kind/level.cl), None for the Julia set itself.
     ``estimate``: whether a proven distance estimate exists for it (the stack's "de" is an
-    empirical one).  ``enclosure``: its orbits' enclosures (enclose/<enclosure>.cl), where
-    the proven march exists for it.  ``own_map``: it iterates a complex map of its own, not
+    empirical one).  ``enclosure``: its orbits' enclosures (enclose/<enclosure>.cl), which
+    every kind has, so the proven march and the quality presets exist for every set.  ``own_map``: it iterates a complex map of its own, not
     the algebra's, so its enclosure piece is the whole enclosure (no algebra piece)."""
 
     name: str
+    enclosure: str
     piece: str | None = None
     estimate: bool = True
-    enclosure: str | None = None
     own_map: bool = False
 
     @property
-    def enclosure_piece(self) -> str | None:
+    def enclosure_piece(self) -> str:
         """Its orbits' enclosures for the proven march, after the algebra's: kernels/enclose/
-        <enclosure>.cl and its twin; None: no proven march."""
-        return f"enclose/{self.enclosure}" if self.enclosure else None
+        <enclosure>.cl and its twin."""
+        return f"enclose/{self.enclosure}"
 
 
 FUNCTIONS_TABLE: dict[str, Function] = {f.name: f for f in (
@@ -154,13 +154,6 @@ def has_distance_estimate(f: Any) -> bool:
     scan (march.method = "auto")."""
     return (KINDS_TABLE[f.kind].estimate and ALGEBRAS_TABLE[f.algebra].estimate
             and FUNCTIONS_TABLE[f.function].degree is not None)
-
-
-def can_prove(f: Any) -> bool:
-    """Whether march.method "proven" has orbit enclosures for ``f`` (a [fractal]): the kinds
-    with an enclosure piece (the Julia sets of every algebra and function, rotated or not;
-    the Mandelbrot sets, the Julia set stacks and the cubic locus), kernels/enclose/."""
-    return KINDS_TABLE[f.kind].enclosure is not None
 
 
 def march_method(scene: Any) -> str:

@@ -20,7 +20,7 @@ from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS, KINDS
 from pyjulia4d.scene import rules
 from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, Integer, Lights, OrWord, Planes,  # noqa: F401
                                     Real, SceneError, Vector, show, show_key)
-from pyjulia4d.scene.quality import MARCH_KEYS, QUALITIES, auto_values, preset_values
+from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, QUALITIES, auto_values, preset_values
 from pyjulia4d.scene.text import parse_override, read_scene_table, toml_value
 
 Vec3 = tuple[float, float, float]
@@ -102,11 +102,11 @@ class March:
     they are not given with it: a scene that gives any of them is "custom"."""
 
     quality: str = "auto"
-    method: str = "auto"
-    z_resolution: int = 250
-    post_steps: int = 4
-    refine: str = "itp"
-    epsilon: float = 1e-3
+    method: str = CUSTOM["method"]            # custom's defaults, written once (quality.CUSTOM)
+    z_resolution: int = CUSTOM["z_resolution"]
+    post_steps: int = CUSTOM["post_steps"]
+    refine: str = CUSTOM["refine"]
+    epsilon: float = CUSTOM["epsilon"]
     max_steps: int = 4096
     near: Union[float, Auto] = "auto"
     far: Union[float, Auto] = "auto"

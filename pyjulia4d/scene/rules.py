@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from pyjulia4d.fractal.registry import FUNCTIONS_OF, MANDELBROT_START, can_prove, has_distance_estimate, locus_escape_radius
+from pyjulia4d.fractal.registry import FUNCTIONS_OF, MANDELBROT_START, has_distance_estimate, locus_escape_radius
 from pyjulia4d.geometry.vec4 import Degenerate, norm, orthonormalise, unit
 from pyjulia4d.scene.checks import SceneError
 
@@ -119,12 +119,6 @@ def check_fractal(scene: Any) -> None:
     if f.theta != 0 and f.algebra != "quaternion":
         raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
                          f"section 2.3), not {f.algebra}: set 0")
-    if m.quality not in ("custom", "auto") and not can_prove(f):
-        raise SceneError("march.quality", f"the presets are proven marches, which exist for the Julia sets of "
-                         f"every algebra and function; for a {f.kind} set set the march keys (march.quality=custom)")
-    if m.method == "proven" and not can_prove(f):
-        raise SceneError("march.method", f"proven needs orbit enclosures, which exist for the Julia sets of "
-                         f"every algebra and function; for a {f.kind} set use fixed, de or auto")
     if has_distance_estimate(f):
         return
     if m.method == "de" and f.kind != "julia_stack":   # the stack's "de": its empirical estimate
