@@ -112,7 +112,14 @@ LIGHT_SCENES = {
 }
 
 
-@pytest.mark.parametrize("name", list(LIGHT_SCENES))
+# the default run samples the light scenes (each builds programs of its own from cold); the
+# rest, whose switches the sampled ones share, run with -m slow
+LIGHT_SAMPLE = ("default", "fog+trap+cut", "hard+trap", "w", "three-lights-soft", "reflection-fixed-cut-eye",
+                "mandelbrot-trap", "hypercomplex")
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=[] if n in LIGHT_SAMPLE else [pytest.mark.slow])
+                                  for n in LIGHT_SCENES])
 def test_light_terms_in_render_match_reference(name):
     # kernels (in packets where the march has them) against the float64 reference render:
     # on pixels both hit with the same depth to 1e-5, the shadow, occlusion and colour terms
@@ -165,14 +172,14 @@ EVERYTHING = ["shading.light=-3,4,-2", "shading.ao=0.5", "shading.fog=0.3", "cli
 @pytest.mark.parametrize("extra", [
     ["shading.shadow=soft", "shading.coloring=iteration", "shading.reflection=0.3",
      "shading.lights=position 2,1,-2; direction 0,-1,0 intensity 0.3"],
-    ["shading.shadow=hard", "shading.coloring=trap", "march.method=fixed", "normals.method=zbuffer",
-     "image.adaptive=true"],
+    pytest.param(["shading.shadow=hard", "shading.coloring=trap", "march.method=fixed", "normals.method=zbuffer",
+                  "image.adaptive=true"], marks=pytest.mark.slow),
     ["shading.shadow=soft", "shading.coloring=w", "render.float=double", "normals.method=gradient",
      "shading.reflection=0.5", "shading.lights=direction 1,1,-1 color 0.2,0.3,1"],
     ["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin",
      "shading.lights=position -2,2,-2; position 2,-2,-2; position 0,3,0"],
-    ["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0", "fractal.kind=mandelbrot",
-     "fractal.max_iter=8", "shading.reflection=0.2"],
+    pytest.param(["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0",
+                  "fractal.kind=mandelbrot", "fractal.max_iter=8", "shading.reflection=0.2"], marks=pytest.mark.slow),
     ["shading.shadow=soft", "fractal.algebra=hypercomplex", "fractal.function=cube", "render.variant=scalar",
      "shading.reflection=0.4", "image.adaptive=true", "shading.sky=0.5,0.6,1"],
 ])

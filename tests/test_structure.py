@@ -1,5 +1,5 @@
 """The package's shape holds: no import circles (late imports included), no private name
-imported across modules, no module far past 500 lines, the float64 reference importable
+imported across modules, no module far past 500 lines, every package in setup.cfg, the float64 reference importable
 without OpenCL, and a registry whose every entry names a kernel piece and a twin that
 exist (and every piece and twin has an entry)."""
 from __future__ import annotations
@@ -111,6 +111,18 @@ def test_no_private_names_across_modules() -> None:
 def test_modules_stay_small() -> None:
     sizes = {m: len(p.read_text().splitlines()) for m, p in MODULES.items()}
     assert {m: n for m, n in sizes.items() if n > MOST_LINES} == {}
+
+
+def test_setup_cfg_ships_every_package() -> None:
+    """A non-editable install (what .ci/run and users get) holds only the packages setup.cfg
+    lists: every folder of pyjulia4d/ with an __init__.py must be among them."""
+    import configparser
+    cfg = configparser.ConfigParser()
+    cfg.read(PKG.parent / "setup.cfg")
+    listed = set(cfg["options"]["packages"].split())
+    on_disk = {".".join(p.parent.relative_to(PKG.parent).parts) for p in PKG.rglob("__init__.py")}
+    assert on_disk - listed == set()
+    assert "pyjulia4d.kernels" in listed
 
 
 def test_reference_imports_without_opencl() -> None:
