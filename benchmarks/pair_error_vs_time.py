@@ -6,6 +6,7 @@ truth is computed once on the render's own rays (pair_accuracy.truth_of: a chord
 2e-4, a 2e-6 scan before each first inside sample, bisection), then every setting renders
 the same view:
 
+* the default (no march key: march.quality "auto", scene/quality.py);
 * the fixed z-resolution scan at z_resolution 250 (the default of a pair without a distance
   estimate), 1000 and 4000;
 * the distance estimate (the default of a pair that has one);
@@ -52,7 +53,8 @@ from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pair_accuracy import compare, pairs, random_overrides, refine_truth, truth_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
-SETTINGS = {"fixed 250": ["march.method=fixed", "march.z_resolution=250"],
+SETTINGS = {"default": [],   # march.quality "auto": what a scene that names no march key gets
+            "fixed 250": ["march.method=fixed", "march.z_resolution=250"],
             "fixed 1000": ["march.method=fixed", "march.z_resolution=1000"],
             "fixed 4000": ["march.method=fixed", "march.z_resolution=4000"],
             "de": ["march.method=de"],
@@ -128,8 +130,9 @@ def plot(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fams = {"fixed scan": ("fixed 250", "fixed 1000", "fixed 4000"), "distance estimate": ("de",),
-            "proven (floors 1/250 .. 1/200000)": ("proven 250", "proven 1000", "draft", "normal", "final")}
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), sharex=True, sharey=True)
+            "proven (floors 1/250 .. 1/200000)": ("proven 250", "proven 1000", "draft", "normal", "final"),
+            "default (auto)": ("default",)}
+    fig, axes = plt.subplots(1, 4, figsize=(16, 4.2), sharex=True, sharey=True)
     for ax, (fam, names) in zip(axes, fams.items()):
         for n, mk in zip(names, "o^sDv"):
             g = [m for m in rows if m["setting"] == n and np.isfinite(m["p99_err"])]
