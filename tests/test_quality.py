@@ -112,3 +112,44 @@ def test_presets_are_valid_overrides_and_ordered():
         Scene.default().with_overrides(preset_overrides(q))
     with pytest.raises(ValueError):
         apply_quality(Scene.default(), "ultra")
+
+
+# auto: the distance estimate only where it bounds the distance (connected sets)
+@pytest.mark.parametrize("over,expect", [
+    ([], True),                                                              # quaternion c = -0.2 + 0.8i: connected
+    (["fractal.c=-1,0,0,0"], True),                                          # the basilica
+    (["fractal.c=0.5414,0.3870,-0.0241,-0.0321"], False),                    # dust: escapes at the 5th iteration
+    (["fractal.function=cube", "fractal.c=0.1668,0.2887,0.0337,-0.1034"], True),
+    (["fractal.algebra=hypercomplex"], True),
+    (["fractal.algebra=hypercomplex", "fractal.function=cube"], False),      # c_a = c_b = -0.2 + 0.8i: dust for z^3
+    (["fractal.algebra=hypercomplex", "fractal.c=0.3,0,0,0.6"], False),      # c_a = 0.9 (dust), c_b = -0.3 (connected)
+    (["fractal.kind=mandelbrot"], True),
+    (["fractal.theta=30"], False),
+    (["fractal.algebra=hypercomplex", "fractal.function=sin"], False),       # no estimate at all
+])
+def test_auto_takes_the_estimate_only_on_connected_sets(over, expect):
+    from pyjulia4d.fractal.registry import march_method
+    from pyjulia4d.scene.quality import estimate_bounds_distance
+    s = Scene.default().with_overrides(over)
+    assert estimate_bounds_distance(s.fractal) is expect
+    assert march_method(s) == ("de" if expect else "proven")
+
+
+def test_critical_orbit_in_its_planes_is_the_4d_orbit():
+    """The planes critical_orbit_bounded iterates in hold the 4D orbit of 0: the float64 twin's
+    own map (reference.julia_inside of the point 0) agrees on c drawn near and far from the
+    connectedness locus, for both algebras and degrees."""
+    from pyjulia4d.reference import Formula, julia_inside
+    from pyjulia4d.scene.quality import CONNECTED_ITER, critical_orbit_bounded
+    rng = np.random.default_rng(7)
+    agree, seen = 0, set()
+    for algebra in ("quaternion", "hypercomplex"):
+        for function, degree in (("sqr", 2), ("cube", 3)):
+            F = Formula(algebra=algebra, function=function)
+            for _ in range(40):
+                c = tuple(rng.normal(size=4) * rng.uniform(0.1, 0.6))
+                radius = 2.0 + 2.0 * 2 * float(np.linalg.norm(c))   # beyond both components' escape radii
+                twin = bool(julia_inside(np.zeros((1, 4)), c, CONNECTED_ITER, radius, F)[0])
+                agree += twin == critical_orbit_bounded(algebra, degree, c)
+                seen.add(twin)
+    assert agree == 4 * 40 and seen == {True, False}

@@ -31,9 +31,10 @@ class RenderResult:
     status: np.ndarray | None    # (H, W) int32, STATUS_* per pixel
     samples: np.ndarray | None   # (H, W) int32, set tests (fixed) or estimates (de) before the hit
     bracket: np.ndarray = None   # (H, W) float32: the surface lies in [depth, depth + bracket]; +inf off hits
-    # (H, W) float32: the summed width of the segments in front of the depth (on a miss: of
-    # the ray) the march did not prove empty (kernels/march/proven.cl): the first crossing lies
-    # in the bracket or in one of them.  The fixed and de marches prove nothing: all of it.
+    # (H, W) float32: on a hit, how far in front of the depth the first segment the march did
+    # not prove empty begins (kernels/march/proven.cl): the first crossing lies in [depth -
+    # unresolved, depth + bracket]; on a miss, the width of the ray left unproven.  The fixed
+    # and de marches prove nothing: all of it.
     unresolved: np.ndarray = None
     counts: dict = field(default_factory=dict)  # pixels by status: "miss", "hit", "capped" (all tiles)
     device_name: str = ""
@@ -92,7 +93,7 @@ class RenderResult:
 
     def error_stats(self) -> dict[str, float]:
         """p50 / p99 / max over the pixels hit of the depth error each states: its bracket
-        behind the depth plus its unresolved width in front (kernels/march/proven.cl).  NaN when
+        behind the depth plus its unresolved reach in front (kernels/march/proven.cl).  NaN when
         nothing was hit."""
         if self.bracket is None or self.unresolved is None:
             return self.bracket_stats()
@@ -118,7 +119,7 @@ class RenderResult:
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
         """What a render says about itself: (header entries for PNG/EXR, the tail of the
         closing line).  Capped rays, the guards that fired, the certified depth bracket and
-        the error each pixel states (bracket plus the unresolved width in front,
+        the error each pixel states (bracket plus the unresolved reach in front,
         kernels/march/proven.cl; p50/p99/max) and the pixels left unresolved are never
         hidden; with ``stated_p99`` (the bound a quality preset states) the line says whether
         this render's stated p99 error is within it."""

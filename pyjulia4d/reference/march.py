@@ -191,7 +191,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     """Segments from near on, each proven empty or shortened (by the enclosure's margin) down
     to the floor (far - near) / z_resolution, where FLOOR_POINTS points to its far end are tested in
     order: the first inside ends the march with the certified bracket from the point before, none
-    passes the segment unproven (march/proven.cl).
+    passes the segment unproven (march/proven.cl).  ``unresolved``: on a hit the reach from
+    the first unproven segment's start to the depth, on a miss the unproven width.
     Returns (t, status, samples, flags, width, unresolved)."""
     n = len(o)
     span = far - near
@@ -199,6 +200,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     h = np.maximum(span * PROVEN_FIRST, floor_w)
     t, t_in, t_out = near.copy(), near.copy(), near.copy()
     open_w = np.zeros(n)
+    t_open = np.full(n, np.inf)   # where the first segment passed unproven begins
     first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
     active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
     count = np.zeros(n, np.int32)
@@ -226,6 +228,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
             before[j] = tj
         opened = at_floor & ~got
         open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
+        t_open[k] = np.where(opened, np.minimum(t_open[k], t[k]), t_open[k])
         hit[k] |= got
         passed = empty | opened
         done = passed & (t1 >= far[k])
@@ -250,8 +253,13 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         if j.size:
             tail_empty, _ = enc_prove(o[j], d[j], t[j], depth[j], c, max_iter, bailout, formula)
             open_w[j] += np.where(tail_empty, 0.0, depth[j] - t[j])
-    # the unproven width in front of a hit or on a miss; a capped ray adds all it did not reach
-    return depth, status, count, np.zeros(n, np.int32), width, np.where(active, open_w + (far - t), open_w)
+            t_open[j] = np.where(tail_empty, t_open[j], np.minimum(t_open[j], t[j]))
+    # on a hit the reach of what is unproven (depth - t_open), on a miss the unproven width;
+    # a capped ray adds all it did not reach (march/proven.cl)
+    with np.errstate(invalid="ignore"):   # inf - inf off the hits
+        reach = np.where(t_open < depth, depth - t_open, 0.0)
+    return depth, status, count, np.zeros(n, np.int32), width, np.where(
+        active, open_w + (far - t), np.where(hit, reach, open_w))
 
 
 # --------------------------------------------------------------------- march/march.cl
