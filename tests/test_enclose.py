@@ -338,3 +338,34 @@ def test_caff_kernel_matches_the_twin_and_holds_the_products():
     assert np.all(np.abs(za * zb - centre) <= r[:, None] + slack)
     ko = outs[6].get().astype(bool)
     assert np.mean(ko != T.caff_outside(a, bailout * bailout)) <= 0.02 and 0 < ko.sum() < n
+
+
+def test_grazing_rays_widen_the_floor_and_finish():
+    """Rays grazing a hypercomplex acos's surface (max_iter 6) run unproven for a third of
+    their length: at the final preset's floor of 1/200000 they were capped past 65536
+    segments.  The floor doubles after FLOOR_RUN unproven floor segments in a row
+    (march/proven.cl), so they finish, kernel and twin alike, with the same status and
+    overlapping stated intervals, the grazing stretch in their unresolved reach."""
+    s = Scene.from_dict({"fractal": {"algebra": "hypercomplex", "function": "acos", "c": [0.0567, 0.124, -0.0511, 0.6521],
+                                     "max_iter": 6},
+                         "camera": {"position": [10.189, 3.66988, 6.38096, 0.465], "target": [0, 0, 0, 0.465]},
+                         "slice": {"normal": [0, 0, -0.081, 1]}, "march": {"quality": "final"},
+                         "image": {"width": 64, "height": 48}})
+    o, d = ref.generate_rays(camera_frame(s), 64, 48)
+    pick = np.ravel_multi_index(([2, 7, 9, 19, 28, 38, 40, 45, 24, 10], [27, 17, 15, 10, 53, 48, 46, 36, 32, 5]),
+                                (48, 64))
+    o, d = o[pick].astype(np.float32).astype(float), d[pick].astype(np.float32).astype(float)
+    depth, status, bracket, unresolved = march_on_rays(s, o, d)
+    f, m = s.fractal, s.march
+    rb, ru = np.zeros(len(o)), np.zeros(len(o))
+    rd, _, rs, rn = ref.march(o, d, f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), -1.0, -1.0,
+                              m.z_resolution, m.post_steps, m.max_steps, "proven", bracket=rb,
+                              formula=formula_of(f), unresolved=ru)
+    assert np.all(status != 2) and np.all(rs != 2)          # none capped
+    assert np.mean(status != rs) <= 0.1
+    assert np.all(rn < m.max_steps / 8)
+    both = (status == 1) & (rs == 1)
+    assert both.sum() >= 6
+    slack = 1e-5 * (1 + depth)
+    lo_k, hi_k, lo_r, hi_r = depth - unresolved, depth + bracket, rd - ru, rd + rb
+    assert np.all(((lo_k <= hi_r + slack) & (lo_r <= hi_k + slack))[both])

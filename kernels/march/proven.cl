@@ -70,6 +70,15 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
  * is found unless it is thinner than floor / FLOOR_POINTS (with 2, the hypercomplex sin
  * stepped over such parts on 0.1 % of its pixels: benchmarks/pair_accuracy.py) */
 #define FLOOR_POINTS 8
+/* a stretch where no proof succeeds (a branch cut or pole the enclosures meet on every
+ * segment, a ray grazing the surface) is crossed at a floor that doubles after every
+ * FLOOR_RUN floor segments passed unproven in a row, up to FLOOR_WIDEST of the ray (its
+ * FLOOR_POINTS points then 1/8000 of the ray apart, finer than the scan at 1000), and is
+ * back at the preset's floor after the next proof: at the final preset's 1/200000, rays of
+ * a hypercomplex acos (c = 0.057 + 0.124i + ..., max_iter 6) lying along its branch cut
+ * ran unproven for a third of their length, past 65536 floor segments, and were capped */
+#define FLOOR_RUN 32
+#define FLOOR_WIDEST ((real)0.001)
 
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
                        int z_resolution, int post_steps, int max_steps, lmask *status,
@@ -80,6 +89,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal h = fmax(span * PROVEN_FIRST, floor_w);
     lreal t = near, t_in = near, t_out = near, open_w = 0;
     lreal t_open = (lreal)INFINITY;   /* where the first segment passed unproven begins */
+    lreal floor_here = floor_w, run = 0;   /* the floor now, unproven floor segments in a row */
+    lreal widest = fmax(floor_w, span * FLOOR_WIDEST);
     lmask first = live & julia_inside(QRAY(o, d, near), jp);
     lmask active = live & !first, hit = first, miss = 0, n = 0;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
@@ -87,7 +98,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lreal margin;
         lmask empty = enc_prove(o, d, t, t1, active, jp, &margin);
         n = L_SEL(n, n + 1, active);
-        lmask at_floor = active & !empty & (h <= floor_w);
+        lmask at_floor = active & !empty & (h <= floor_here);
         lmask got = 0;
         if (L_ANY(at_floor)) {   /* FLOOR_POINTS points across it, in order: a thin part may hold the first */
             lmask look = at_floor;
@@ -105,6 +116,10 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lmask open = at_floor & !got;
         open_w = L_SEL(open_w, open_w + (t1 - t), open);
         t_open = L_SEL(t_open, fmin(t_open, t), open);
+        run = L_SEL(L_SEL(run, (lreal)0, empty), run + 1, open);
+        lmask wider = open & (run >= (real)FLOOR_RUN);
+        floor_here = L_SEL(L_SEL(floor_here, floor_w, empty), fmin(floor_here * 2, widest), wider);
+        run = L_SEL(run, (lreal)0, wider);
         hit |= got;
         lmask pass = empty | open;
         lmask done = pass & (t1 >= far);
@@ -114,7 +129,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lreal grow = clamp(fac, (lreal)1, (lreal)4);
         lreal shrink = clamp(fac, (lreal)(1.0 / 64), (lreal)0.5);
         h = L_SEL(h, fmin(h * grow, span), empty);
-        h = L_SEL(h, fmax(h * shrink, floor_w), active & !empty & !at_floor);
+        h = L_SEL(h, fmax(h * shrink, floor_here), active & !empty & !at_floor);
+        h = L_SEL(h, floor_here, open);
         t = L_SEL(t, t1, pass & !done);
         active &= !(got | done);
     }

@@ -184,6 +184,8 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
 PROVEN_FIRST = 0.125
 PROVEN_GAIN = 0.8
 FLOOR_POINTS = 8   # the points an unproven floor segment is tested at (march/proven.cl)
+FLOOR_RUN = 32     # unproven floor segments in a row that double the floor (march/proven.cl)
+FLOOR_WIDEST = 0.001   # of the ray: the widest the floor grows to
 
 
 def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
@@ -201,6 +203,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     t, t_in, t_out = near.copy(), near.copy(), near.copy()
     open_w = np.zeros(n)
     t_open = np.full(n, np.inf)   # where the first segment passed unproven begins
+    floor_here, run = floor_w.copy(), np.zeros(n)   # the floor now, unproven floor segments in a row
+    widest = np.maximum(floor_w, span * FLOOR_WIDEST)
     first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
     active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
     count = np.zeros(n, np.int32)
@@ -211,7 +215,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         t1 = np.minimum(t[k] + h[k], far[k])
         empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
         count[k] += 1
-        at_floor = ~empty & (h[k] <= floor_w[k])
+        at_floor = ~empty & (h[k] <= floor_here[k])
         got = np.zeros(k.size, bool)
         look = at_floor.copy()
         before = t[k].copy()
@@ -229,6 +233,11 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         opened = at_floor & ~got
         open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
         t_open[k] = np.where(opened, np.minimum(t_open[k], t[k]), t_open[k])
+        run[k] = np.where(opened, run[k] + 1, np.where(empty, 0.0, run[k]))
+        wider = opened & (run[k] >= FLOOR_RUN)
+        floor_here[k] = np.where(wider, np.minimum(floor_here[k] * 2, widest[k]),
+                                 np.where(empty, floor_w[k], floor_here[k]))
+        run[k] = np.where(wider, 0.0, run[k])
         hit[k] |= got
         passed = empty | opened
         done = passed & (t1 >= far[k])
@@ -237,7 +246,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         fac = np.sqrt(np.maximum(mg * PROVEN_GAIN, 0.0))   # the margin falls about as h^-2 (march/proven.cl)
         grow, shrink = np.clip(fac, 1, 4), np.clip(fac, 1 / 64, 0.5)
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
-        h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_w[k]), h[k])
+        h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_here[k]), h[k])
+        h[k] = np.where(opened, floor_here[k], h[k])
         t[k] = np.where(passed & ~done, t1, t[k])
         active[k] &= ~(got | done)
     status = np.where(hit, STATUS_HIT, np.where(miss, STATUS_MISS, STATUS_CAPPED)).astype(np.int32)
