@@ -44,6 +44,23 @@ def test_png_rgba8(tmp_path) -> None:
     assert [p.name for p in tmp_path.iterdir()] == ["out.png"]
 
 
+def test_png_bands_match_the_transfer_function(tmp_path) -> None:
+    """write_png encodes in bands of PNG_BAND_ROWS rows (peak memory): on an image of several
+    bands and a ragged last one, every pixel is the sRGB transfer function of IEC 61966-2-1
+    rounded to 8 bits, NaN as 0, values outside [0, 1] clipped."""
+    rng = np.random.default_rng(3)
+    h, w = 2 * output.PNG_BAND_ROWS + 7, 5
+    color = rng.uniform(-0.1, 1.1, (h, w, 3)).astype(np.float32)
+    color[0, 0, 0] = np.nan
+    alpha = rng.uniform(0, 1, (h, w)).astype(np.float32)
+    write_png(tmp_path / "b.png", color, alpha)
+    got = np.asarray(Image.open(tmp_path / "b.png"))
+    x = np.clip(np.nan_to_num(color.astype(np.float64)), 0, 1)
+    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+    assert np.array_equal(got[..., :3], np.rint(srgb * 255).astype(np.uint8))
+    assert np.array_equal(got[..., 3], np.rint(alpha.astype(np.float64) * 255).astype(np.uint8))
+
+
 def test_exr_channels_and_header(tmp_path) -> None:
     rng = np.random.default_rng(2)
     channels = {n: rng.random((H, W)).astype(np.float32) for n in EXR_NAMES}

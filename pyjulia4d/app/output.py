@@ -87,6 +87,9 @@ def check_output_path(path: str | Path) -> Path:
     return p
 
 
+PNG_BAND_ROWS = 64   # rows encoded at a time (write_png)
+
+
 def to_u8(x: np.ndarray) -> np.ndarray:
     x = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0)
     return np.rint(np.clip(x, 0.0, 1.0) * 255.0).astype(np.uint8)
@@ -112,8 +115,13 @@ def write_png(
     alpha = np.asarray(alpha)
     if color.ndim != 3 or color.shape[2] != 3 or alpha.shape != color.shape[:2]:
         raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
-    rgb = linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0))
-    rgba = np.concatenate([to_u8(rgb), to_u8(alpha)[..., None]], axis=2)
+    # in bands of rows: the float64 temporaries of the transfer function on a whole 3840x2160
+    # image took 800 MB (a PNG render's peak was 1.16 GB); a band's are a few MB
+    rgba = np.empty(color.shape[:2] + (4,), np.uint8)
+    for r0 in range(0, color.shape[0], PNG_BAND_ROWS):
+        band = slice(r0, r0 + PNG_BAND_ROWS)
+        rgba[band, :, :3] = to_u8(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)))
+        rgba[band, :, 3] = to_u8(alpha[band])
     info = PngImagePlugin.PngInfo()
     for k, v in (text or {}).items():
         info.add_itxt(k, str(v))  # iTXt: UTF-8, unlike tEXt's Latin-1
