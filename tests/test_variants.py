@@ -85,21 +85,29 @@ def test_packets_give_the_same_pixels(over, lanes):
 
 def test_variant_choice_and_its_cache(tmp_path, monkeypatch):
     from harness import device
+    from pyjulia4d.opencl.devices import device_key, forget_remembered
 
     dev = device()
     monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
-    lanes_mod._memo.clear()
+    forget_remembered()
     assert lanes_mod.lanes_for(dev, "scalar", False) == 1
     assert lanes_mod.lanes_for(dev, "packet", True) == 1          # packets are float
     probed = lanes_mod.lanes_for(dev, "packet", False)
     assert probed in (1,) + lanes_mod.WIDTHS
     known = json.loads((tmp_path / "lanes.json").read_text())
-    assert known[lanes_mod.device_key(dev)] == probed
+    assert known[device_key(dev)] == probed
     # cached: no second probe, in this process or the next
-    lanes_mod._memo.clear()
+    forget_remembered()
     monkeypatch.setattr(lanes_mod, "probe", lambda *a, **k: pytest.fail("probed twice"))
     assert lanes_mod.lanes_for(dev, "packet", False) == probed
-    lanes_mod._memo.clear()
+    # the compiler probe likewise: remembered in compiles.json, no second build
+    from pyjulia4d.opencl import devices
+    assert devices.compile_error(dev) == ""
+    assert json.loads((tmp_path / "compiles.json").read_text())[device_key(dev)] == ""
+    forget_remembered()
+    monkeypatch.setattr(devices, "_probe_build", lambda *a: pytest.fail("built the probe twice"))
+    assert devices.compile_error(dev) == ""
+    forget_remembered()
 
 
 def test_scene_variant_key():

@@ -1,10 +1,14 @@
 """OpenCL device discovery and selection."""
 from __future__ import annotations
 
+import json
 import warnings
+from typing import Callable
 
 import pyopencl as cl
 
+from pyjulia4d.files import atomic_write
+from pyjulia4d.resources import cache_dir
 
 class DeviceError(ValueError):
     """No OpenCL device, or none matching the request."""
@@ -60,27 +64,59 @@ def build(prg: cl.Program, options=()) -> cl.Program:
 
 
 _PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *= 2.0f; }"
-_compiles: dict[int, str] = {}
+_remembered: dict[tuple[str, str], object] = {}
+
+
+def remembered(name: str, device: cl.Device, kind: type, find: Callable[[cl.Device], object]):
+    """An answer about ``device`` found once per driver: kept in this process and in
+    ``<cache>/<name>.json`` under its device_key, found by ``find(device)`` where neither
+    holds one of type ``kind``.  An unreadable or unwritable cache only costs finding it."""
+    key = device_key(device)
+    if (name, key) in _remembered:
+        return _remembered[name, key]
+    path = cache_dir() / f"{name}.json"
+    try:
+        known = json.loads(path.read_text())
+    except (OSError, ValueError):
+        known = {}
+    known = known if isinstance(known, dict) else {}
+    if not isinstance(known.get(key), kind):
+        known[key] = find(device)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_write(path) as tmp:
+                tmp.write_text(json.dumps(known, indent=1, sort_keys=True))
+        except OSError:
+            pass
+    _remembered[name, key] = known[key]
+    return known[key]
+
+
+def forget_remembered() -> None:
+    """Drop this process's remembered answers (the cache folder's stay)."""
+    _remembered.clear()
+
+
+def _probe_build(device: cl.Device) -> str:
+    try:
+        ctx = cl.Context([device])
+        build(cl.Program(ctx, _PROBE_SOURCE))
+        return ""
+    except (cl.Error, RuntimeError) as e:
+        lines = [ln.strip() for ln in str(e).splitlines() if "error" in ln.lower() and ln.strip()]
+        msg = next((ln for ln in lines if not ln.startswith("clBuildProgram")), "")
+        return msg or (lines[0] if lines else type(e).__name__)
 
 
 def compile_error(device: cl.Device) -> str:
     """"" when ``device`` compiles OpenCL C, else the first line of its build error.
 
-    Checked once per device and process.  Seen: PyPI's PoCL 3.0 (LLVM 14) on a CPU its
-    LLVM does not know (AMD Zen 5) fails every build with "unknown target CPU
+    Found by building a probe kernel once per driver (remembered: each start-up built one
+    per device, 0.16 CPU-s of a 0.9 s tiny render).  Seen: PyPI's PoCL 3.0 (LLVM 14) on a
+    CPU its LLVM does not know (AMD Zen 5) fails every build with "unknown target CPU
     'generic'"; Debian's pocl-opencl-icd picks its kernel library by CPU features and
     builds there."""
-    key = device.int_ptr
-    if key not in _compiles:
-        try:
-            ctx = cl.Context([device])
-            build(cl.Program(ctx, _PROBE_SOURCE))
-            _compiles[key] = ""
-        except (cl.Error, RuntimeError) as e:
-            lines = [ln.strip() for ln in str(e).splitlines() if "error" in ln.lower() and ln.strip()]
-            msg = next((ln for ln in lines if not ln.startswith("clBuildProgram")), "")
-            _compiles[key] = msg or (lines[0] if lines else type(e).__name__)
-    return _compiles[key]
+    return remembered("compiles", device, str, _probe_build)
 
 
 def cannot_compile(device: cl.Device) -> DeviceError:

@@ -12,20 +12,15 @@ driver version in ``~/.cache/pyjulia4d/lanes.json`` (``PYJULIA4D_CACHE`` moves i
 """
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pyopencl as cl
 
-from pyjulia4d.opencl.devices import device_key, device_type
-from pyjulia4d.files import atomic_write
-from pyjulia4d.resources import cache_dir
+from pyjulia4d.opencl.devices import device_type, remembered
 
 WIDTHS = (16, 8, 4)
 
-_memo: dict[str, int] = {}
 
 _PROBE = r"""
 import sys, warnings
@@ -44,10 +39,6 @@ hit = (one.status == 1) & (pk.status == 1)
 close = np.mean(np.abs(one.depth[hit] - pk.depth[hit]) <= one.bracket[hit] + pk.bracket[hit] + 1e-5) >= 0.99
 print("ok" if same and close else "wrong")
 """
-
-
-def cache_path() -> Path:
-    return cache_dir() / "lanes.json"
 
 
 def device_spec(device: cl.Device) -> str:
@@ -99,22 +90,4 @@ def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
         return 1
     if variant == "auto" and device_type(device) != "CPU":
         return 1
-    key = device_key(device)
-    if key in _memo:
-        return _memo[key]
-    path = cache_path()
-    try:
-        known = json.loads(path.read_text())
-    except (OSError, ValueError):
-        known = {}
-    if not isinstance(known, dict) or not isinstance(known.get(key), int):
-        known = known if isinstance(known, dict) else {}
-        known[key] = probe(device)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with atomic_write(path) as tmp:
-                tmp.write_text(json.dumps(known, indent=1, sort_keys=True))
-        except OSError:
-            pass  # an unwritable cache only costs the probe next time
-    _memo[key] = int(known[key])
-    return _memo[key]
+    return int(remembered("lanes", device, int, probe))
