@@ -147,13 +147,14 @@ class RenderResult:
             ok = value <= stated_p99
             header["pyjulia4d.preset_bound_met"] = "yes" if ok else "no"
             return (f" (within the preset's stated {stated_p99:.0e})" if ok else
-                    f" (ABOVE the preset's stated {stated_p99:.0e}: this scene needs a finer preset)")
+                    f" (ABOVE the preset's stated {stated_p99:.0e}: parts of the set finer than the floor "
+                    f"near the rays left space unproven in front of the hits; a finer preset proves more)")
 
         if self.proven:
             if not math.isnan(e["p99"]):
                 tail += (f"; depth error p50 {e['p50']:.2g} p99 {e['p99']:.2g} max {e['max']:.2g}"
-                         f"{target(e['p99'])}: the bracket (p99 {b['p99']:.2g}) plus the space left "
-                         f"unproven in front of {un['hit']} hits")
+                         f"{target(e['p99'])}: the bracket (p99 {b['p99']:.2g}) plus, on {un['hit']} hits, the "
+                         f"reach of the space left unproven in front")
             tail += (f"; {un['miss']} misses with unproven space, where a thin part may hide" if un["miss"]
                      else "; every miss proven empty")
         else:
