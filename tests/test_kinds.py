@@ -360,7 +360,7 @@ def test_transcendental_mandelbrot_on_the_complex_plane(function, start):
     np.testing.assert_array_equal(inside, ok)
 
 
-@pytest.mark.parametrize("function", ["cos", "sinh"])
+@pytest.mark.parametrize("function", ["cos", pytest.param("sinh", marks=pytest.mark.slow)])
 def test_transcendental_mandelbrot_kernel_matches_twin(function):
     # the whole pipeline (fixed scan: no estimate for these) against the float64 render, the
     # twin framing the camera from its own float64 pass as render() does
