@@ -132,7 +132,10 @@ def plot(rows: list[dict], path: Path) -> None:
     fams = {"fixed scan": ("fixed 250", "fixed 1000", "fixed 4000"), "distance estimate": ("de",),
             "proven (floors 1/250 .. 1/200000)": ("proven 250", "proven 1000", "draft", "normal", "final"),
             "default (auto)": ("default",)}
-    fig, axes = plt.subplots(1, 4, figsize=(16, 4.2), sharex=True, sharey=True)
+    # a panel per family the run has rows of
+    fams = {f: ns for f, ns in fams.items() if any(m["setting"] in ns for m in rows)}
+    fig, axes = plt.subplots(1, len(fams), figsize=(4 * len(fams), 4.2), sharex=True, sharey=True, squeeze=False)
+    axes = axes[0]
     for ax, (fam, names) in zip(axes, fams.items()):
         for n, mk in zip(names, "o^sDv"):
             g = [m for m in rows if m["setting"] == n and np.isfinite(m["p99_err"])]
