@@ -103,8 +103,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     w, h = (int(x) for x in a.size.lower().split("x"))
 
-    from pyjulia4d.opencl.devices import select_device
-    from pyjulia4d.opencl.lanes import cache_path, lanes_for
+    from pyjulia4d.opencl.devices import remembered_path, select_device
+    from pyjulia4d.opencl.lanes import lanes_for
 
     devices = cpu_devices()
     usable = [(s, n) for s, n, err in devices if not err]
@@ -127,7 +127,7 @@ def main(argv=None) -> int:
     ratios = []
     for i, (name, overrides) in enumerate(todo.items()):
         order = usable if i % 2 == 0 else usable[::-1]
-        got = {n: run_child(s, overrides + [f"image.width={w}", f"image.height={h}"], a.repeats, cache_path())
+        got = {n: run_child(s, overrides + [f"image.width={w}", f"image.height={h}"], a.repeats, remembered_path("lanes"))
                for s, n in order}
         res = [got[n] for n in names]
         cells = [f"{r['kernel']:.3f}" if "kernel" in r else f"error: {r['error'][:60]}" for r in res]

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from pathlib import Path
 from typing import Callable
 
 import pyopencl as cl
@@ -67,6 +68,11 @@ _PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *=
 _remembered: dict[tuple[str, str], object] = {}
 
 
+def remembered_path(name: str) -> Path:
+    """The file ``remembered`` keeps the answers called ``name`` in."""
+    return cache_dir() / f"{name}.json"
+
+
 def remembered(name: str, device: cl.Device, kind: type, find: Callable[[cl.Device], object]):
     """An answer about ``device`` found once per driver: kept in this process and in
     ``<cache>/<name>.json`` under its device_key, found by ``find(device)`` where neither
@@ -74,7 +80,7 @@ def remembered(name: str, device: cl.Device, kind: type, find: Callable[[cl.Devi
     key = device_key(device)
     if (name, key) in _remembered:
         return _remembered[name, key]
-    path = cache_dir() / f"{name}.json"
+    path = remembered_path(name)
     try:
         known = json.loads(path.read_text())
     except (OSError, ValueError):
