@@ -7,9 +7,9 @@
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
  * guard flags (common/codes.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit;
- * unresolved the width of the ray in front of the depth (the whole ray on a miss) that
- * the march did not prove empty (march/proven.cl; the other marches prove nothing: all of
- * it), 0 for rays that miss the bounding ball. */
+ * unresolved how far in front of the depth the space the march did not prove empty
+ * begins (on a miss the unproven width; march/proven.cl; the other marches prove nothing:
+ * all of it), 0 for rays that miss the bounding ball. */
 
 #ifdef RAYS_FROM_BUFFERS
 #define RAY_ARGS __global const real4 *origins, __global const real4 *dirs

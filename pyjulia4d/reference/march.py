@@ -283,8 +283,9 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     FLAG_CUT_FACE | k << 5.
     ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
     ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere),
-    ``unresolved`` (float array, optional) the width in front of each depth (the whole ray
-    on a miss) the march did not prove empty (0 off the bounding ball)."""
+    ``unresolved`` (float array, optional) how far in front of each depth the space the
+    march did not prove empty begins (the unproven width on a miss; 0 off the bounding
+    ball)."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = dot4(o, d)
