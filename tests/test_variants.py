@@ -110,6 +110,25 @@ def test_variant_choice_and_its_cache(tmp_path, monkeypatch):
     forget_remembered()
 
 
+@pytest.mark.parametrize("junk", ["", "{", "[1, 2]", '{"x": 1}', "null", "\u0000\u00ff"])
+def test_a_damaged_cache_is_found_again(tmp_path, monkeypatch, junk):
+    """compiles.json and lanes.json that do not hold the answer (empty, cut short, not a
+    table, another device's, binary) are answered again and rewritten, never trusted."""
+    from harness import device
+    from pyjulia4d.opencl import devices
+    dev = device()
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    for name in ("compiles", "lanes"):
+        (tmp_path / f"{name}.json").write_text(junk)
+    devices.forget_remembered()
+    monkeypatch.setattr(lanes_mod, "probe", lambda d: 8)
+    assert devices.compile_error(dev) == ""
+    assert lanes_mod.lanes_for(dev, "packet", False) == 8
+    assert json.loads((tmp_path / "lanes.json").read_text())[devices.device_key(dev)] == 8
+    assert json.loads((tmp_path / "compiles.json").read_text())[devices.device_key(dev)] == ""
+    devices.forget_remembered()
+
+
 def test_scene_variant_key():
     s = Scene.default().with_overrides(["render.variant=scalar", "image.width=9", "image.height=7"])
     assert render(s).lanes == 1
