@@ -76,9 +76,8 @@ def measure(case, method, scale, repeats) -> dict:
     mism = float(np.mean(a.status != b.status))
     pix = b.depth[both].astype(float) * 2 * math.tan(math.radians(s.camera.fov) / 2) / s.image.height
     ang = np.degrees(np.arccos(np.clip(np.sum(a.normal[both] * b.normal[both], -1), -1, 1)))
-    tol = case.depth_tol_for(method)
-    within = (mism <= case.status_tol and (err.size == 0 or (np.median(err) <= tol
-                                                            and np.mean(err > tol) <= case.status_tol))
+    tol, stol = case.depth_tol_for(method), case.status_tol_for(method)
+    within = (mism <= stol and (err.size == 0 or (np.median(err) <= tol and np.mean(err > tol) <= stol))
               and both.sum() >= case.both_hit_min)
     verdict = "LIMIT" if case.limit else ("ok" if within else "FAIL")
     return {
@@ -96,7 +95,7 @@ def measure(case, method, scale, repeats) -> dict:
         "guards32": " ".join(f"{k}={a.guards[k]}" for k in GUARDS if a.guards[k]) or "-",
         "guards64": " ".join(f"{k}={b.guards[k]}" for k in GUARDS if b.guards[k]) or "-",
         "nan_inf32": leaks(a), "nan_inf64": leaks(b),
-        "status_tol": case.status_tol, "depth_tol": tol,
+        "status_tol": stol, "depth_tol": tol,
         "verdict": verdict, "limit": case.limit,
     }
 

@@ -19,11 +19,22 @@
  * and counted: the effective epsilon becomes the spacing of t (seed 001 §4.2's epsilon
  * as a function of distance, forced by the number format), and the bracket one ulp. */
 
+/* Over-relaxed steps (Keinert, Schaefer, Korndoerfer, Ganse and Stamminger, "Enhanced Sphere
+ * Tracing", 2014): each step is DE_OVER_RELAX times the estimate; where the new point's
+ * sphere and the last one's do not overlap (r + r_prev < step: the path between them is
+ * not covered) the step is taken back to (2 - DE_OVER_RELAX) times the last estimate,
+ * inside its sphere, and the ray goes on with plain steps.  So the spheres still cover the
+ * path, as plain steps' do, and a point beyond a gap is never a hit.  1.2 took 14 % fewer
+ * estimates on the default scene (float64 twin, 160x120); 1.4 and more gained nothing
+ * (the fallbacks ate it). */
+#define DE_OVER_RELAX ((real)1.2)
+
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
                        int z_resolution, int post_steps, int max_steps, lmask *status,
                        lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
     lreal t = near, t_prev = near;
+    lreal omega = DE_OVER_RELAX, step = 0, r_prev = 0;
     lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lmask out = active & (t > far);
@@ -32,18 +43,24 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         active &= !out;
         lmask escaped;
         lreal dist = julia_distance_formula(QRAY(o, d, t), jp, &escaped);
-        lmask got = active & !escaped;
+        lreal r = L_SEL((lreal)0, dist, escaped);
+        lmask gap = active & (omega > (real)1) & (r + r_prev < step);
+        lmask got = active & !escaped & !gap;
         *samples = L_SEL(*samples, (lmask)(i + 1), got);
         hit |= got;
         if (i == 0)
             first = got;
         active &= !got;
-        shell |= active & (dist < jp.epsilon);
-        lreal next = t + fmax(dist, jp.epsilon);
+        shell |= active & !gap & (dist < jp.epsilon);
+        step = L_SEL(fmax(dist, jp.epsilon) * omega, step * ((real)1 - omega), gap);
+        omega = L_SEL(omega, (lreal)1, gap);
+        r_prev = L_SEL(r, r_prev, gap);
+        lreal next = t + step;
         lmask stall = active & (next == t);    /* the step rounded away: one ulp instead */
         next = L_SEL(next, nextafter(t, (lreal)INFINITY), stall);
         *flags |= L_SEL((lmask)0, (lmask)GUARD_ULP_STEP, stall);
-        t_prev = L_SEL(t_prev, t, active);
+        /* the bracket's outer end stays the last point whose sphere counted */
+        t_prev = L_SEL(t_prev, t, active & !gap);
         t = L_SEL(t, next, active);
     }
     *samples = L_SEL(*samples, (lmask)max_steps, active);

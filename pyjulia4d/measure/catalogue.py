@@ -49,6 +49,10 @@ class Case:
     both_hit_min: int = 1          # pixels both renders must hit (0: a case that may see nothing)
     fixed_depth_tol: float = 0.0   # depth_tol for the fixed scan where it differs (0: the same)
     methods: tuple[str, ...] = METHODS  # the march methods the case runs with (no de without an estimate)
+    de_status_tol: float = 0.0     # status_tol for the estimate where it differs (0: the same)
+
+    def status_tol_for(self, method: str) -> float:
+        return self.de_status_tol if method == "de" and self.de_status_tol else self.status_tol
 
     def depth_tol_for(self, method: str) -> float:
         return self.fixed_depth_tol if method == "fixed" and self.fixed_depth_tol else self.depth_tol
@@ -125,8 +129,9 @@ def _build() -> list[Case]:
              "is a thin hull that marching may step over",
              "terminates; the fixed scan may miss the thin hull (as float64 does); both "
              "methods find the certified truncated surface, whose first crossing float32 and "
-             "float64 decide differently where the hull is thinner than their steps (de: 7 %)",
-             0.08, 1e-3, "", cheap),
+             "float64 decide differently where the hull is thinner than their steps (de: 10 %, "
+             "its over-relaxed steps landing on other points; 7 % with plain steps)",
+             0.08, 1e-3, "", cheap, de_status_tol=0.15),
         Case("c_dendrite_-2", ("fractal.c=-2,0,0,0", "fractal.max_iter=30"),
              "c = -2: the set is the segment [-2, 2] (zero volume); thin object",
              "the truncated set is a thin spindle both methods step over (de: rays that came "
@@ -138,8 +143,9 @@ def _build() -> list[Case]:
              "fixed: thin hull, mostly stepped over; de: the certified march finds the hull "
              "where its epsilon steps meet it (rays passing within epsilon without entering it "
              "are shell_miss); float32 and float64 find different first crossings of the "
-             "branches on ~5 % of the rays both hit (96x72)",
-             0.08, 1e-3, "", cheap),
+             "branches on ~5 % of the rays both hit (96x72; 12 % at 24x18 with the estimate's "
+             "over-relaxed steps)",
+             0.08, 1e-3, "", cheap, de_status_tol=0.15),
         Case("max_iter_1", ("fractal.max_iter=1",),
              "max_iter 1: the estimate and normals from a single iterate",
              "a smooth blob; exact agreement", 0.02, 1e-4, "", cheap),

@@ -102,9 +102,13 @@ def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, po
     return t, status, samples, np.zeros(n, np.int32), width, unresolved
 
 
+DE_OVER_RELAX = 1.2   # over-relaxed steps (march/de.cl)
+
+
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
              itp=True, formula: Formula = QUATERNION_SQR):
-    """r_{n+1} = r_n + max(d(r_n), eps) (seed 001 §3.2 eq. 9) until a point is inside (its
+    """r_{n+1} = r_n + 1.2 max(d(r_n), eps) (seed 001 §3.2 eq. 9, over-relaxed as in Keinert et
+    al. 2014 with the step taken back where two spheres leave a gap) until a point is inside (its
     orbit never escaped); with the previous point, the certified bracket refined by
     refine_bracket.  A step that rounds away (t + step == t) becomes one ulp of t
     (GUARD_ULP_STEP); a ray that came within epsilon by the estimate and never got inside
@@ -119,6 +123,7 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
     shell = np.zeros(n, bool)
     active = np.ones(n, bool)
     bracketed = np.zeros(n, bool)
+    omega, step, r_prev = np.full(n, DE_OVER_RELAX), np.zeros(n), np.zeros(n)
     for i in range(max_steps):
         idx = np.nonzero(active)[0]
         if idx.size == 0:
@@ -131,7 +136,10 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         active[gone] = False
         idx = idx[~out]
         dist, escaped = julia_distance_formula(o[idx] + t[idx, None] * d[idx], c, max_iter, bailout, formula)
-        hit = ~escaped
+        r = np.where(escaped, dist, 0.0)
+        # over-relaxed steps; a gap between the spheres takes the step back (march/de.cl)
+        gap = (omega[idx] > 1) & (r + r_prev[idx] < step[idx])
+        hit = ~escaped & ~gap
         got = idx[hit]
         status[got] = STATUS_HIT
         samples[got] = i + 1
@@ -140,12 +148,17 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
             width[got] = 0.0
         else:
             bracketed[got] = True
-        k = idx[~hit]
-        shell[k] |= dist[~hit] < epsilon
-        t_prev[k] = t[k]
-        t[k] = t[k] + np.maximum(dist[~hit], epsilon)
-        stall = k[t[k] == t_prev[k]]
-        t[stall] = np.nextafter(t_prev[stall], np.inf)
+        k, g, rk = idx[~hit], gap[~hit], r[~hit]
+        dk = dist[~hit]
+        shell[k] |= ~g & (dk < epsilon)
+        step[k] = np.where(g, step[k] * (1 - omega[k]), np.maximum(dk, epsilon) * omega[k])
+        omega[k] = np.where(g, 1.0, omega[k])
+        r_prev[k] = np.where(g, r_prev[k], rk)
+        t_prev[k] = np.where(g, t_prev[k], t[k])
+        t_old = t[k].copy()
+        t[k] = t[k] + step[k]
+        stall = k[t[k] == t_old]
+        t[stall] = np.nextafter(t_old[t[k] == t_old], np.inf)
         flags[stall] |= GUARD_ULP_STEP
     k = np.nonzero(bracketed)[0]
     if k.size:
