@@ -227,6 +227,7 @@ int z_resolution, int post_steps, int max_steps, lmask *status,
 lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
 lreal t = near, t_prev = near;
+lreal omega = ((real)1.2), step = 0, r_prev = 0;
 lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
 for (int i = 0; i < max_steps && (active); ++i) {
 lmask out = active & (t > far);
@@ -235,18 +236,23 @@ miss |= out;
 active &= !out;
 lmask escaped;
 lreal dist = julia_distance_formula(((o) + (t) * (d)), jp, &escaped);
-lmask got = active & !escaped;
+lreal r = ((escaped) ? (dist) : ((lreal)0));
+lmask gap = active & (omega > (real)1) & (r + r_prev < step);
+lmask got = active & !escaped & !gap;
 *samples = ((got) ? ((lmask)(i + 1)) : (*samples));
 hit |= got;
 if (i == 0)
 first = got;
 active &= !got;
-shell |= active & (dist < jp.epsilon);
-lreal next = t + fmax(dist, jp.epsilon);
+shell |= active & !gap & (dist < jp.epsilon);
+step = ((gap) ? (step * ((real)1 - omega)) : (fmax(dist, jp.epsilon) * omega));
+omega = ((gap) ? ((lreal)1) : (omega));
+r_prev = ((gap) ? (r_prev) : (r));
+lreal next = t + step;
 lmask stall = active & (next == t);
 next = ((stall) ? (nextafter(t, (lreal)INFINITY)) : (next));
 *flags |= ((stall) ? ((lmask)4) : ((lmask)0));
-t_prev = ((active) ? (t) : (t_prev));
+t_prev = ((active & !gap) ? (t) : (t_prev));
 t = ((active) ? (next) : (t));
 }
 *samples = ((active) ? ((lmask)max_steps) : (*samples));
