@@ -638,3 +638,28 @@ def test_signal_during_the_write(sig: int, phase: str, tmp_path) -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_signal_dropped_in_a_finaliser_still_stops_the_render() -> None:
+    """Python prints and drops an exception raised inside a finaliser: a SIGTERM whose
+    handler runs there would leave the render running, deaf to signals.  The handler also
+    asks pyjulia4d.pipeline.progress for a stop, raised at the next progress update."""
+    from pyjulia4d.app import cli
+    from pyjulia4d.pipeline import progress
+
+    class Finalised:
+        def __del__(self):
+            cli._raise_terminated(signal.SIGTERM, None)
+
+    old = {s: signal.getsignal(s) for s in cli._SIGNALS}
+    try:
+        with cli._signals_raise():
+            Finalised()   # the handler's Terminated is dropped here, as in a real finaliser
+            bar = progress.Progress(10, "render", "pixel", enabled=False)
+            with pytest.raises(cli.Terminated):
+                bar.update(1)
+        bar.update(1)     # the stop ends with the block
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)

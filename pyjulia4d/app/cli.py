@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, Iterator, NoReturn, Sequence
 
 from pyjulia4d.app.output import check_output_path, write_image
+from pyjulia4d.pipeline.progress import clear_stop, request_stop
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError, show_key
 from pyjulia4d.scene.text import override_key
@@ -306,6 +307,8 @@ def _raise_terminated(signum: int, frame: Any) -> None:
     # a second SIGTERM/SIGHUP during the clean-up the first one starts would cut it short
     for s in _SIGNALS:
         signal.signal(s, signal.SIG_IGN)
+    # raised again at the next progress update, should this one land in a finaliser
+    request_stop(Terminated(signum))
     raise Terminated(signum)
 
 
@@ -324,6 +327,7 @@ def _signals_raise() -> Iterator[None]:
     try:
         yield
     finally:
+        clear_stop()
         for s, h in old.items():
             signal.signal(s, h if h is not None else signal.SIG_DFL)
 

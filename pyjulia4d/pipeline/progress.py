@@ -13,6 +13,22 @@ from tqdm import tqdm
 # line(n done, total, seconds so far, seconds left, note) -> the text of one progress line
 LineText = Callable[[int, int, float, float, str], str]
 
+# A stop a signal handler asked for (the command line's SIGTERM and SIGHUP), raised again at
+# every update: a handler's exception that lands inside a finaliser (__del__, a weakref
+# callback) is printed and dropped by Python, and the render would run on, deaf to the
+# signals the handler has set to ignore.  Seen once in CI, under load: SIGHUP left a slow
+# render running past the test's 30 s.
+_stop: list[BaseException] = []
+
+
+def request_stop(exc: BaseException) -> None:
+    """Raise ``exc`` at every Progress.update from now on, until clear_stop()."""
+    _stop[:] = [exc]
+
+
+def clear_stop() -> None:
+    _stop.clear()
+
 
 class Progress:
     def __init__(self, total: int, desc: str, unit: str, enabled: bool = True, line: LineText | None = None,
@@ -27,6 +43,8 @@ class Progress:
                          leave=False, desc=desc) if enabled and tty else None)
 
     def update(self, k: int = 1, note: str = "") -> None:
+        if _stop:
+            raise _stop[0]
         self.n += k
         if self.bar is not None:
             self.bar.update(k)
