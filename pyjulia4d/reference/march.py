@@ -155,11 +155,11 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
         omega[k] = np.where(g, 1.0, omega[k])
         r_prev[k] = np.where(g, r_prev[k], rk)
         t_prev[k] = np.where(g, t_prev[k], t[k])
-        t_old = t[k].copy()
-        t[k] = t[k] + step[k]
-        stall = k[t[k] == t_old]
-        t[stall] = np.nextafter(t_old[t[k] == t_old], np.inf)
-        flags[stall] |= GUARD_ULP_STEP
+        t_old = t[k]
+        t[k] = t_old + step[k]
+        rounded = t[k] == t_old   # the step rounded away: one ulp instead
+        t[k[rounded]] = np.nextafter(t_old[rounded], np.inf)
+        flags[k[rounded]] |= GUARD_ULP_STEP
     k = np.nonzero(bracketed)[0]
     if k.size:
         t[k], width[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], post_steps, c, max_iter, bailout, itp,

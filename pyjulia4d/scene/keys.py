@@ -32,7 +32,7 @@ MEANINGS = {
     "slice.normal": "normal of the 3D hyperplane the camera looks into (POV-Ray's slice)",
     "slice.distance": "the hyperplane's distance from the origin",
     "march.quality": "draft, normal or final: measured march presets (proven marches); custom: the march keys as "
-                     "given; auto: normal where the set has no distance estimate, else the estimate",
+                     "given; auto: the distance estimate where it bounds the distance (connected sets), else normal",
     "march.method": "fixed (z-resolution scan), de (distance estimate) or auto (de where it exists)",
     "march.z_resolution": "fixed: samples between near and far",
     "march.post_steps": "refinement steps of the certified depth bracket after a hit",

@@ -30,6 +30,7 @@ is what the benchmarks (preset_check.py, error_vs_time.py) hold a preset's silho
 """
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from pyjulia4d.fractal.registry import FUNCTIONS_TABLE, has_distance_estimate
@@ -60,6 +61,7 @@ MARCH_KEYS = ("method", "z_resolution", "post_steps", "epsilon", "refine")
 CONNECTED_ITER = 1000
 
 
+@functools.lru_cache(maxsize=256)   # every Scene built with "auto" asks (0.3 ms each)
 def critical_orbit_bounded(algebra: str, degree: int, c: tuple) -> bool:
     """Whether the orbit of the critical point 0 of q -> q^degree + c stays bounded for
     CONNECTED_ITER iterations, in the complex planes the orbit lives in: a quaternion orbit
