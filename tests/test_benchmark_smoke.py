@@ -118,6 +118,7 @@ def test_peers_report_runs(tmp_path):
     assert "| pyjulia4d default |" in md and "pixels per CPU-second" in md
 
 
+@pytest.mark.slow   # a child per CPU runtime, each building from cold: the longest test of the default run
 def test_cpu_runtimes_benchmark_runs(tmp_path, capsys):
     """benchmarks/cpu_runtimes.py on one pair, tiny: a table row per pair with every CPU
     device that compiles, and the results file with its commit and devices."""
