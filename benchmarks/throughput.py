@@ -4,9 +4,9 @@ For each scene and precision it counts the iterations of f = q^2 + c that the ma
 tests make - the same kernel source built with -D COUNT_ITERATIONS, which adds a per-ray
 counter (kernels/common/lanes.cl), summed on the host - and times the march kernel alone in the
 normal build (median of --repeats after a warm-up launch, rays made once), one ray per
-work-item and in packets (the width pyjulia4d.lanes probes for the device, single
-precision), and in packets of rays shuffled across the image (what divergence costs:
-neighbouring pixels' rays take similar paths, random ones do not).  Iterations per
+work-item and in packets (the width pyjulia4d.lanes probes for the device and precision),
+and, in single precision, in packets of rays shuffled across the image (what divergence
+costs: neighbouring pixels' rays take similar paths, random ones do not).  Iterations per
 second = counted iterations / march seconds.
 
 The peak: a kernel of independent FMA chains (8 chains of 512 dependent fma's per
@@ -205,12 +205,14 @@ def main(argv=None) -> int:
     lines += ["", "| scene | precision | rays per work-item | iterations of f in the march | "
               "march kernel s (median) | iterations/s | share of the FMA peak (20 flops each) | "
               "pixels hit |", "|---|---|---|---|---|---|---|---|"]
-    auto = lanes_for(dev, "packet", False)
+    auto = {prec: lanes_for(dev, "packet", prec == "double") for prec in ("single", "double")}
     for name, over in SCENES.items():
         for prec in ("single", "double"):
             s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",
                                                        f"render.float={prec}"])
-            runs = [(1, False)] + ([(auto, False), (auto, True)] if prec == "single" and auto > 1 else [])
+            wide = auto[prec]
+            runs = [(1, False)] + ([(wide, False)] if wide > 1 else []) + \
+                ([(wide, True)] if prec == "single" and wide > 1 else [])
             for lanes, shuffle in runs:
                 r = march_throughput(s, dev, a.repeats, lanes, shuffle)
                 share = r["its"] * FLOPS_PER_ITERATION / peak[prec] if prec in peak else float("nan")

@@ -46,7 +46,7 @@ inline lreal julia_level(quat p, julia_params jp, lmask *inside)
     *inside = m2 <= jp.bailout2;
     lmask k = jp.max_iter - steps;
 #if JULIA_GROWTH == 2
-    lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
+    lreal e = ldexp(log(m2 / jp.bailout2), L_INT(min(k, 60)));
 #else
     lreal e = log(m2 / jp.bailout2) * pow((lreal)JULIA_GROWTH, convert_lreal(min(k, 60)));
 #endif
@@ -66,7 +66,7 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
 {
     /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
     lreal mq = fmax(m2, REAL_MIN);
-    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), -e / 2);
+    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), L_INT(-e / 2));
     ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
     /* the 1/2 of the lower bound G / (2 |G'|) (Koebe), whatever the degree */
     return ratio * log(mq) / (real)4;
@@ -77,10 +77,10 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
         dm2 = L_SEL(dm2, dm2 * (factor), live); \
         lmask big_ = (live) & (dm2 > (real)1e16); \
         if (L_ANY(big_)) { \
-            lmask k_; \
+            lint k_; \
             lreal mant_ = frexp(dm2, &k_); \
             dm2 = L_SEL(dm2, mant_, big_); \
-            e = L_SEL(e, e + k_, big_); \
+            e = L_SEL(e, e + L_MASK(k_), big_); \
         } \
     } while (0)
 

@@ -18,13 +18,13 @@ def device():
     return select_device(os.environ.get("PYJULIA4D_DEVICE") or None)
 
 
-def packet_widths(widths=(4, 8, 16)):
+def packet_widths(widths=(4, 8, 16), double: bool = False):
     """The packet widths the device under test survives: those up to the width its probe
-    found (pyjulia4d/lanes.py runs the probe in a child process; a width a driver crashes
-    on - PyPI's PoCL on float16 - must never run in the test process itself)."""
+    found for the precision (pyjulia4d/lanes.py runs the probe in a child process; a width a
+    driver crashes on - PyPI's PoCL on float16 - must never run in the test process itself)."""
     from pyjulia4d.opencl.lanes import lanes_for
 
-    most = lanes_for(device(), "packet", False)
+    most = lanes_for(device(), "packet", double)
     return [w for w in widths if w <= most]
 
 

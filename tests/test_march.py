@@ -60,8 +60,10 @@ CASES = [
 
 def _variants(case):
     # packets of 16 and 8 rays (48x36 = 1728: whole packets; a 7-ray tail at 13 lanes is
-    # not a width we build) are single precision only
-    return [1] if "render.float=double" in case else [1] + packet_widths((8, 16))
+    # not a width we build); double precision packets are at most 8 wide (opencl/lanes.py)
+    if "render.float=double" in case:
+        return [1] + packet_widths((8,), double=True)
+    return [1] + packet_widths((8, 16))
 
 
 @pytest.mark.parametrize("over,lanes", [(c, n) for c in CASES for n in _variants(c)])

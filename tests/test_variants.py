@@ -1,5 +1,6 @@
 """One source, two variants (kernels/common/lanes.cl, "Lanes"): the march run one ray per
-work-item and in packets of 4, 8 and 16 neighbouring rays must give the same pixels.
+work-item and in packets of 4, 8 and 16 neighbouring rays (4 and 8 in double precision) must
+give the same pixels.
 
 Not bit for bit: the packet variant sums |q|^2 as four products where the one-ray variant
 calls dot(), and ITP's interpolation amplifies that last-bit difference into a different
@@ -45,6 +46,12 @@ def _cases():
             slow = lanes != max(packet_widths()) and i not in SAMPLED
             out.append(pytest.param(over, lanes, id=f"over{i}-{lanes}",
                                     marks=[pytest.mark.slow] if slow else []))
+    # double precision: its widest packet on a sample (the estimate, the fixed scan, the proven
+    # march, a transcendental function), the rest slow
+    for i, over in enumerate(SCENES):
+        for lanes in packet_widths((8,), double=True):
+            out.append(pytest.param(over + ["render.float=double"], lanes, id=f"over{i}-double-{lanes}",
+                                    marks=[] if i in (0, 1, 2, 8) else [pytest.mark.slow]))
     return out
 
 
@@ -91,15 +98,19 @@ def test_variant_choice_and_its_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
     forget_remembered()
     assert lanes_mod.lanes_for(dev, "scalar", False) == 1
-    assert lanes_mod.lanes_for(dev, "packet", True) == 1          # packets are float
     probed = lanes_mod.lanes_for(dev, "packet", False)
     assert probed in (1,) + lanes_mod.WIDTHS
     known = json.loads((tmp_path / "lanes.json").read_text())
     assert known[device_key(dev)] == probed
+    # double precision: a probe of its own, kept apart
+    probed_double = lanes_mod.lanes_for(dev, "packet", True)
+    assert probed_double in (1,) + lanes_mod.DOUBLE_WIDTHS
+    assert json.loads((tmp_path / "lanes_double.json").read_text())[device_key(dev)] == probed_double
     # cached: no second probe, in this process or the next
     forget_remembered()
     monkeypatch.setattr(lanes_mod, "probe", lambda *a, **k: pytest.fail("probed twice"))
     assert lanes_mod.lanes_for(dev, "packet", False) == probed
+    assert lanes_mod.lanes_for(dev, "packet", True) == probed_double
     # the compiler probe likewise: remembered in compiles.json, no second build
     from pyjulia4d.opencl import devices
     assert devices.compile_error(dev) == ""

@@ -38,10 +38,12 @@ typedef struct {
 #define COUNT_ITER(jp, n) do { if ((jp).count) *(jp).count += (n); } while (0)
 #define COUNTER_ARG , __global int *iter_count
 #define COUNTER_INIT(i) , iter_count + (i)
+#define COUNTER_NONE , 0    /* a kernel without the counter argument counts nothing */
 #else
 #define COUNT_ITER(jp, n)
 #define COUNTER_ARG
 #define COUNTER_INIT(i)
+#define COUNTER_NONE
 #endif
 
 /* Pixel status codes and guard flags: common/codes.cl (read by pyjulia4d/pipeline/codes.py too). */
@@ -52,7 +54,10 @@ typedef struct {
  * form, quat = four realN, so a CPU runs the N rays in its vector lanes (PoCL does not
  * vectorise a data-dependent loop across work-items).  A lane mask is what a comparison
  * gives: 1 / 0 for one lane, -1 / 0 per lane for N; finished lanes are frozen by L_SEL and
- * loops run while L_ANY lane is live.  Packets are single precision only. */
+ * loops run while L_ANY lane is live.  A comparison of doubleN gives longN, so in double
+ * precision packets (-D REAL_DOUBLE with LANES = N) lmask is longN; its lanes are mask_t
+ * (int, or long there) and the int exponents of ldexp / frexp are lint, converted with
+ * L_INT / L_MASK.  Counts and codes live in lmask either way. */
 #define CAT_(a, b) a##b
 #define CAT(a, b) CAT_(a, b)
 /* A packet is a block of BLOCK_W x BLOCK_H neighbouring pixels (-D from build.py's
@@ -64,6 +69,10 @@ typedef struct {
 #if LANES == 1
 typedef real lreal;
 typedef int lmask;
+typedef int mask_t;
+typedef int lint;
+#define L_INT(m) (m)
+#define L_MASK(i) (i)
 typedef real4 quat;
 #define L_ANY(m) (m)
 #define L_SEL(a, b, m) ((m) ? (b) : (a))
@@ -81,10 +90,21 @@ typedef real4 quat;
 #define convert_lreal(m) ((real)(m))
 #else
 #ifdef REAL_DOUBLE
-#error "packets of rays are single precision (LANES > 1 with REAL_DOUBLE)"
-#endif
-typedef CAT(float, LANES) lreal;   /* packets are float (checked above) */
+typedef CAT(double, LANES) lreal;
+typedef CAT(long, LANES) lmask;
+typedef long mask_t;
+#define L_INT(m) CAT(convert_int, LANES)(m)
+#define L_MASK(i) CAT(convert_long, LANES)(i)
+#define convert_lreal(m) CAT(convert_double, LANES)(m)
+#else
+typedef CAT(float, LANES) lreal;
 typedef CAT(int, LANES) lmask;
+typedef int mask_t;
+#define L_INT(m) (m)
+#define L_MASK(i) (i)
+#define convert_lreal(m) CAT(convert_float, LANES)(m)
+#endif
+typedef CAT(int, LANES) lint;
 typedef struct { lreal x, y, z, w; } quat;
 #define L_ANY(m) any(m)
 #define L_SEL(a, b, m) select((a), (b), (m))
@@ -102,7 +122,6 @@ inline lreal QDOT_UNIFORM(quat a, real4 v) { return a.x * v.x + a.y * v.y + a.z 
 inline lreal QLEN(quat q) { return sqrt(QNORM2(q)); }
 inline quat QSCALE(lreal s, quat q) { return QUAT(s * q.x, s * q.y, s * q.z, s * q.w); }
 #define L_TRUE (-1)
-#define convert_lreal(m) CAT(convert_float, LANES)(m)
 inline quat QSEL(quat a, quat b, lmask m)
 {
     return QUAT(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m), select(a.w, b.w, m));

@@ -135,15 +135,15 @@ inline lreal stack_distance_formula(quat p, julia_params jp, lmask *escaped)
     int n = 0;
     for (; n < jp.max_iter && L_ANY(live); ++n) {
         lreal r2 = (real)2 * sqrt(m2);
-        gb = L_SEL(gb, r2 * gb + ldexp((lreal)ch, -e), live);
+        gb = L_SEL(gb, r2 * gb + ldexp((lreal)ch, L_INT(-e)), live);
         ga = L_SEL(ga, r2 * ga, live);
         lmask big = live & (fmax(ga, gb) > (real)1e16);
         if (L_ANY(big)) {
-            lmask k;
-            frexp(fmax(ga, gb), &k);
-            k = L_SEL((lmask)0, k, big);
-            ga = ldexp(ga, -k);
-            gb = ldexp(gb, -k);
+            lint k_;
+            frexp(fmax(ga, gb), &k_);
+            lmask k = L_SEL((lmask)0, L_MASK(k_), big);
+            ga = ldexp(ga, L_INT(-k));
+            gb = ldexp(gb, L_INT(-k));
             e += k;
         }
         STACK_STEP(zr, zi, cr, ci, live);

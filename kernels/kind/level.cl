@@ -8,7 +8,7 @@ inline lreal kind_level(lreal m2, real bailout2, lmask k, int growth)
 {
     lreal e;
     if (growth == 2)   /* exact: a power of two */
-        e = ldexp(log(m2 / bailout2), min(k, 60));
+        e = ldexp(log(m2 / bailout2), L_INT(min(k, 60)));
     else
         e = log(m2 / bailout2) * pow((lreal)growth, convert_lreal(min(k, 60)));
     return L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));

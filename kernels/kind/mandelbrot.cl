@@ -66,7 +66,7 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
  * dr = |q'| is kept as mantissa * 2^e (DE_GROW), so the + 1 is added as 2^-e. */
 #define MANDEL_GROW(dr, e, factor, live) do { \
         DE_GROW(dr, e, factor, live); \
-        dr = L_SEL(dr, dr + ldexp((lreal)1, -(e)), live); \
+        dr = L_SEL(dr, dr + ldexp((lreal)1, L_INT(-(e))), live); \
     } while (0)
 
 #ifndef ALG_SPLIT

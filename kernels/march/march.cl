@@ -83,7 +83,7 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
         ((real *)&o.z)[k] = ok.z; ((real *)&o.w)[k] = ok.w;
         ((real *)&d.x)[k] = dk.x; ((real *)&d.y)[k] = dk.y;
         ((real *)&d.z)[k] = dk.z; ((real *)&d.w)[k] = dk.w;
-        ((int *)&valid)[k] = lane_index[k] < (size_t)n_items ? -1 : 0;
+        ((mask_t *)&valid)[k] = lane_index[k] < (size_t)n_items ? -1 : 0;
     }
 #endif
 
@@ -139,14 +139,14 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
         if (i >= (size_t)n_items)
             continue;
         real tk = ((real *)&t)[k];
-        int sk = ((int *)&st)[k];
+        int sk = ((mask_t *)&st)[k];
         real4 ok = (real4)(((real *)&o.x)[k], ((real *)&o.y)[k], ((real *)&o.z)[k], ((real *)&o.w)[k]);
         real4 dk = (real4)(((real *)&d.x)[k], ((real *)&d.y)[k], ((real *)&d.z)[k], ((real *)&d.w)[k]);
         depth[i] = tk;
         point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
         status[i] = sk;
-        samples[i] = ((int *)&n)[k];
-        flags[i] = ((int *)&fl)[k];
+        samples[i] = ((mask_t *)&n)[k];
+        flags[i] = ((mask_t *)&fl)[k];
         bracket[i] = sk == STATUS_HIT ? ((real *)&width)[k] : INFINITY;
         unresolved[i] = ((real *)&unres)[k];
     }

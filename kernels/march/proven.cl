@@ -169,7 +169,7 @@ __kernel void prove_segments(const int n_items, __global const real4 *origins, _
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
         return;
-    julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_INIT(i) };
+    julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_NONE };
     lreal m;
     proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &m) ? 1 : 0;
     margins[i] = m;

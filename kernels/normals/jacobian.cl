@@ -149,7 +149,7 @@ __kernel void normals_jacobian(const int n_items, __global const real4 *point, _
         size_t i = i0 + k;
         normal[i] = status[i] == STATUS_HIT
                         ? (real4)(((real *)&nx)[k], ((real *)&ny)[k], ((real *)&nz)[k],
-                                  (real)((int *)&guard)[k])
+                                  (real)((mask_t *)&guard)[k])
                         : (real4)(0);
     }
 #endif

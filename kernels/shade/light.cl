@@ -164,7 +164,7 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
         ((real *)&pin.x)[k] = ik.x; ((real *)&pin.y)[k] = ik.y; ((real *)&pin.z)[k] = ik.z; ((real *)&pin.w)[k] = ik.w;
         ((real *)&p.x)[k] = pk.x; ((real *)&p.y)[k] = pk.y; ((real *)&p.z)[k] = pk.z; ((real *)&p.w)[k] = pk.w;
         ((real *)&nw.x)[k] = nk.x; ((real *)&nw.y)[k] = nk.y; ((real *)&nw.z)[k] = nk.z; ((real *)&nw.w)[k] = nk.w;
-        ((int *)&hit)[k] = h && i0 + k < (size_t)n_items ? -1 : 0;
+        ((mask_t *)&hit)[k] = h && i0 + k < (size_t)n_items ? -1 : 0;
     }
 #endif
     lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;

@@ -6,9 +6,12 @@ data-dependent loop across work-items: the packet march of the default scene run
 development machine); GPUs run one ray per work-item.  Which widths a CPU driver survives
 is found by a probe that cannot take a render down: a child process builds and runs the
 packet march at 16, then 8, then 4 lanes on a tiny scene and compares it with the one-ray
-kernel; the widest that passes is used.  PyPI's PoCL 3.0 killed the process with SIGSEGV on
+kernel; the widest that passes is used.  Double precision has its own probe, of 8 and 4
+lanes: eight doubles fill the register sixteen floats do, and 16 ran slower than 8 on both
+CPU runtimes here (default scene, 320x240: 1.4x slower on Intel's, 1.0x on PoCL).  PyPI's PoCL 3.0 killed the process with SIGSEGV on
 float16 kernels, which is why the probe runs apart.  The answer is cached per device and
-driver version in ``~/.cache/pyjulia4d/lanes.json`` (``PYJULIA4D_CACHE`` moves it).
+driver version in ``~/.cache/pyjulia4d/lanes.json`` and ``lanes_double.json``
+(``PYJULIA4D_CACHE`` moves them).
 """
 from __future__ import annotations
 
@@ -20,6 +23,7 @@ import pyopencl as cl
 from pyjulia4d.opencl.devices import device_type, remembered
 
 WIDTHS = (16, 8, 4)
+DOUBLE_WIDTHS = (8, 4)
 
 
 _PROBE = r"""
@@ -29,9 +33,10 @@ import numpy as np
 from pyjulia4d import Scene
 from pyjulia4d.opencl.devices import select_device
 from pyjulia4d.opencl.executor import render
-spec, lanes = sys.argv[1], int(sys.argv[2])
+spec, lanes, prec = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 dev = select_device(spec)
-s = Scene.default().with_overrides(["image.width=37", "image.height=29", "march.post_steps=6"])
+s = Scene.default().with_overrides(["image.width=37", "image.height=29", "march.post_steps=6",
+                                    "render.float=" + prec])
 one = render(s, device=dev, lanes=1)
 pk = render(s, device=dev, lanes=lanes)
 same = np.mean(one.status == pk.status) >= 0.99
@@ -53,14 +58,14 @@ def device_spec(device: cl.Device) -> str:
     raise ValueError("device not found among the platforms")
 
 
-def probe(device: cl.Device, timeout: float = 120.0) -> int:
-    """The widest of WIDTHS whose packet march builds, runs and agrees with one ray per
-    work-item in a child process; 1 if none does."""
+def probe(device: cl.Device, timeout: float = 120.0, double: bool = False) -> int:
+    """The widest of WIDTHS (DOUBLE_WIDTHS with ``double``) whose packet march builds, runs and
+    agrees with one ray per work-item in a child process; 1 if none does."""
     spec = device_spec(device)
-    for lanes in WIDTHS:
+    for lanes in DOUBLE_WIDTHS if double else WIDTHS:
         try:
-            p = subprocess.run([sys.executable, "-c", _PROBE, spec, str(lanes)], capture_output=True,
-                               text=True, timeout=timeout)
+            p = subprocess.run([sys.executable, "-c", _PROBE, spec, str(lanes), "double" if double else "single"],
+                               capture_output=True, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
             continue
         if p.returncode == 0 and p.stdout.strip().endswith("ok"):
@@ -82,12 +87,19 @@ def march_lanes(width: int, method: str) -> int:
     return min(width, PROVEN_LANES) if method == "proven" else width
 
 
+def probe_double(device: cl.Device) -> int:
+    """probe in double precision."""
+    return probe(device, double=True)
+
+
 def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     """Rays per work-item of the march for ``render.variant`` on ``device``: 1 for
-    "scalar", for double precision (packets are float) and for GPUs under "auto"; for
-    "packet", or a CPU under "auto", the probed width (cached)."""
-    if variant == "scalar" or double:
+    "scalar" and for GPUs under "auto"; for "packet", or a CPU under "auto", the width
+    probed for the precision (cached)."""
+    if variant == "scalar":
         return 1
     if variant == "auto" and device_type(device) != "CPU":
         return 1
+    if double:
+        return int(remembered("lanes_double", device, int, probe_double))
     return int(remembered("lanes", device, int, probe))

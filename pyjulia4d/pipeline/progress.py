@@ -8,7 +8,6 @@ import sys
 import time
 from typing import Callable
 
-from tqdm import tqdm
 
 # line(n done, total, seconds so far, seconds left, note) -> the text of one progress line
 LineText = Callable[[int, int, float, float, str], str]
@@ -39,6 +38,8 @@ class Progress:
         self.line = line or (lambda n, total, spent, left, note:
                              f"{desc}: {n} of {total} {unit}s, {spent:.0f} s, about {left:.0f} s left")
         tty = hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
+        if enabled and tty:
+            from tqdm import tqdm   # here: its import (with importlib.metadata's) is 60 ms of start-up
         self.bar = (tqdm(total=total, unit=unit, unit_scale=unit_scale, file=sys.stderr, delay=delay,
                          leave=False, desc=desc) if enabled and tty else None)
 
