@@ -10,6 +10,8 @@ int max_iter;
 } julia_params;
 typedef real lreal;
 typedef int lmask;
+typedef int mask_t;
+typedef int lint;
 typedef real4 quat;
 typedef struct { lreal re, im; } cplx;
 inline cplx C(lreal re, lreal im) { cplx z = {re, im}; return z; }
@@ -148,14 +150,14 @@ live = m2 <= jp.bailout2;
 ;
 *inside = m2 <= jp.bailout2;
 lmask k = jp.max_iter - steps;
-lreal e = ldexp(log(m2 / jp.bailout2), min(k, 60));
+lreal e = ldexp(log(m2 / jp.bailout2), (min(k, 60)));
 lreal out = (((k > 60) | (e > (real)69)) ? ((lreal)1e30) : (expm1(fmin(e, (real)69))));
 return ((*inside) ? (m2 / jp.bailout2 - (real)1) : (out));
 }
 inline lreal de_value(lreal m2, lreal dm2, lmask e)
 {
 lreal mq = fmax(m2, FLT_MIN);
-lreal ratio = ldexp(sqrt(mq / fmax(dm2, FLT_MIN)), -e / 2);
+lreal ratio = ldexp(sqrt(mq / fmax(dm2, FLT_MIN)), (-e / 2));
 ratio = (((e & 1) != 0) ? (ratio * (real)0.70710678118654752) : (ratio));
 return ratio * log(mq) / (real)4;
 }
@@ -169,7 +171,7 @@ lmask e = 0;
 lmask live = m2 <= jp.bailout2;
 int n = 0;
 for (; n < jp.max_iter && (live); ++n) {
-do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) { lmask k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + k_) : (e)); } } while (0);
+do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) { lint k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + (k_)) : (e)); } } while (0);
 q = ((live) ? (julia_f(q, c)) : (q));
 m2 = dot((q), (q));
 live = m2 <= jp.bailout2;
