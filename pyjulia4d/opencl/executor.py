@@ -21,7 +21,7 @@ from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.opencl.devices import has_fp64, select_device
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes
-from pyjulia4d.pipeline.calibrate import SKIP_BELOW_SECONDS, Prediction, judge, predict, tile_side
+from pyjulia4d.pipeline.calibrate import Prediction, judge, predict, tile_side, wanted
 from pyjulia4d.pipeline.framing import fit_camera
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, check_flag, check_lanes, check_tile, gradient_step, make_plan,
@@ -377,7 +377,7 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
             scene, _ = fit_camera(scene, first_pass)
     plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
     prediction = None
-    if calibrate and plan.estimate.seconds > SKIP_BELOW_SECONDS:
+    if calibrate and wanted(plan.estimate.seconds):
         def run_probe(tiles) -> float:
             """The probe's kernel seconds, divided by the compute units a tile of the render
             keeps busy: each probe block is one work-group, run by one of them."""

@@ -13,6 +13,9 @@ of the render proper on scenes of every method.  The prediction then
   that dominates the work (workload.estimate) and saying the prediction came from a probe;
 - sizes the tiles so that one takes about TILE_SECONDS (``tile_side``): work is queued a
   tile at a time, so Ctrl-C is honoured within a tile or two, and the progress moves.
+
+Renders whose upper bound is below SKIP_BELOW_SECONDS (and WARN_SECONDS) are not probed
+(``wanted``).
 """
 from __future__ import annotations
 
@@ -25,7 +28,17 @@ from pyjulia4d.pipeline.workload import PROBE_RAYS, WorkloadError
 
 WARN_SECONDS = 60.0            # say how long, when it is longer than this
 REFUSE_SECONDS = 6 * 3600.0    # refuse (unless forced) when it is longer than this
-SKIP_BELOW_SECONDS = 0.25      # no probe where even the upper bound is shorter
+# No probe where even the upper bound (workload.estimate) is shorter than this and than
+# WARN_SECONDS: there is nothing to refuse or warn about, and the default tiles stay.  The
+# probe's 35 launches of 8x8 blocks cost 0.19 of a 640x480 render's 0.49 CPU-s on Intel's
+# runtime (0.09 of 0.57 on PoCL; benchmarks/peers.py's plain look); that render's bound is
+# 12 s, its truth 0.1 s, so Ctrl-C, honoured between tiles, still comes within a tile.
+SKIP_BELOW_SECONDS = 20.0
+
+
+def wanted(bound_seconds: float) -> bool:
+    """Whether a render whose work is bounded by ``bound_seconds`` needs the probe."""
+    return bound_seconds > min(SKIP_BELOW_SECONDS, WARN_SECONDS)
 TILE_SECONDS = 0.1             # the work of one tile: the latency of Ctrl-C
 MIN_TILE = 16
 
