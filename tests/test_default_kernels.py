@@ -51,8 +51,9 @@ def test_default_scene_uses_the_pre_kinds_pieces_and_switches():
     cfg = kernel_config.march_config(Scene.default(), 1)
     # the iteration and the march as before the kinds (the shading pieces after them are its own),
     # after common/codes.cl, which holds the status and guard codes common/lanes.cl defined before (#defines only)
-    assert cfg.pieces[:11] == ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate",
-                               "march/refine", "march/de", "rays", "march/march", "normals/jacobian")
+    # and march/cone.cl's start of the camera rays (-D CONE_START), which the kinds never touch
+    assert cfg.pieces[:12] == ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate",
+                               "march/refine", "march/de", "rays", "march/cone", "march/march", "normals/jacobian")
     assert not [p for p in cfg.pieces if p.startswith("kind/")]
     assert not [d for d in cfg.defines if d.startswith(("KIND_", "ROTATE_", "STACK_", "LOCUS_"))]
 

@@ -6,12 +6,14 @@
 typedef double real;
 typedef double4 real4;
 typedef double3 real3;
+typedef double2 real2;
 #define REAL_MAX DBL_MAX
 #define REAL_MIN DBL_MIN
 #else
 typedef float real;
 typedef float4 real4;
 typedef float3 real3;
+typedef float2 real2;
 #define REAL_MAX FLT_MAX
 #define REAL_MIN FLT_MIN
 #endif

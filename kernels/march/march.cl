@@ -38,13 +38,24 @@
 #define CLIP_ARGS
 #endif
 
+/* -D CONE_START (the estimate's march of camera rays, march/cone.cl): each ray of a block
+ * whose entry the block's cone covers starts at the cone's t_last; cone holds the tile's
+ * blocks (cone_w to a row of them, the first the block of pixel (x0, y0)). */
+#ifdef CONE_START
+#define CONE_ARGS , __global const real2 *cone, const int cone_w
+#define CONE_AT(i) (((y0 + (int)((i) / (size_t)tile_w)) / CONE_BLOCK - y0 / CONE_BLOCK) * cone_w + \
+                    (x0 + (int)((i) % (size_t)tile_w)) / CONE_BLOCK - x0 / CONE_BLOCK)
+#else
+#define CONE_ARGS
+#endif
+
 __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,
                     __global real *depth, __global real4 *point,
                     __global int *status, __global int *samples, __global int *flags,
-                    __global real *bracket, __global real *unresolved COUNTER_ARG CLIP_ARGS)
+                    __global real *bracket, __global real *unresolved COUNTER_ARG CLIP_ARGS CONE_ARGS)
 {
     /* LANES neighbouring rays per work-item (common/lanes.cl): one ray, or a block of BLOCK_W x
      * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
@@ -117,11 +128,39 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
     }
 #endif
     live &= far >= near;
+    lreal start = near;
+#ifdef CONE_START
+    lreal t_lo, t_last;
+#if LANES == 1
+    real2 cv = cone[CONE_AT(i0)];
+    t_lo = cv.x;
+    t_last = cv.y;
+#else
+    for (int k = 0; k < LANES; ++k) {
+        real2 cv = cone[CONE_AT(lane_index[k] < (size_t)n_items ? lane_index[k] : i0)];
+        ((real *)&t_lo)[k] = cv.x;
+        ((real *)&t_last)[k] = cv.y;
+    }
+#endif
+    lmask coned = live & (t_last > near) & (near >= t_lo) & (t_last < far);
+    start = L_SEL(near, t_last, coned);
+#endif
     lmask st = STATUS_MISS, n = 0, fl = 0;
     lreal t = INFINITY, width = INFINITY, unres = 0;
     if (L_ANY(live))
-        t = march_ray(o, d, near, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
+        t = march_ray(o, d, start, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
                       &width, &unres);
+#ifdef CONE_START
+    /* a first point inside: the cone's estimate was wrong for this ray; march it from its entry */
+    lmask redo = coned & (st == STATUS_HIT) & (width == (real)0);
+    if (L_ANY(redo)) {
+        lreal t2 = march_ray(o, d, near, far, redo, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
+                             &width, &unres);
+        t = L_SEL(t, t2, redo);
+    }
+    /* the estimate proves nothing: unresolved is measured from the entry, as without the cone */
+    unres = L_SEL(unres, unres + (start - near), coned & !redo);
+#endif
 #ifdef CLIP
     fl |= L_SEL((lmask)0, (lmask)FLAG_CUT_FACE | ((cut - 1) << 5), (st == STATUS_HIT) & (width == (real)0) & (cut > 0));
 #endif

@@ -53,6 +53,7 @@ class Precision:
         self.scalar = np.float64 if double else np.float32
         self.vec_dtype = cl.cltypes.double4 if double else cl.cltypes.float4
         self.vec = cl.cltypes.make_double4 if double else cl.cltypes.make_float4
+        self.cone_dtype = cl.cltypes.double2 if double else cl.cltypes.float2
 
     def v4(self, v) -> np.ndarray:
         return self.vec(*[float(x) for x in v])
@@ -169,6 +170,9 @@ class TileRunner:
                 bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
             if plan.shades:
                 bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
+            if plan.march.cone:   # march/cone.cl: (t_lo, t_last) per block of the tile
+                nb = max(bw * bh for _, _, bw, bh in (t.cone_blocks() for t in plan.tiles))
+                bufs["cone"] = cla.empty(self.queue, nb, pr.cone_dtype)
             if plan.reflects:   # the reflected rays, their march, normals and colour
                 for k in ("origins", "dirs", "point2", "normal2"):
                     bufs[k] = cla.empty(self.queue, nmax, pr.vec_dtype)
@@ -197,6 +201,7 @@ class TileRunner:
                             np.float32(sa.shininess))
         self.fog = (np.float32(sa.fog), np.float32(sa.fog_start))
         self.march_k = cl.Kernel(self.march_prg, "march")
+        self.cone_k = cl.Kernel(self.march_prg, "cone_starts") if plan.march.cone else None
         planes = plan.clip.planes
         self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
         self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
@@ -236,10 +241,20 @@ class TileRunner:
         plan, pr, q = self.plan, self.pr, self.queue
         bufs, stage = self.slots[slot]
         n = tile.n
-        kernels = [launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
-                          np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const, bufs["depth"].data, bufs["point"].data,
-                          bufs["status"].data, bufs["samples"].data, bufs["flags"].data,
-                          bufs["bracket"].data, bufs["unresolved"].data, *self.clip_args, items=march_items(n, tile.aw, plan.lanes))]
+        kernels, cone = [], ()
+        if self.cone_k is not None:
+            ma = plan.march
+            bx0, by0, bw, bh = tile.cone_blocks()
+            kernels.append(launch(q, self.cone_k, bw * bh, np.int32(bw), np.int32(bx0), np.int32(by0), *self.camera,
+                                  pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.radius),
+                                  pr.scalar(ma.near), pr.scalar(ma.far), np.int32(ma.max_steps), bufs["cone"].data,
+                                  lanes=plan.lanes))
+            cone = (bufs["cone"].data, np.int32(bw))
+        kernels.append(launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
+                              np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const,
+                              bufs["depth"].data, bufs["point"].data, bufs["status"].data, bufs["samples"].data,
+                              bufs["flags"].data, bufs["bracket"].data, bufs["unresolved"].data, *self.clip_args,
+                              *cone, items=march_items(n, tile.aw, plan.lanes)))
         if plan.normals:
             method = plan.scene.normals.method
             packet = plan.normals_in_march_config

@@ -73,6 +73,12 @@ def precision_defines(scene: Scene) -> tuple[str, ...]:
     return ("REAL_DOUBLE",) if scene.render.float == "double" else ()
 
 
+def cone_start(scene: Scene) -> bool:
+    """Whether the camera rays' march starts where a cone of the block's centre ray reached
+    (-D CONE_START, kernels/march/cone.cl): the distance-estimate march, unclipped."""
+    return march_method(scene) == "de" and not scene.clip.planes
+
+
 def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     """The pieces and switches of one scene's render program.  The march makes its rays
     from the camera; ``ray_buffers`` (-D RAYS_FROM_BUFFERS) builds it to read given rays
@@ -96,7 +102,11 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
         defines.append("RAYS_FROM_BUFFERS")
     if scene.clip.planes:
         defines.append("CLIP")
-    pieces += [f"march/{march_method(scene)}", "rays", "march/march"]
+    pieces += [f"march/{march_method(scene)}", "rays"]
+    if cone_start(scene) and not ray_buffers:
+        pieces.append("march/cone")
+        defines.append("CONE_START")
+    pieces.append("march/march")
     if scene.clip.planes:
         pieces.append("march/clip")
     pieces.append(f"normals/{scene.normals.method}")

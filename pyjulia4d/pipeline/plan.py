@@ -55,6 +55,22 @@ class Tile:
         """The tile's pixels in the image (rows, columns)."""
         return slice(self.y0, self.y0 + self.h), slice(self.x0, self.x0 + self.w)
 
+    def cone_blocks(self) -> tuple[int, int, int, int]:
+        """(bx0, by0, bw, bh): the image's CONE_BLOCK-pixel blocks the box meets, first and count."""
+        return cone_blocks(self.ax0, self.ay0, self.aw, self.ah)
+
+
+CONE_BLOCK = 4   # pixels on a side of a cone's block (kernels/march/cone.cl CONE_BLOCK)
+
+
+def cone_blocks(x0: int, y0: int, w: int, h: int) -> tuple[int, int, int, int]:
+    """(bx0, by0, bw, bh) of the CONE_BLOCK x CONE_BLOCK blocks of the image (block (bx, by) holds
+    pixels [CONE_BLOCK bx, CONE_BLOCK (bx + 1)) x ...) that pixels [x0, x0 + w) x [y0, y0 + h) meet:
+    blocks are the image's, whatever the tile, so a pixel starts where it would in any tiling."""
+    b = CONE_BLOCK
+    bx0, by0 = x0 // b, y0 // b
+    return bx0, by0, (x0 + w - 1) // b - bx0 + 1, (y0 + h - 1) // b - by0 + 1
+
 
 def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0,
                region: tuple[int, int, int, int] | None = None) -> tuple[Tile, ...]:
@@ -93,6 +109,7 @@ class MarchArgs:
     max_steps: int
     method: str            # "fixed", "de" or "proven": march.method resolved (fractal/registry.march_method)
     refine: str
+    cone: bool = False     # camera rays start where their block's cone reached (kernel_config.cone_start)
 
 
 @dataclass(frozen=True)
@@ -152,7 +169,7 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
                         near=-1.0 if m.near == "auto" else float(m.near),
                         far=-1.0 if m.far == "auto" else float(m.far), z_resolution=m.z_resolution,
                         post_steps=m.post_steps, max_steps=m.max_steps, method=march_method(scene),
-                        refine=m.refine),
+                        refine=m.refine, cone=kernel_config.cone_start(scene)),
         clip=ClipArgs(tuple(clip_planes(scene))),
         normals=NormalsArgs(scene.normals.method, gradient_step(scene)),
         light_args=LightArgs(**light),

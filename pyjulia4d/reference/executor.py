@@ -13,6 +13,7 @@ from pyjulia4d.pipeline.framing import fit_camera
 from pyjulia4d.pipeline.plan import Plan, make_plan
 from pyjulia4d.pipeline.result import RenderResult, count_guards
 from pyjulia4d.reference.antialias import flag_edges
+from pyjulia4d.reference.cone import cone_of_pixels, cone_starts
 from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.reference.march import march
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian, normals_zbuffer
@@ -59,6 +60,11 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
                                     guard, F)
         return normals_zbuffer(point, depth, status, w, h, frame, guard)
 
+    cone = None
+    if ma.cone:   # march/cone.cl: each block's start, the same for every sample of its pixels
+        cone = cone_of_pixels(cone_starts(frame, w, h, ma.c, ma.max_iter, ma.bailout, ma.radius, ma.near, ma.far,
+                                          ma.max_steps, F), (0, 0, w, h))
+
     def one_pass(sample: int, samples: int):
         origins, dirs = generate_rays(frame, w, h, sample=sample, samples=samples)
         guard = np.zeros(len(origins), np.int64)
@@ -66,7 +72,7 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
         unresolved = np.zeros(len(origins))
         depth, point, status, smp = march(origins, dirs, ma.c, ma.max_iter, ma.bailout, ma.epsilon, ma.radius,
                                           ma.near, ma.far, ma.z_resolution, ma.post_steps, ma.max_steps,
-                                          ma.method, guard, ma.refine, bracket, F, planes, unresolved)
+                                          ma.method, guard, ma.refine, bracket, F, planes, unresolved, cone)
         normal = clip_normals(guard, status, frame, planes, normals(point, depth, status, guard))
         refl = None
         if sa.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray

@@ -289,7 +289,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
           z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
-          formula: Formula = QUATERNION_SQR, clip=None, unresolved=None):
+          formula: Formula = QUATERNION_SQR, clip=None, unresolved=None, cone=None):
     """Clip each ray to the bounding 4-ball (and the ``clip`` half-spaces m . x <= e, world
     space: camera.clip_planes), then march; returns (depth, point, status, samples).  A hit
     at the first point of an interval a plane started is on its cut face: flags get
@@ -298,7 +298,9 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     ``bracket`` (float array, optional) each hit's certified bracket width (+inf elsewhere),
     ``unresolved`` (float array, optional) how far in front of each depth the space the
     march did not prove empty begins (the unproven width on a miss; 0 off the bounding
-    ball)."""
+    ball).  ``cone`` = (t_lo, t_last) per ray (reference/cone.py, -D CONE_START): a ray whose
+    entry is at or after t_lo starts at t_last, and is marched again from its entry where
+    that first point is inside."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
     b = dot4(o, d)
@@ -324,6 +326,12 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
         cut = np.where(raise_, k + 1, cut)
         live &= ~((dn == 0) & (on > 0))
     live &= far >= near
+    start = near
+    coned = np.zeros(len(o), bool)
+    if cone is not None:
+        t_lo, t_last = (np.asarray(a, np.float64) for a in cone)
+        coned = live & (t_last > near) & (near >= t_lo) & (t_last < far)
+        start = np.where(coned, t_last, near)
     n = len(o)
     depth = np.full(n, np.inf)
     status = np.full(n, STATUS_MISS, np.int32)
@@ -331,9 +339,20 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     k = np.nonzero(live)[0]
     if k.size:
         fn = {"fixed": march_fixed, "proven": march_proven}.get(method, march_de)
-        depth[k], status[k], samples[k], fl, wd, un = fn(o[k], d[k], near[k], far[k], c, max_iter, bailout,
+        depth[k], status[k], samples[k], fl, wd, un = fn(o[k], d[k], start[k], far[k], c, max_iter, bailout,
                                                      epsilon, z_resolution, post_steps, max_steps,
                                                      refine == "itp", formula)
+        if cone is not None:
+            # a first point inside: the cone's estimate was wrong for this ray (march/march.cl)
+            redo = coned[k] & (status[k] == STATUS_HIT) & (wd == 0)
+            j = k[redo]
+            if j.size:
+                depth[j], status[j], samples[j], fl2, wd[redo], un[redo] = fn(
+                    o[j], d[j], near[j], far[j], c, max_iter, bailout, epsilon, z_resolution, post_steps,
+                    max_steps, refine == "itp", formula)
+                fl[redo] |= fl2
+            moved = coned[k] & ~redo
+            un[moved] += start[k][moved] - near[k][moved]
         if flags is not None:
             flags[k] |= fl
             face = (status[k] == STATUS_HIT) & (wd == 0) & (cut[k] > 0)

@@ -2,6 +2,7 @@
 typedef float real;
 typedef float4 real4;
 typedef float3 real3;
+typedef float2 real2;
 typedef struct {
 real4 c;
 real bailout2;
