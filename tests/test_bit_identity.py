@@ -4,7 +4,8 @@ cluster tile, the other kinds) is rendered by the code of BASE, taken from git, 
 checkout, each in a child process on the same device, and every channel of every result
 must be identical.  BASE was the last commit before the package was rearranged; it moves
 forward only to a commit whose kernels change the results on purpose (69d2d94: the
-estimate's over-relaxed steps, march/de.cl), and the commit message says so.
+estimate's over-relaxed steps, march/de.cl; c78ebbb: the cone starts of its camera rays,
+march/cone.cl), and the commit message says so.
 
 Skipped where git or BASE is not at hand (an installed package, a shallow clone)."""
 from __future__ import annotations
@@ -20,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BASE = "69d2d94e68ce6aa3e8e13e676fe3174128a3c938"
+BASE = "c78ebbb4ad7094a6277f1188823205f36414bdeb"
 ROOT = Path(__file__).resolve().parent.parent
 
 SCENES = {
