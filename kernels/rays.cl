@@ -53,6 +53,26 @@ inline void sample_offset(int x, int y, int k, int n, real *ox, real *oy)
     *oy = ((real)(k / g) + (real)(h2 >> 8) * (real)(1.0 / 16777216.0)) / (real)g;
 }
 
+/* The ray o + t d (|d| = 1) within the bounding 4-ball |p| <= radius: [*near, *far], near
+ * clamped at the eye, each replaced by near_set / far_set where those are >= 0; returns the
+ * lanes whose ray meets the ball.  |o + t d|^2 = radius^2  ->  t = -b -+ sqrt(b^2 - (|o|^2 -
+ * radius^2)).  The discriminant is taken as radius^2 - |o - b d|^2 (the squared distance of
+ * the ray's closest approach), which is the same for |d| = 1 but does not cancel
+ * catastrophically: b^2 - |o|^2 loses everything in float32 for a camera 1e4 away
+ * (ulp(1e8) = 8 > radius^2), which threw near/far off by ~1 (extreme case camera_far). */
+inline lmask ball_span(quat o, quat d, real radius, real near_set, real far_set, lreal *near, lreal *far)
+{
+    lreal b = QDOT(o, d);
+    quat perp = QRAY(o, d, -b);
+    lreal disc = radius * radius - QNORM2(perp);
+    lreal s = sqrt(fmax(disc, (real)0));
+    *near = fmax(-b - s, (real)0);
+    *far = -b + s;
+    if (near_set >= (real)0) *near = (lreal)near_set;
+    if (far_set >= (real)0) *far = (lreal)far_set;
+    return disc >= (real)0;
+}
+
 __kernel void generate_rays(const int n_items, const real4 position, const real4 forward, const real4 right,
                             const real4 up, const real tan_half_fov, const int width,
                             const int height, const int x0, const int y0, const int tile_w,

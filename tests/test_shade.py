@@ -114,8 +114,7 @@ LIGHT_SCENES = {
 
 # the default run samples the light scenes (each builds programs of its own from cold); the
 # rest, whose switches the sampled ones share, run with -m slow
-LIGHT_SAMPLE = ("default", "fog+trap+cut", "hard+trap", "w", "three-lights-soft", "reflection-fixed-cut-eye",
-                "mandelbrot-trap", "hypercomplex")
+LIGHT_SAMPLE = ("default", "fog+trap+cut", "three-lights-soft", "reflection-fixed-cut-eye", "hypercomplex")
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=[] if n in LIGHT_SAMPLE else [pytest.mark.slow])
@@ -176,8 +175,8 @@ EVERYTHING = ["shading.light=-3,4,-2", "shading.ao=0.5", "shading.fog=0.3", "cli
                   "image.adaptive=true"], marks=pytest.mark.slow),
     ["shading.shadow=soft", "shading.coloring=w", "render.float=double", "normals.method=gradient",
      "shading.reflection=0.5", "shading.lights=direction 1,1,-1 color 0.2,0.3,1"],
-    ["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin",
-     "shading.lights=position -2,2,-2; position 2,-2,-2; position 0,3,0"],
+    pytest.param(["shading.coloring=trap", "fractal.algebra=hypercomplex", "fractal.function=sin",
+                  "shading.lights=position -2,2,-2; position 2,-2,-2; position 0,3,0"], marks=pytest.mark.slow),
     pytest.param(["shading.coloring=iteration", "fractal.algebra=cquat", "shading.specular=0",
                   "fractal.kind=mandelbrot", "fractal.max_iter=8", "shading.reflection=0.2"], marks=pytest.mark.slow),
     ["shading.shadow=soft", "fractal.algebra=hypercomplex", "fractal.function=cube", "render.variant=scalar",

@@ -46,12 +46,12 @@ def _cases():
             slow = lanes != max(packet_widths()) and i not in SAMPLED
             out.append(pytest.param(over, lanes, id=f"over{i}-{lanes}",
                                     marks=[pytest.mark.slow] if slow else []))
-    # double precision: its widest packet on a sample (the estimate, the fixed scan, the proven
-    # march, a transcendental function), the rest slow
+    # double precision: its widest packet on a sample (the default's estimate, a transcendental
+    # function's proven march), the rest slow
     for i, over in enumerate(SCENES):
         for lanes in packet_widths((8,), double=True):
             out.append(pytest.param(over + ["render.float=double"], lanes, id=f"over{i}-double-{lanes}",
-                                    marks=[] if i in (0, 1, 2, 8) else [pytest.mark.slow]))
+                                    marks=[] if i in (0, 8) else [pytest.mark.slow]))
     return out
 
 

@@ -51,16 +51,8 @@ __kernel void cone_starts(const int n_items, const int blocks_w, const int bx0, 
         ((real *)&d.x)[j] = dk.x; ((real *)&d.y)[j] = dk.y; ((real *)&d.z)[j] = dk.z; ((real *)&d.w)[j] = dk.w;
     }
 #endif
-    /* the ray's entry and exit of the bounding ball, as march/march.cl takes them */
-    lreal b = QDOT(o, d);
-    quat perp = QRAY(o, d, -b);
-    lreal disc = radius * radius - QNORM2(perp);
-    lreal s = sqrt(fmax(disc, (real)0));
-    lreal t = fmax(-b - s, (real)0);
-    lreal far = -b + s;
-    if (near_set >= (real)0) t = (lreal)near_set;
-    if (far_set >= (real)0) far = (lreal)far_set;
-    lmask active = (disc >= (real)0) & (far >= t);
+    lreal t, far;   /* the ray's entry and exit of the bounding ball, as march/march.cl takes them */
+    lmask active = ball_span(o, d, radius, near_set, far_set, &t, &far) & (far >= t);
     lreal t_lo = (lreal)INFINITY, t_last = (lreal)-1;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lmask escaped;

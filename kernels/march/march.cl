@@ -98,21 +98,8 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
     }
 #endif
 
-    /* |o + t d|^2 = radius^2  ->  t = -b -+ sqrt(b^2 - (|o|^2 - radius^2)).  The
-     * discriminant is taken as radius^2 - |o - b d|^2 (the squared distance of the
-     * ray's closest approach), which is the same for |d| = 1 but does not cancel
-     * catastrophically: b^2 - |o|^2 loses everything in float32 for a camera 1e4 away
-     * (ulp(1e8) = 8 > radius^2), which threw near/far off by ~1 (extreme case
-     * camera_far). */
-    lreal b = QDOT(o, d);
-    quat perp = QRAY(o, d, -b);
-    lreal disc = radius * radius - QNORM2(perp);
-    lreal s = sqrt(fmax(disc, (real)0));
-    lreal near = fmax(-b - s, (real)0);
-    lreal far = -b + s;
-    if (near_set >= (real)0) near = (lreal)near_set;
-    if (far_set >= (real)0) far = (lreal)far_set;
-    lmask live = valid & (disc >= (real)0);
+    lreal near, far;
+    lmask live = valid & ball_span(o, d, radius, near_set, far_set, &near, &far);
 #ifdef CLIP
     lmask cut = 0;                  /* 1 + the plane that set near, 0: the ball did */
     for (int k = 0; k < n_clip; ++k) {

@@ -9,7 +9,8 @@ import numpy as np
 from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
-from pyjulia4d.reference.iterate import dot4, julia_distance_formula
+from pyjulia4d.reference.iterate import julia_distance_formula
+from pyjulia4d.reference.march import ball_span
 
 CONE_SPREAD = 2.8285   # 2 sqrt(2), rounded up (march/cone.cl)
 
@@ -30,17 +31,8 @@ def cone_starts(frame: Frame, width: int, height: int, c, max_iter: int, bailout
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     o = np.tile(np.asarray(frame.position, np.float64), (len(d), 1))
     k = CONE_SPREAD * 2 * frame.tan_half_fov / height
-    b = dot4(o, d)
-    perp = o - b[:, None] * d
-    disc = radius * radius - dot4(perp, perp)
-    s = np.sqrt(np.maximum(disc, 0.0))
-    t = np.maximum(-b - s, 0.0)
-    far = -b + s
-    if near_set >= 0:
-        t = np.full_like(t, near_set)
-    if far_set >= 0:
-        far = np.full_like(far, far_set)
-    active = (disc >= 0) & (far >= t)
+    t, far, meets = ball_span(o, d, radius, near_set, far_set)
+    active = meets & (far >= t)
     t_lo, t_last = np.full(len(d), np.inf), np.full(len(d), -1.0)
     for i in range(max_steps):
         if not active.any():

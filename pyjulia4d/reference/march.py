@@ -285,7 +285,24 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         active, open_w + (far - t), np.where(hit, reach, open_w))
 
 
-# --------------------------------------------------------------------- march/march.cl
+# --------------------------------------------------------------------- rays.cl ball_span, march/march.cl
+
+def ball_span(o, d, radius, near_set, far_set):
+    """(near, far, meets): each ray o + t d (|d| = 1) within the bounding 4-ball, near clamped at
+    the eye, replaced by near_set / far_set where those are >= 0 (rays.cl ball_span)."""
+    b = dot4(o, d)
+    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye
+    perp = o - b[:, None] * d
+    disc = radius * radius - dot4(perp, perp)
+    s = np.sqrt(np.maximum(disc, 0.0))
+    near = np.maximum(-b - s, 0.0)
+    far = -b + s
+    if near_set >= 0:
+        near = np.full_like(near, near_set)
+    if far_set >= 0:
+        far = np.full_like(far, far_set)
+    return near, far, disc >= 0
+
 
 def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
           z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
@@ -303,18 +320,7 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     that first point is inside."""
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
-    b = dot4(o, d)
-    # radius^2 - |o - b d|^2, not b^2 - (|o|^2 - radius^2): no cancellation for a far eye (march/march.cl)
-    perp = o - b[:, None] * d
-    disc = radius * radius - dot4(perp, perp)
-    s = np.sqrt(np.maximum(disc, 0.0))
-    near = np.maximum(-b - s, 0.0)
-    far = -b + s
-    if near_set >= 0:
-        near = np.full_like(near, near_set)
-    if far_set >= 0:
-        far = np.full_like(far, far_set)
-    live = disc >= 0
+    near, far, live = ball_span(o, d, radius, near_set, far_set)
     cut = np.zeros(len(o), np.int64)      # 1 + the plane that set near (march.cl, -D CLIP)
     for k, (m, off) in enumerate(clip or ()):
         dn, on = d @ m, o @ m - off
