@@ -195,10 +195,10 @@ def test_proven_segments_hold_no_inside_point(algebra, function, how):
 _SLOW = pytest.mark.slow
 KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0.0, marks=_SLOW),
                 ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
-                pytest.param("hypercomplex", "tan", 0.0, marks=_SLOW), ("hypercomplex", "ln", 0.0),
+                pytest.param("hypercomplex", "tan", 0.0, marks=_SLOW), pytest.param("hypercomplex", "ln", 0.0, marks=_SLOW),
                 pytest.param("hypercomplex", "asinh", 0.0, marks=_SLOW), ("cquat", "cube", 0.0),
                 pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0),
-                ("quaternion", "sqr", "mandelbrot"), ("hypercomplex", "sinh", "mandelbrot"),
+                ("quaternion", "sqr", "mandelbrot"), pytest.param("hypercomplex", "sinh", "mandelbrot", marks=_SLOW),
                 pytest.param("cquat", "cube", "mandelbrot", marks=_SLOW), ("quaternion", "sqr", "julia_stack"),
                 ("quaternion", "sqr", "cubic_locus")]
 
@@ -262,13 +262,14 @@ def march_on_rays(s, o, d):
     return (depth.get().astype(float), status.get(), bracket.get().astype(float), unresolved.get().astype(float))
 
 
-@pytest.mark.parametrize("algebra,function,kind", [("quaternion", "cube", "julia"), ("hypercomplex", "sin", "julia"),
+@pytest.mark.parametrize("algebra,function,kind", [pytest.param("quaternion", "cube", "julia", marks=_SLOW),
+                                                   ("hypercomplex", "sin", "julia"),
                                                    pytest.param("hypercomplex", "cosh", "julia", marks=_SLOW),
                                                    pytest.param("cquat", "sqr", "julia", marks=_SLOW),
                                                    pytest.param("commutative", "cube", "julia", marks=_SLOW),
                                                    ("quaternion", "sqr", "mandelbrot"),
                                                    pytest.param("hypercomplex", "cosh", "mandelbrot", marks=_SLOW),
-                                                   ("quaternion", "sqr", "julia_stack"),
+                                                   pytest.param("quaternion", "sqr", "julia_stack", marks=_SLOW),
                                                    pytest.param("quaternion", "sqr", "cubic_locus", marks=_SLOW)])
 def test_stated_interval_holds_the_brute_force(algebra, function, kind):
     # the cubic locus hits few pixels of a small view, and its spikes can be thinner than the

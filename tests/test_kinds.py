@@ -183,7 +183,8 @@ def test_mandelbrot_probe_matches_reference(algebra, function, fl):
 
 @pytest.mark.parametrize("over", [
     ("quaternion", "sqr", "camera.position=-0.5,1.4,-2.6,0", "camera.target=-0.5,0,0,0"),
-    ("quaternion", "cube", "camera.position=0.3,1.6,-2.4,0.5", "march.method=fixed"),
+    pytest.param(("quaternion", "cube", "camera.position=0.3,1.6,-2.4,0.5", "march.method=fixed"),
+                 marks=pytest.mark.slow),   # the suite's five minutes; the fixed scan's kinds: test_stack_locus
     ("hypercomplex", "sqr", "camera.position=-0.4,2.2,-3.2,0", "camera.target=-0.4,0,0,0",
      "normals.method=gradient"),
 ])
@@ -204,7 +205,8 @@ def test_mandelbrot_render_matches_reference(over):
 @pytest.mark.parametrize("lanes", packet_widths((8,)))
 @pytest.mark.parametrize("over", [
     ["fractal.kind=mandelbrot", "camera.position=-0.5,1.4,-2.6,0", "camera.target=-0.5,0,0,0"],
-    ["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "camera.position=-0.5,2,-3,0"],
+    pytest.param(["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "camera.position=-0.5,2,-3,0"],
+                 marks=pytest.mark.slow),
     ["fractal.theta=60", "fractal.function=cube", "fractal.c=0.3,0.4,0,0"],
 ])
 def test_new_kinds_packets_give_the_same_pixels(over, lanes):
