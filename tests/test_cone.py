@@ -119,3 +119,38 @@ def test_the_cone_saves_steps_and_keeps_the_picture():
     assert on.samples.mean() < 0.9 * off.samples.mean()   # 0.68 at 640x480: the cones are narrower
     # the unresolved stretch is measured from the entry either way (the estimate proves nothing)
     assert np.allclose(on.unresolved[hit], on.depth[hit] - (off.depth[hit] - off.unresolved[hit]), atol=1e-5)
+
+
+def _random_scene(rng) -> list[str]:
+    alg = str(rng.choice(["quaternion", "hypercomplex"]))
+    c = rng.uniform(-0.8, 0.8, 4) * rng.uniform(0.2, 1.0)
+    if alg == "hypercomplex":
+        c[3] = 0.0
+    pos = rng.normal(size=4)
+    pos[3] *= 0.3
+    pos *= rng.uniform(1.8, 12) / np.linalg.norm(pos)
+    return [f"fractal.algebra={alg}", f"fractal.function={rng.choice(['sqr', 'cube'])}",
+            "fractal.c=" + ",".join(f"{x:.4f}" for x in c), "camera.position=" + ",".join(f"{x:.3f}" for x in pos),
+            f"camera.fov={rng.uniform(5, 90):.1f}", f"image.width={int(rng.integers(17, 100))}",
+            f"image.height={int(rng.integers(13, 80))}", "march.method=de",
+            f"fractal.max_iter={int(rng.integers(4, 30))}", f"render.float={rng.choice(['single', 'double'])}",
+            f"image.samples={int(rng.choice([1, 2, 4]))}"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(12))
+def test_random_scenes_with_and_without_the_cone(seed):
+    """Random squares and cubes (c, camera, field of view, size, samples, precision; the
+    estimate forced, dust included): finite outputs, and the same pixels hit with the cone
+    and without on 98 % of the pixels or more (80 such scenes measured 98.95 % at the least,
+    a dust set on which both missed 0.8 % of the proven march's pixels, and 100 % on most)."""
+    s = Scene.default().with_overrides(_random_scene(np.random.default_rng(seed)))
+    on = render(s, force=True)
+    original = kernel_config.cone_start
+    try:
+        kernel_config.cone_start = lambda scene: False
+        off = render(s, force=True)
+    finally:
+        kernel_config.cone_start = original
+    assert np.all(np.isfinite(on.color)) and not np.any(np.isnan(on.depth))
+    assert np.mean(on.status == off.status) >= 0.98
