@@ -33,11 +33,10 @@ __kernel void cone_starts(const int n_items, const int blocks_w, const int bx0, 
         return;
     julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_NONE };
     real k = CONE_SPREAD * (real)2 * tan_half_fov / (real)image_h;
-    quat o, d;
+    quat o = QUAT((lreal)eye.x, (lreal)eye.y, (lreal)eye.z, (lreal)eye.w), d;   /* every ray leaves the eye */
 #if LANES == 1
     {
         int bx = bx0 + (int)(i0 % (size_t)blocks_w), by = by0 + (int)(i0 / (size_t)blocks_w);
-        o = eye;
         d = camera_ray_at(bx * CONE_BLOCK, by * CONE_BLOCK, (real)(CONE_BLOCK / 2), (real)(CONE_BLOCK / 2),
                           forward, right, up, tan_half_fov, image_w, image_h);
     }
@@ -47,7 +46,6 @@ __kernel void cone_starts(const int n_items, const int blocks_w, const int bx0, 
         int bx = bx0 + (int)(i % (size_t)blocks_w), by = by0 + (int)(i / (size_t)blocks_w);
         real4 dk = camera_ray_at(bx * CONE_BLOCK, by * CONE_BLOCK, (real)(CONE_BLOCK / 2), (real)(CONE_BLOCK / 2),
                                  forward, right, up, tan_half_fov, image_w, image_h);
-        ((real *)&o.x)[j] = eye.x; ((real *)&o.y)[j] = eye.y; ((real *)&o.z)[j] = eye.z; ((real *)&o.w)[j] = eye.w;
         ((real *)&d.x)[j] = dk.x; ((real *)&d.y)[j] = dk.y; ((real *)&d.z)[j] = dk.z; ((real *)&d.w)[j] = dk.w;
     }
 #endif

@@ -202,6 +202,8 @@ class TileRunner:
         self.fog = (np.float32(sa.fog), np.float32(sa.fog_start))
         self.march_k = cl.Kernel(self.march_prg, "march")
         self.cone_k = cl.Kernel(self.march_prg, "cone_starts") if plan.march.cone else None
+        self.cone_const = (pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.radius),
+                           pr.scalar(ma.near), pr.scalar(ma.far), np.int32(ma.max_steps))
         planes = plan.clip.planes
         self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
         self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
@@ -243,12 +245,9 @@ class TileRunner:
         n = tile.n
         kernels, cone = [], ()
         if self.cone_k is not None:
-            ma = plan.march
             bx0, by0, bw, bh = tile.cone_blocks()
             kernels.append(launch(q, self.cone_k, bw * bh, np.int32(bw), np.int32(bx0), np.int32(by0), *self.camera,
-                                  pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.radius),
-                                  pr.scalar(ma.near), pr.scalar(ma.far), np.int32(ma.max_steps), bufs["cone"].data,
-                                  lanes=plan.lanes))
+                                  *self.cone_const, bufs["cone"].data, lanes=plan.lanes))
             cone = (bufs["cone"].data, np.int32(bw))
         kernels.append(launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
                               np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const,

@@ -8,8 +8,9 @@ is found by a probe that cannot take a render down: a child process builds and r
 packet march at 16, then 8, then 4 lanes on a tiny scene and compares it with the one-ray
 kernel; the widest that passes is used.  Double precision has its own probe, of 8 and 4
 lanes: eight doubles fill the register sixteen floats do, and 16 ran slower than 8 on both
-CPU runtimes here (default scene, 320x240: 1.4x slower on Intel's, 1.0x on PoCL).  PyPI's PoCL 3.0 killed the process with SIGSEGV on
-float16 kernels, which is why the probe runs apart.  The answer is cached per device and
+CPU runtimes here (default scene, 320x240: 1.4x slower on Intel's, 1.0x on PoCL).  PyPI's
+PoCL 3.0 killed the process with SIGSEGV on float16 kernels, which is why the probe runs
+apart.  The answer is cached per device and
 driver version in ``~/.cache/pyjulia4d/lanes.json`` and ``lanes_double.json``
 (``PYJULIA4D_CACHE`` moves them).
 """
@@ -87,11 +88,6 @@ def march_lanes(width: int, method: str) -> int:
     return min(width, PROVEN_LANES) if method == "proven" else width
 
 
-def probe_double(device: cl.Device) -> int:
-    """probe in double precision."""
-    return probe(device, double=True)
-
-
 def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     """Rays per work-item of the march for ``render.variant`` on ``device``: 1 for
     "scalar" and for GPUs under "auto"; for "packet", or a CPU under "auto", the width
@@ -101,5 +97,5 @@ def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     if variant == "auto" and device_type(device) != "CPU":
         return 1
     if double:
-        return int(remembered("lanes_double", device, int, probe_double))
+        return int(remembered("lanes_double", device, int, lambda d: probe(d, double=True)))
     return int(remembered("lanes", device, int, probe))

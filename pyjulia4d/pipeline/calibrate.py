@@ -34,13 +34,13 @@ REFUSE_SECONDS = 6 * 3600.0    # refuse (unless forced) when it is longer than t
 # runtime (0.09 of 0.57 on PoCL; benchmarks/peers.py's plain look); that render's bound is
 # 12 s, its truth 0.1 s, so Ctrl-C, honoured between tiles, still comes within a tile.
 SKIP_BELOW_SECONDS = 20.0
+TILE_SECONDS = 0.1             # the work of one tile: the latency of Ctrl-C
+MIN_TILE = 16
 
 
 def wanted(bound_seconds: float) -> bool:
     """Whether a render whose work is bounded by ``bound_seconds`` needs the probe."""
     return bound_seconds > min(SKIP_BELOW_SECONDS, WARN_SECONDS)
-TILE_SECONDS = 0.1             # the work of one tile: the latency of Ctrl-C
-MIN_TILE = 16
 
 
 @dataclass(frozen=True)
