@@ -1,4 +1,4 @@
-"""Command line: ``pyjulia4d render|animate|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
+"""Command line: ``pyjulia4d render|animate|explore|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
 
 Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
 status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
@@ -14,13 +14,14 @@ import warnings
 from pathlib import Path
 from typing import Any, Iterator, NoReturn, Sequence
 
-from pyjulia4d.app.output import check_output_path, write_image
+from pyjulia4d.app.output import check_output_path, render_header, write_image
 from pyjulia4d.pipeline.progress import clear_stop, request_stop
 from pyjulia4d.scene.model import Scene
-from pyjulia4d.scene.checks import SceneError, show_key
+from pyjulia4d.scene.checks import SceneError, one_line, show_key
 from pyjulia4d.scene.text import override_key
 
 PROG = "pyjulia4d"
+DEFAULT_PORT = 8470   # explore's port
 
 
 class UsageError(Exception):
@@ -88,6 +89,20 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--channels", metavar="LIST", help="EXR channel groups (as for render)")
     a.add_argument("--force", action="store_true", help="render frames whose work is refused as hopeless")
     _cluster_options(a, "whole frames")
+
+    e = sub.add_parser("explore", help="explore a scene in the browser: a local page that renders as you drag")
+    e.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
+                   help="scene to start from, or an image pyjulia4d rendered (default: the built-in scene)")
+    e.add_argument("--port", metavar="N", default=str(DEFAULT_PORT),
+                   help=f"port to listen on (default {DEFAULT_PORT}; 0: any free one)")
+    e.add_argument("--host", metavar="ADDRESS", default="127.0.0.1",
+                   help="address to listen on (default 127.0.0.1: this machine only)")
+    e.add_argument("--folder", metavar="DIR", default=".",
+                   help="where the page saves scenes, images and animations (default: the current directory)")
+    e.add_argument("--no-browser", action="store_true", help="do not open the page in a browser")
+    e.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene value, as for render")
+    e.add_argument("--device", metavar="SPEC", help="OpenCL device (as for render)")
 
     sub.add_parser("devices", help="list the OpenCL devices, which cannot compile, and the default")
 
@@ -165,15 +180,13 @@ def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
 
 
 def _render(args: argparse.Namespace) -> int:
-    overrides = _size_overrides(args)
-    if args.scene is None:   # the built-in scene; framed (camera.fit) unless a position is set
-        scene = Scene.from_dict({}, overrides)
+    # the built-in scene is framed (camera.fit) unless a position is set; an image is rendered again
+    scene = _scene_of(args.scene, _size_overrides(args))
+    if args.scene is None:
         default_out = "julia.png"
-    elif Path(args.scene).suffix.lower() in IMAGE_SUFFIXES:   # render it again
-        scene = scene_from_image(args.scene, overrides)
+    elif Path(args.scene).suffix.lower() in IMAGE_SUFFIXES:
         default_out = Path(args.scene).stem + "-rerender.png"
     else:
-        scene = Scene.from_toml(args.scene, overrides)
         default_out = Path(args.scene).stem + ".png"
     out = check_output_path(default_out if args.output is None else args.output)
     outputs = _outputs(args.channels, out)
@@ -189,14 +202,8 @@ def _render(args: argparse.Namespace) -> int:
         from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
 
         result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
-    from pyjulia4d.scene.quality import resolved_quality, stated_p99
-
-    # capped rays, the guards that fired, the certified depth bracket and the unresolved
-    # space are part of the result: said in the header and the closing line, never hidden
-    report, tail = result.report(stated_p99(resolved_quality(scene)))
-    # the scene as rendered: with camera.fit, the camera the framing pass chose
+    header, tail = render_header(scene, result)
     rendered = getattr(result, "scene", None) or scene
-    header = {"pyjulia4d.scene": rendered.to_toml(), **report}
     if scene.camera.fit and rendered is not scene:
         pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
         tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
@@ -211,6 +218,26 @@ def _render(args: argparse.Namespace) -> int:
         f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
     return 0
+
+
+def _scene_of(path: str | None, overrides: Sequence[str]) -> Scene:
+    """The scene a command starts from: the built-in one (framed), a scene file, or the scene
+    in an image's header."""
+    if path is None:
+        return Scene.from_dict({}, overrides)
+    if Path(path).suffix.lower() in IMAGE_SUFFIXES:
+        return scene_from_image(path, overrides)
+    return Scene.from_toml(path, overrides)
+
+
+def _explore(args: argparse.Namespace) -> int:
+    """explore: the local page (app/explore/); every argument checked before the device."""
+    from pyjulia4d.app.explore.run import check_folder, check_port, explore
+
+    port = check_port(args.port)
+    folder = check_folder(args.folder)
+    scene = _scene_of(args.scene, args.overrides)
+    return explore(scene, select_device(args.device), args.host, port, folder, not args.no_browser)
 
 
 def _animate(args: argparse.Namespace) -> int:
@@ -249,7 +276,7 @@ def _import_pov(args: argparse.Namespace) -> int:
     out = check_toml_path(args.output if args.output is not None else Path(args.pov).stem + ".toml", args.pov)
     write_toml(out, imported.toml)
     for w in imported.warnings:
-        _say(f"pyjulia4d: warning: {_one_line(Warning(w))}")
+        _say(f"pyjulia4d: warning: {one_line(Warning(w))}")
     s = imported.scene
     print(f"wrote {out}: {s.fractal.algebra} {s.fractal.function}, c = {list(s.fractal.c)}, "
           f"max_iter {s.fractal.max_iter}, {s.image.width}x{s.image.height} "
@@ -281,10 +308,6 @@ def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
     return tuple(o for g in groups for o in CHANNEL_GROUPS[g])
 
 
-def _one_line(e: BaseException) -> str:
-    return " ".join(str(e).splitlines()) or type(e).__name__
-
-
 def _say(line: str) -> None:
     """One line on stderr, whatever its encoding, even with the terminal gone."""
     try:
@@ -297,7 +320,7 @@ def _say(line: str) -> None:
 
 
 def _warn_one_line(message, category, filename, lineno, file=None, line=None) -> None:
-    _say(f"pyjulia4d: warning: {_one_line(Warning(message))}")
+    _say(f"pyjulia4d: warning: {one_line(Warning(message))}")
 
 
 _SIGNALS = tuple(getattr(signal, s) for s in ("SIGTERM", "SIGHUP") if hasattr(signal, s))
@@ -338,7 +361,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = _parser().parse_args(argv)
     except UsageError as e:
-        _say(f"pyjulia4d: error: {_one_line(e)} (see --help)")
+        _say(f"pyjulia4d: error: {one_line(e)} (see --help)")
         return 2
     shown = warnings.showwarning
     warnings.showwarning = _warn_one_line  # workload and precision warnings: one line each
@@ -362,9 +385,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _import_pov(args)
             if args.command == "animate":
                 return _animate(args)
+            if args.command == "explore":
+                return _explore(args)
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
-        _say(f"pyjulia4d: error: {_one_line(e)}")
+        _say(f"pyjulia4d: error: {one_line(e)}")
         return 2
     except KeyboardInterrupt:
         _say("pyjulia4d: interrupted")

@@ -168,6 +168,19 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
         raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
 
 
+def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:
+    """An image's header entries - the scene as rendered (with camera.fit, the camera the
+    framing pass chose: the same picture comes back from it) and the render's report - and the
+    tail of the closing line that says the same (RenderResult.report)."""
+    from pyjulia4d.scene.quality import resolved_quality, stated_p99
+
+    # capped rays, the guards that fired, the certified depth bracket and the unresolved
+    # space are part of the result: said in the header and the closing line, never hidden
+    report, tail = result.report(stated_p99(resolved_quality(scene)))
+    rendered = getattr(result, "scene", None) or scene
+    return {"pyjulia4d.scene": rendered.to_toml(), **report}, tail
+
+
 def read_header(path: str | Path) -> dict[str, str] | None:
     """An image's header entries (PNG text chunks, EXR string attributes), as write_image
     wrote them; None if it cannot be read."""

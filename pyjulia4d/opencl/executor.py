@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import time
 import warnings
+from typing import Callable
 
 import numpy as np
 import pyopencl as cl
@@ -337,7 +338,8 @@ def _seconds(events) -> float:
 
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False, tile: int = TILE, lanes: int | None = None,
-           outputs=None, region=None, calibrate: bool = True) -> RenderResult:
+           outputs=None, region=None, calibrate: bool = True,
+           on_progress: Callable[[int, int], None] | None = None) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
@@ -347,7 +349,10 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     (x0, y0, w, h) renders those pixels of the image alone, bit for bit as the whole
     render has them (the distributed renderer's unit of one frame).  ``calibrate``: a probe
     render of the scene predicts the time first (calibrate.py: refuse, warn, size the tiles
-    so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``."""
+    so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``.
+    ``on_progress(pixels done, pixels in all)`` is called as each tile is filed (antialiasing's
+    passes count again); an exception it raises abandons the render (the explorer's stale
+    previews)."""
     t_start = time.perf_counter()
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
@@ -356,12 +361,14 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
                                    f"{type(device).__name__}")
     for name, value in (("progress", progress), ("calibrate", calibrate), ("force", force)):
         check_flag(name, value)
+    if on_progress is not None and not callable(on_progress):
+        raise SceneError("on_progress", f"expected None or a callable, got {type(on_progress).__name__}")
     if lanes is not None:
         check_lanes(lanes)
     check_tile(tile)
     dev = device if isinstance(device, cl.Device) else select_device(device)
     plan, prediction = plan_render(scene, dev, lanes, outputs, force, tile, region, calibrate)
-    result = run_plan(plan, dev, progress)
+    result = run_plan(plan, dev, progress, on_progress)
     result.prediction = prediction
     result.seconds = time.perf_counter() - t_start
     return result
@@ -420,10 +427,12 @@ def planar_empty(shape: tuple, dtype) -> np.ndarray:
     return np.empty(shape, dtype)
 
 
-def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult:
+def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
+             on_progress: Callable[[int, int], None] | None = None) -> RenderResult:
     """Execute ``plan`` on ``dev``, tile by tile: its pixels through rays, march, normals and
     shading, the antialiasing passes, filed into the image; the counts, guards and kernel
-    time go into the result (its ``seconds`` are the kernels' and the filing's)."""
+    time go into the result (its ``seconds`` are the kernels' and the filing's).
+    ``on_progress``: as for render."""
     t_start = time.perf_counter()
     scene, lanes = plan.scene, plan.lanes
     runner = TileRunner(plan, dev)
@@ -489,7 +498,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False) -> RenderResult
             note(t, got)
 
     with Progress(W * H * (1 + S if aa else 1), "render", "px", enabled=progress, line=_render_line,
-                  unit_scale=True) as bar:
+                  unit_scale=True, hook=on_progress) as bar:
         # the centre of each pixel: every output (depth, normal, position come from it)
         _run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
         if aa:

@@ -31,8 +31,11 @@ def clear_stop() -> None:
 
 class Progress:
     def __init__(self, total: int, desc: str, unit: str, enabled: bool = True, line: LineText | None = None,
-                 first: float = 3.0, every: float = 10.0, unit_scale: bool = False, delay: float = 1.0) -> None:
-        self.total, self.n, self.enabled, self.every = total, 0, enabled, every
+                 first: float = 3.0, every: float = 10.0, unit_scale: bool = False, delay: float = 1.0,
+                 hook: Callable[[int, int], None] | None = None) -> None:
+        """``hook(n, total)`` is called after every update, shown or not; an exception it raises
+        stops the work (explore's renders: a newer request makes the running one stale)."""
+        self.total, self.n, self.enabled, self.every, self.hook = total, 0, enabled, every, hook
         self.t0 = time.perf_counter()
         self.last = self.t0 - every + first
         self.line = line or (lambda n, total, spent, left, note:
@@ -47,6 +50,8 @@ class Progress:
         if _stop:
             raise _stop[0]
         self.n += k
+        if self.hook is not None:
+            self.hook(self.n, self.total)
         if self.bar is not None:
             self.bar.update(k)
             return

@@ -31,6 +31,11 @@ class SceneError(ValueError):
         return (SceneError, (self.key, self.reason))
 
 
+def one_line(e: BaseException) -> str:
+    """An exception's message on one line (the command line's and the explorer's errors)."""
+    return " ".join(str(e).splitlines()) or type(e).__name__
+
+
 # A checker is called as check(dotted key, raw value) and returns the normalised value;
 # ``valid`` is its valid range in words, as README's "Scene keys" table shows it.
 #

@@ -1,0 +1,208 @@
+"""The explorer's render loop, shared by the page (server.py) and the notebook (notebook.py).
+
+- The latest request wins: a request replaces any that waits, and the render in progress
+  is abandoned at its next tile (executor.render's ``on_progress`` raises Stale), so no queue
+  of stale frames builds up behind a drag.
+- While a control moves, one small preview per request, its size chosen from the speed of
+  the last ones so that a preview takes about PREVIEW_SECONDS.
+- At rest, progressive refinement: the preview, half size, the full size, then the full size
+  with the scene's image.samples, each shown as it is done.  The last stage renders the scene
+  exactly as given, so the picture at rest is the one ``pyjulia4d render`` makes of the saved
+  scene on the same device.
+
+Fractal artists know this from Mandelbulber2's navigator and Fragmentarium's progressive
+refinement.  The loop knows nothing of the page: it calls ``render(scene, on_progress)`` and
+hands each Picture to ``show``, each one-line error to ``fail``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import io
+import math
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from pyjulia4d.scene.checks import one_line
+from pyjulia4d.scene.model import Scene
+
+# A preview's aim (render time alone); the page asks at most one per frame of its display.
+PREVIEW_SECONDS = 0.08
+MIN_PREVIEW_PIXELS = 64 * 48
+FIRST_RATE = 3e5          # pixels per second assumed before the first preview is timed
+
+
+class Stale(Exception):
+    """The render was overtaken by a newer request (raised inside on_progress)."""
+
+
+@dataclass(frozen=True)
+class Picture:
+    """One finished stage: its PNG (8-bit sRGB, no alpha: misses show the background), the
+    scene as rendered (camera.fit resolved), and the render's facts in words."""
+    generation: int
+    stage: str            # "preview", "refine" or "final"
+    scene: Scene
+    png: bytes
+    facts: dict
+
+
+def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str, Scene]]:
+    """The renders one request makes: a preview of about ``preview_pixels`` pixels; at rest
+    (``moving`` false) then half size and the full size, and the full size again with
+    image.samples where that is above 1."""
+    w, h, s = scene.image.width, scene.image.height, scene.image.samples
+    full = w * h
+    k = min(1.0, math.sqrt(max(MIN_PREVIEW_PIXELS, preview_pixels) / full))
+
+    def sized(f: float, samples: int = 1) -> Scene:
+        return scene.replace(**{"image.width": max(1, round(w * f)), "image.height": max(1, round(h * f)),
+                                "image.samples": samples, "image.adaptive": False})
+
+    out = []
+    if k < 1.0:
+        out.append(("preview", sized(k)))
+    if moving and out:
+        return out
+    if 0.25 * full > 1.5 * k * k * full:   # a half-size stage well above the preview's size
+        out.append(("refine", sized(0.5)))
+    if s > 1 or scene.image.adaptive:
+        out.append(("refine", sized(1.0)))
+    out.append(("final", scene))
+    return out
+
+
+def picture_png(color: np.ndarray) -> bytes:
+    """(H, W, 3) linear colour -> PNG bytes, sRGB-encoded, fast zlib level (a local page)."""
+    from PIL import Image
+
+    from pyjulia4d.app.output import to_u8
+    from pyjulia4d.pipeline.colormap import linear_to_srgb
+
+    rgb = to_u8(linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0)))
+    buf = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(rgb)).save(buf, format="PNG", compress_level=1)
+    return buf.getvalue()
+
+
+def facts(result: Any, stage: str) -> dict:
+    """What the page shows of a render: size, time, share hit, the depth bracket, the pixels
+    left unresolved, capped rays and the guards that fired (result.report's words)."""
+    header, _ = result.report()
+    h, w = result.color.shape[:2]
+    un = result.unresolved_counts()
+    return {"stage": stage, "size": f"{w}x{h}", "seconds": f"{result.seconds:.3f}",
+            "hit": f"{100 * result.hit_fraction:.1f} %",
+            "bracket": header["pyjulia4d.depth_bracket"] or "none hit",
+            "error": header["pyjulia4d.depth_error"] if result.proven else "not proven (the march proves nothing)",
+            "unresolved": f"{un['hit']} hits, {un['miss']} misses",
+            "capped": str(result.capped),
+            "guards": ", ".join(f"{k} {v}" for k, v in result.guards.items() if v) or "none",
+            "device": result.device_name}
+
+
+class RenderLoop:
+    """A worker thread rendering the latest request (see the module's docstring)."""
+
+    def __init__(self, render: Callable[[Scene, Callable[[int, int], None]], Any],
+                 show: Callable[[Picture], None], fail: Callable[[str], None],
+                 preview_seconds: float = PREVIEW_SECONDS) -> None:
+        self._render, self._show, self._fail = render, show, fail
+        self.preview_seconds = preview_seconds
+        self.rate = FIRST_RATE
+        self._cond = threading.Condition()
+        self._pending: tuple[int, Scene, bool] | None = None
+        self._generation = 0
+        self._closed = False
+        self._thread = threading.Thread(target=self._run, name="pyjulia4d-explore", daemon=True)
+        self._thread.start()
+
+    def request(self, scene: Scene, moving: bool = False) -> int:
+        """Render ``scene`` (replacing whatever waits or runs); returns its generation."""
+        with self._cond:
+            self._generation += 1
+            self._pending = (self._generation, scene, bool(moving))
+            self._moving = bool(moving)
+            self._cond.notify()
+            return self._generation
+
+    @property
+    def generation(self) -> int:
+        return self._generation
+
+    def idle(self) -> bool:
+        """Nothing waits and nothing runs."""
+        with self._cond:
+            return self._pending is None and not self._busy
+
+    _busy = False
+    _moving = False
+
+    def close(self, timeout: float = 10.0) -> None:
+        with self._cond:
+            self._closed = True
+            self._generation += 1
+            self._cond.notify()
+        self._thread.join(timeout)
+
+    def _stop_if_stale(self, generation: int, stage: list[str]) -> Callable[[int, int], None]:
+        """on_progress for the stages of ``generation``: Stale once a newer request came, except
+        that a preview is finished while the newer one is a preview too - a drag sends
+        requests faster than previews render, and cancelling each would show none."""
+        def check(done: int, total: int) -> None:
+            if self._generation != generation and not (stage[0] == "preview" and self._moving):
+                raise Stale()
+        return check
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                while self._pending is None and not self._closed:
+                    self._busy = False
+                    self._cond.wait()
+                if self._closed:
+                    return
+                (generation, scene, moving), self._pending = self._pending, None
+                self._busy = True
+            self._serve(generation, scene, moving)
+
+    def _serve(self, generation: int, scene: Scene, moving: bool) -> None:
+        current = [""]
+        check = self._stop_if_stale(generation, current)
+        try:
+            plan = stages(scene, moving, self.rate * self.preview_seconds)
+        except ValueError as e:
+            self._fail(one_line(e))
+            return
+        camera = None   # the camera a framing pass chose (camera.fit), kept for the later stages
+        for stage, s in plan:
+            if self._generation != generation:
+                return
+            if camera is not None:
+                s = dataclasses.replace(s, camera=camera)
+            current[0] = stage
+            t0 = time.perf_counter()
+            try:
+                result = self._render(s, check)
+                png = picture_png(result.color)
+            except Stale:
+                return
+            except ValueError as e:   # SceneError, a refusal, a device's one-line error
+                self._fail(one_line(e))
+                return
+            except Exception as e:   # never a dead page: the error in one line, the loop goes on
+                self._fail(f"render failed: {type(e).__name__}: {one_line(e)}")
+                return
+            seconds = time.perf_counter() - t0
+            if stage == "preview" and seconds > 0:
+                pixels = s.image.width * s.image.height
+                self.rate = 0.5 * self.rate + 0.5 * pixels / seconds
+            rendered = result.scene or s
+            if s.camera.fit:
+                camera = rendered.camera
+            if self._generation != generation and stage != "preview":
+                return
+            self._show(Picture(generation, stage, rendered, png, facts(result, stage)))

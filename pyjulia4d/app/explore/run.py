@@ -1,0 +1,95 @@
+"""Starting the explorer: the renderer behind a session, the first pass that frames the scene
+and builds its kernels before the page opens, and ``pyjulia4d explore`` itself."""
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+import threading
+from pathlib import Path
+from typing import Any, Callable
+
+from pyjulia4d.app.explore.loop import stages
+from pyjulia4d.app.explore.session import Render
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.model import Scene
+
+# The explorer's tiles: a stale stage is abandoned at the end of a tile (loop.py), so they
+# are smaller than a file render's (pipeline/plan.py TILE = 512).
+EXPLORE_TILE = 128
+# What a stage keeps: the picture and the facts it shows (loop.facts).
+STAGE_OUTPUTS = ("color", "alpha", "bracket", "unresolved")
+WARM_PIXELS = 160 * 120
+
+
+def device_renderer(device: Any) -> Render:
+    """session.Render on an OpenCL device: a stage in small tiles without the time probe;
+    the file render as ``pyjulia4d render`` makes it (probed, every output)."""
+    from pyjulia4d.opencl.executor import render
+
+    def run(scene: Scene, hook: Callable[[int, int], None], whole: bool) -> Any:
+        if whole:
+            return render(scene, device=device, on_progress=hook)
+        return render(scene, device=device, on_progress=hook, calibrate=False, tile=EXPLORE_TILE,
+                      outputs=STAGE_OUTPUTS)
+
+    return run
+
+
+def warm(scene: Scene, render: Render) -> Scene:
+    """The scene after a small first render: framed (camera.fit resolved, so that each page
+    starts from the same camera), its kernels built."""
+    _, first = stages(scene, True, WARM_PIXELS)[0]
+    result = render(first, lambda done, total: None, False)
+    rendered = getattr(result, "scene", None)
+    if scene.camera.fit and rendered is not None:
+        return dataclasses.replace(scene, camera=rendered.camera)
+    return scene
+
+
+def check_folder(folder: str) -> Path:
+    """--folder: an existing, writable directory."""
+    p = Path(folder)
+    shown = folder if folder.isprintable() else repr(folder)
+    if not p.is_dir():
+        raise SceneError("--folder", f"{shown}: no such directory")
+    if not os.access(p, os.W_OK | os.X_OK):
+        raise SceneError("--folder", f"{shown}: cannot write there")
+    return p.resolve()
+
+
+def check_port(text: str) -> int:
+    s = text.strip()
+    if not (s.isascii() and s.isdigit() and len(s) <= 5 and int(s) <= 65535):
+        raise SceneError("--port", f"expected a port number in [0, 65535] (0: any free one), got {text!r}"[:120])
+    return int(s)
+
+
+def explore(scene: Scene, device: Any, host: str, port: int, folder: Path, open_browser: bool) -> int:
+    """Frame and build, bind, say where it listens, open the browser, serve until Ctrl-C."""
+    from pyjulia4d.app.explore.server import LOCAL_HOSTS, bind, make_app, serve, url_of
+
+    render = device_renderer(device)
+    scene = warm(scene, render)
+    try:
+        sock = bind(host, port)
+    except OSError as e:
+        raise SceneError("--port", f"cannot listen on {host} port {port}: {e.strerror or e}"
+                         + ("; --port 0 picks a free one" if port else "")) from None
+    url = url_of(sock)
+    hosts = tuple(dict.fromkeys(LOCAL_HOSTS + (host.strip("[]"), host)))
+    app = make_app(scene, render, folder, hosts if host not in ("0.0.0.0", "::") else ("*",))
+
+    def started() -> None:
+        print(f"pyjulia4d explore: listening on {url} (files are saved in {folder}; Ctrl-C stops)", flush=True)
+        if open_browser:
+            import webbrowser
+
+            threading.Thread(target=webbrowser.open, args=(url,), daemon=True).start()
+
+    try:
+        serve(app, sock, started)
+    finally:
+        sock.close()
+    sys.stdout.flush()
+    return 0
