@@ -182,10 +182,10 @@ def form_html(scene: Scene) -> str:
             for name in c.names():
                 esc = html.escape(name, quote=True)
                 if c.widget == "select":
-                    options = _options(c, scene)
+                    choices = options(c, scene)
                     opts = "".join(f'<option value="{html.escape(o, quote=True)}"'
                                    f'{" selected" if o == values[name] else ""}>{html.escape(o)}</option>'
-                                   for o in options)
+                                   for o in choices)
                     fields.append(f'<select name="{esc}" id="{esc}" title="{tip}">{opts}</select>')
                     continue
                 fields.append(f'<input type="number" name="{esc}" id="{esc}" step="any" '
@@ -201,9 +201,9 @@ def form_html(scene: Scene) -> str:
     return "\n".join(parts)
 
 
-def _options(c: Control, scene: Scene) -> tuple[str, ...]:
-    """A select's choices: every function of the registry for the function (the page narrows
-    them to the algebra's with FUNCTIONS_OF), the key's own choices otherwise."""
+def options(c: Control, scene: Scene) -> tuple[str, ...]:
+    """A select's choices: the functions of the scene's algebra for the function (the page
+    changes them with the algebra), the key's own choices otherwise."""
     if c.key == "fractal.algebra":
         return tuple(ALGEBRAS)
     if c.key == "fractal.kind":
