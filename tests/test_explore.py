@@ -500,3 +500,27 @@ def test_the_picture_at_rest_is_the_command_lines_render_of_the_saved_scene(tmp_
         assert rgba.shape == (90, 120, 4)
         assert np.array_equal(rgba[..., :3], page), name
     assert 0.05 < np.mean(np.any(page > 0, axis=2)) < 0.95   # a picture of the set, not of nothing
+
+
+def test_the_notebook_view_renders_as_its_sliders_move(tmp_path):
+    pytest.importorskip("ipywidgets", reason="the notebook view needs ipywidgets (pip install '.[notebook]')")
+    import harness
+    from pyjulia4d.app.explore.notebook import Explorer
+
+    ex = Explorer(Scene.from_dict({"image": {"width": 80, "height": 60}}), device=harness.device(), folder=tmp_path)
+    try:
+        end = time.time() + 60
+        while not ex.image.value and time.time() < end:
+            time.sleep(0.02)
+        first = bytes(ex.image.value)
+        assert first and "80x60" in ex.facts.value
+        ex.widgets["fractal.c[1]"].value = 0.3
+        while bytes(ex.image.value) == first and time.time() < end:
+            time.sleep(0.02)
+        assert bytes(ex.image.value) != first
+        ex.widgets["fractal.algebra"].value = "hypercomplex"   # the function list follows the algebra
+        assert "atanh" in ex.widgets["fractal.function"].options
+        ex.widgets["image.width"].value = 0   # below the key's range: one line, nothing breaks
+        assert "image.width: must be in" in ex.message.value
+    finally:
+        ex.close()
