@@ -140,7 +140,8 @@ def stop(proc: subprocess.Popen) -> None:
         proc.kill()
 
 
-def run(changes: int, drag_seconds: float, overrides: list[str], device: str | None) -> dict:
+def run(changes: int, drag_seconds: float, overrides: list[str], device: str | None,
+        screenshot: Path | None = None) -> dict:
     from selenium.webdriver.support.ui import WebDriverWait
 
     tmp = Path(tempfile.mkdtemp(prefix="explore-latency-"))
@@ -169,6 +170,10 @@ def run(changes: int, drag_seconds: float, overrides: list[str], device: str | N
                 nexts.append(got[0] / 1000)
                 finals.append(got[1] / 1000)
         frames, stages = d.execute_async_script(DRAG, drag_seconds)
+        if screenshot is not None:   # the page at rest after the drag
+            WebDriverWait(d, 120).until(
+                lambda d: d.find_element("id", "view").get_attribute("data-stage") == "final")
+            d.save_screenshot(str(screenshot))
     finally:
         d.quit()
         if proc is not None:
@@ -204,8 +209,10 @@ def main(argv=None) -> int:
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--device", default=None)
     ap.add_argument("--out", type=Path, default=RESULTS)
+    ap.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
+                    help="also save the page at rest after the drag (docs/explore.md's picture)")
     a = ap.parse_args(argv)
-    r = run(a.changes, a.drag_seconds, a.overrides, a.device)
+    r = run(a.changes, a.drag_seconds, a.overrides, a.device, a.screenshot)
     text = table(r, a.changes, a.drag_seconds)
     print(text)
     scene = f" with {' '.join(a.overrides)}" if a.overrides else " (the default scene)"

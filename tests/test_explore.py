@@ -524,3 +524,43 @@ def test_the_notebook_view_renders_as_its_sliders_move(tmp_path):
         assert "image.width: must be in" in ex.message.value
     finally:
         ex.close()
+
+
+# ---------------------------------------------------------------- the command line
+
+
+@pytest.mark.parametrize("args,says", [
+    (["--port", "abc"], "--port: expected a port number in [0, 65535]"),
+    (["--port", "65536"], "--port: expected a port number"),
+    (["--port", "-1"], "--port: expected a port number"),
+    (["--folder", "/nonexistent/x"], "--folder: /nonexistent/x: no such directory"),
+    (["--set", "fractal.max_iter=0"], "fractal.max_iter: must be in"),
+    (["missing.toml"], "missing.toml: cannot read"),
+    (["--host", "no-such-host.invalid", "--port", "0"], "--host: cannot listen on no-such-host.invalid"),
+    (["--bogus"], "unrecognized arguments: --bogus"),
+])
+def test_bad_explore_arguments_are_one_line_and_status_2(tmp_path, capsys, monkeypatch, args, says):
+    from pyjulia4d.app.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["explore", "--no-browser", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pyjulia4d: error: ") and says in err and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_port_in_use_is_one_line(tmp_path, capsys, monkeypatch):
+    import socket
+
+    from pyjulia4d.app.cli import main
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen(1)
+        port = s.getsockname()[1]
+        monkeypatch.chdir(tmp_path)
+        assert main(["explore", "--no-browser", "--port", str(port), "--set", "image.width=32",
+                     "--set", "image.height=24"]) == 2
+    err = capsys.readouterr().err
+    assert f"--port: cannot listen on 127.0.0.1 port {port}: Address already in use; --port 0 picks a free one" in err
+    assert list(tmp_path.iterdir()) == []

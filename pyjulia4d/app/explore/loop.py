@@ -97,8 +97,9 @@ def facts(result: Any, stage: str) -> dict:
     return {"stage": stage, "size": f"{w}x{h}", "seconds": f"{result.seconds:.3f}",
             "hit": f"{100 * result.hit_fraction:.1f} %",
             "bracket": header["pyjulia4d.depth_bracket"] or "none hit",
-            "error": header["pyjulia4d.depth_error"] if result.proven else "not proven (the march proves nothing)",
-            "unresolved": f"{un['hit']} hits, {un['miss']} misses",
+            "error": (header["pyjulia4d.depth_error"] if result.proven else
+                      "not stated: this march proves no space in front of its hits empty"),
+            "unresolved": (f"{un['hit']} hits, {un['miss']} misses" if result.proven else "every ray"),
             "capped": str(result.capped),
             "guards": ", ".join(f"{k} {v}" for k, v in result.guards.items() if v) or "none",
             "device": result.device_name}

@@ -3,8 +3,9 @@ and builds its kernels before the page opens, and ``pyjulia4d explore`` itself."
 from __future__ import annotations
 
 import dataclasses
-import os
+import errno
 import sys
+import tempfile
 import threading
 from pathlib import Path
 from typing import Any, Callable
@@ -53,8 +54,11 @@ def check_folder(folder: str) -> Path:
     shown = folder if folder.isprintable() else repr(folder)
     if not p.is_dir():
         raise SceneError("--folder", f"{shown}: no such directory")
-    if not os.access(p, os.W_OK | os.X_OK):
-        raise SceneError("--folder", f"{shown}: cannot write there")
+    try:   # the only exact test of "can a file be made here" is to make one
+        with tempfile.TemporaryFile(dir=p):
+            pass
+    except OSError as e:
+        raise SceneError("--folder", f"{shown}: cannot write there: {e.strerror or e}") from None
     return p.resolve()
 
 
@@ -74,8 +78,10 @@ def explore(scene: Scene, device: Any, host: str, port: int, folder: Path, open_
     try:
         sock = bind(host, port)
     except OSError as e:
-        raise SceneError("--port", f"cannot listen on {host} port {port}: {e.strerror or e}"
-                         + ("; --port 0 picks a free one" if port else "")) from None
+        if e.errno in (errno.EADDRINUSE, errno.EACCES):
+            raise SceneError("--port", f"cannot listen on {host} port {port}: {e.strerror or e}"
+                             + ("; --port 0 picks a free one" if port else "")) from None
+        raise SceneError("--host", f"cannot listen on {host}: {e.strerror or e}") from None
     url = url_of(sock)
     hosts = tuple(dict.fromkeys(LOCAL_HOSTS + (host.strip("[]"), host)))
     app = make_app(scene, render, folder, hosts if host not in ("0.0.0.0", "::") else ("*",))

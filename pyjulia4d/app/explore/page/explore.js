@@ -14,6 +14,7 @@
   const progress = document.getElementById("file-progress");
   const DATA = window.PYJULIA4D || { functions: {} };
   const DEGREES_PER_PIXEL = 0.4;
+  const TYPING_PAUSE_MS = 600;
 
   let ws = null;
   let everConnected = false;
@@ -49,6 +50,14 @@
     if (slider) slider.value = value;
   }
 
+  // the picture's box: the scene's image size in CSS pixels (at most the column's width), so
+  // that a preview, smaller, is stretched to the size of the picture it stands for
+  function sizeView() {
+    const w = Number(form.elements.namedItem("image.width").value);
+    const h = Number(form.elements.namedItem("image.height").value);
+    if (w > 0 && h > 0) { view.style.width = `${w}px`; view.style.aspectRatio = `${w} / ${h}`; }
+  }
+
   function allValues() {
     const out = {};
     for (const el of form.elements) if (el.name) out[el.name] = el.value;
@@ -76,6 +85,7 @@
 
   function onPicture(blob) {
     const meta = frameMeta || {};
+    sizeView();
     frameMeta = null;
     const url = URL.createObjectURL(blob);
     const old = shownUrl;
@@ -92,7 +102,7 @@
   function onMessage(m) {
     switch (m.type) {
       case "frame": frameMeta = m; break;
-      case "values": for (const [k, v] of Object.entries(m.values)) setValue(k, v); break;
+      case "values": for (const [k, v] of Object.entries(m.values)) setValue(k, v); sizeView(); break;
       case "error": showError(m.message); break;
       case "status": statusLine.textContent = m.message; break;
       case "progress":
@@ -162,6 +172,8 @@
     restTimer = setTimeout(() => { flush(); send({ op: "refine" }); }, 200);
   }
 
+  // typing into a field: sent once the typing pauses (or at its change event, whichever is first)
+  const typing = {};
   form.addEventListener("input", (ev) => {
     const t = ev.target;
     if (t.type === "range" && t.dataset.for) {
@@ -169,13 +181,13 @@
       field.value = t.value;
       field.classList.remove("invalid");
       change({ [t.dataset.for]: t.value }, true);
+    } else if (t.name && t.tagName === "INPUT") {
+      clearTimeout(typing[t.name]);
+      typing[t.name] = setTimeout(() => { delete typing[t.name]; commit(t); }, TYPING_PAUSE_MS);
     }
   });
 
-  form.addEventListener("change", (ev) => {
-    const t = ev.target;
-    if (t.type === "range" && t.dataset.for) { change({ [t.dataset.for]: t.value }, false); return; }
-    if (!t.name) return;
+  function commit(t) {
     t.classList.remove("invalid");
     const values = { [t.name]: t.value };
     if (t.name === "fractal.algebra") {
@@ -185,6 +197,14 @@
     const slider = form.querySelector(`input[type=range][data-for="${CSS.escape(t.name)}"]`);
     if (slider) slider.value = t.value;
     change(values, false);
+  }
+
+  form.addEventListener("change", (ev) => {
+    const t = ev.target;
+    if (t.type === "range" && t.dataset.for) { change({ [t.dataset.for]: t.value }, false); return; }
+    if (!t.name) return;
+    if (t.name in typing) { clearTimeout(typing[t.name]); delete typing[t.name]; }
+    commit(t);
   });
 
   // ---------------------------------------------------------------- the camera by hand
