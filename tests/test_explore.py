@@ -564,3 +564,36 @@ def test_a_port_in_use_is_one_line(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert f"--port: cannot listen on 127.0.0.1 port {port}: Address already in use; --port 0 picks a free one" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_generated_socket_messages_get_at_most_one_line_each_and_the_socket_stays(client):
+    """Random JSON values, truncated JSON and junk text on the socket: each is answered by at
+    most one error line (or carried out), and a valid request after them still renders."""
+    rng = random.Random(11)
+    leaves = [None, True, 1, -1.5, 1e308, "", "x" * 50, "fractal.c[0]", "../../etc/passwd", "set", "orbit"]
+
+    def value(depth=0):
+        r = rng.random()
+        if depth < 3 and r < 0.2:
+            return [value(depth + 1) for _ in range(rng.randint(0, 3))]
+        if depth < 3 and r < 0.45:
+            keys = ["op", "values", "moving", "yaw", "degrees", "factor", "name", "frames", "fps", "x"]
+            return {rng.choice(keys): value(depth + 1) for _ in range(rng.randint(0, 4))}
+        return rng.choice(leaves)
+
+    with client.websocket_connect("ws://127.0.0.1:8470/ws", headers={"origin": "http://127.0.0.1:8470"}) as ws:
+        receive_until(ws, "frame")
+        for k in range(300):
+            msg = value()
+            if isinstance(msg, dict) and rng.random() < 0.5:
+                msg["op"] = rng.choice(["set", "orbit", "turn_w", "zoom", "keyframe", "save_scene", "render_file"])
+            text = json.dumps(msg)
+            if rng.random() < 0.15:
+                text = text[: rng.randint(0, len(text))] + rng.choice(["", "}", "\x00", "\ufffd"])
+            ws.send_text(text)
+        ws.send_text(json.dumps({"op": "set", "values": {"fractal.c[1]": "0.5"}}))
+        ws.send_text(json.dumps({"op": "save_scene", "name": "after-fuzz.toml"}))
+        seen = receive_until(ws, "status", limit=5000)
+        errors = [m for m in seen if isinstance(m, dict) and m.get("type") == "error"]
+        assert errors and all("\n" not in m["message"] for m in errors)
+        assert len(errors) <= 300

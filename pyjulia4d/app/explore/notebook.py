@@ -17,6 +17,7 @@ from typing import Any
 
 from pyjulia4d.app.explore import controls
 from pyjulia4d.app.explore.session import Session
+from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
 REST_SECONDS = 0.25   # after the last change, the picture is refined
@@ -29,6 +30,9 @@ def _scene(scene: Scene | str | Path | None) -> Scene:
         return Scene.from_dict({})
     if isinstance(scene, Scene):
         return scene
+    if not isinstance(scene, (str, Path)):
+        raise SceneError("scene", f"expected None, a pyjulia4d.Scene or a scene file's path, got "
+                                  f"{type(scene).__name__}")
     return Scene.from_toml(scene)
 
 

@@ -73,7 +73,10 @@ def make_app(scene: Scene, render: Render, folder: str | Path, hosts: tuple[str,
         outbox: asyncio.Queue = asyncio.Queue()
 
         def emit(message: dict, data: bytes | None) -> None:
-            loop.call_soon_threadsafe(outbox.put_nowait, (message, data))
+            try:
+                loop.call_soon_threadsafe(outbox.put_nowait, (message, data))
+            except RuntimeError:   # the server's event loop is closed: the page is gone
+                pass
 
         async def send_all() -> None:
             while True:
