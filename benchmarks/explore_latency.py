@@ -27,13 +27,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import queue
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -43,6 +41,8 @@ for p in (ROOT / "benchmarks", ROOT):
         sys.path.insert(0, str(p))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+
+from pyjulia4d.app.explore.drive import headless_chromium, start_server, stop_server  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "explore_latency.md"
 
@@ -92,19 +92,10 @@ const tick = setInterval(() => {
 
 
 def browser():
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    chromium = next((p for p in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if p), None)
-    driver = shutil.which("chromedriver")
-    if chromium is None or driver is None:
-        sys.exit("explore_latency: needs chromium and chromedriver (apt-get install chromium chromium-driver)")
-    options = webdriver.ChromeOptions()
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1400,1000"):
-        options.add_argument(arg)
-    options.binary_location = chromium
-    d = webdriver.Chrome(service=Service(driver), options=options)
+    try:
+        d = headless_chromium()
+    except RuntimeError as e:
+        sys.exit(f"explore_latency: {e}")
     d.set_script_timeout(120)
     d.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": EARLY})
     return d
@@ -116,44 +107,35 @@ def launch(args: list[str], env: dict, d) -> tuple[subprocess.Popen, str, float,
     from selenium.webdriver.support.ui import WebDriverWait
 
     t0 = time.perf_counter()
-    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    lines: queue.Queue = queue.Queue()
-    threading.Thread(target=lambda: [lines.put(x) for x in proc.stdout], daemon=True).start()
     try:
-        line = lines.get(timeout=300)
-    except queue.Empty:
-        proc.kill()
-        sys.exit(f"explore_latency: the server did not start: {proc.stderr.read()}")
+        proc, url = start_server(args, env, timeout=300)
+    except RuntimeError as e:
+        sys.exit(f"explore_latency: {e}")
     t_listen = time.perf_counter() - t0
-    url = line.split("listening on ")[1].split()[0]
     d.get(url)
     WebDriverWait(d, 120, poll_frequency=0.005).until(
         lambda d: d.find_element("id", "view").get_attribute("data-count"))
     return proc, url, t_listen, time.perf_counter() - t0
 
 
-def stop(proc: subprocess.Popen) -> None:
-    proc.terminate()
-    try:
-        proc.wait(15)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-
-
 def run(changes: int, drag_seconds: float, overrides: list[str], device: str | None,
-        screenshot: Path | None = None) -> dict:
+        screenshot: Path | None = None, cold: bool = True) -> dict:
     from selenium.webdriver.support.ui import WebDriverWait
 
     tmp = Path(tempfile.mkdtemp(prefix="explore-latency-"))
     env = dict(os.environ, PYJULIA4D_CACHE=str(tmp / "cache"), POCL_CACHE_DIR=str(tmp / "pocl"),
                XDG_CACHE_HOME=str(tmp / "xdg"))
     d = browser()
-    args = [sys.executable, "-m", "pyjulia4d", "explore", "--no-browser", "--port", "0", "--folder", str(tmp)]
+    args = ["--folder", str(tmp)]
     args += [a for o in overrides for a in ("--set", o)] + (["--device", device] if device else [])
     proc = None
     try:
-        proc, _, cold_listen, cold_first = launch(args, env, d)   # empty caches: every kernel built
-        stop(proc)
+        cold_listen = cold_first = None
+        if cold:
+            proc, _, cold_listen, cold_first = launch(args, env, d)   # empty caches: every kernel built
+            stop_server(proc)
+        else:   # the caches as they are
+            env = None
         proc, url, warm_listen, warm_first = launch(args, env, d)   # the caches the first run filled
         # a second page on the running server: its first picture on the browser's own clock
         d.get("about:blank")
@@ -177,18 +159,22 @@ def run(changes: int, drag_seconds: float, overrides: list[str], device: str | N
     finally:
         d.quit()
         if proc is not None:
-            stop(proc)
+            stop_server(proc)
         shutil.rmtree(tmp, ignore_errors=True)
     return {"cold_listen": cold_listen, "cold_first": cold_first, "warm_listen": warm_listen,
             "warm_first": warm_first, "page_ms": page_ms, "next": nexts, "final": finals,
             "previews": frames / drag_seconds, "stages": sorted(set(stages)), "device": device_name, "size": size}
 
 
+def seconds(x: float | None) -> str:
+    return "-" if x is None else f"{x:.2f} s"
+
+
 def table(r: dict, changes: int, drag_seconds: float) -> str:
     med = statistics.median
     rows = [
-        ("command -> server listening, empty caches (every kernel built)", f"{r['cold_listen']:.2f} s", ""),
-        ("command -> first picture in the page, empty caches", f"{r['cold_first']:.2f} s", ""),
+        ("command -> server listening, empty caches (every kernel built)", seconds(r["cold_listen"]), ""),
+        ("command -> first picture in the page, empty caches", seconds(r["cold_first"]), ""),
         ("command -> server listening, caches filled", f"{r['warm_listen']:.2f} s", ""),
         ("command -> first picture in the page, caches filled", f"{r['warm_first']:.2f} s", ""),
         ("page open -> first picture (warm server)", f"{r['page_ms'] / 1000:.2f} s", "at most 3 s"),
@@ -211,14 +197,17 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=RESULTS)
     ap.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
                     help="also save the page at rest after the drag (docs/explore.md's picture)")
+    ap.add_argument("--keep-caches", action="store_true",
+                    help="skip the start with empty caches: one start, with the caches as they are")
     a = ap.parse_args(argv)
-    r = run(a.changes, a.drag_seconds, a.overrides, a.device, a.screenshot)
+    r = run(a.changes, a.drag_seconds, a.overrides, a.device, a.screenshot, cold=not a.keep_caches)
     text = table(r, a.changes, a.drag_seconds)
     print(text)
     scene = f" with {' '.join(a.overrides)}" if a.overrides else " (the default scene)"
     append_run(a.out, "# The explorer's latency in a real browser (benchmarks/explore_latency.py)\n",
                f"\n## {utc_now()}, commit {git_commit()}{scene}\n\n"
                f"`python benchmarks/explore_latency.py --changes {a.changes} --drag-seconds {a.drag_seconds:g}"
+               f"{' --keep-caches' if a.keep_caches else ''}"
                f"{''.join(' --set ' + o for o in a.overrides)}`\n\n{text}")
     return 0
 

@@ -188,3 +188,19 @@ def test_pair_error_vs_time_benchmark_runs(tmp_path, capsys):
     assert "commit" in (tmp_path / "pair_error_vs_time.md").read_text()
     assert (tmp_path / "pair_error_vs_time.png").stat().st_size > 0
     assert len((tmp_path / "pair_error_vs_time.csv").read_text().splitlines()) == 4
+
+
+def test_explore_latency_report_runs(tmp_path):
+    """benchmarks/explore_latency.py, tiny, with the caches as they are: the table with every
+    measure of a start, and the results file with its commit (skipped where no browser is)."""
+    from pyjulia4d.app.explore.drive import HOW_TO_GET, browser_paths
+
+    if None in browser_paths() or not importlib.util.find_spec("selenium"):
+        pytest.skip(HOW_TO_GET)
+    lat = load("explore_latency")
+    out = tmp_path / "explore_latency.md"
+    assert lat.main(["--changes", "1", "--drag-seconds", "0.5", "--keep-caches", "--set", "image.width=64",
+                     "--set", "image.height=48", "--out", str(out)]) == 0
+    md = out.read_text()
+    assert "commit" in md and "| page open -> first picture (warm server) |" in md
+    assert "previews per second while dragging" in md and "Scene size 64x48" in md

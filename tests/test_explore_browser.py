@@ -6,11 +6,8 @@ Skipped, with the reason, where no browser is installed (.ci/run installs one)."
 import base64
 import io
 import os
-import queue
-import shutil
 import subprocess
 import sys
-import threading
 import time
 
 import numpy as np
@@ -19,23 +16,17 @@ from PIL import Image
 
 from pyjulia4d.scene.model import Scene
 
+from pyjulia4d.app.explore.drive import HOW_TO_GET, browser_paths, headless_chromium, start_server, stop_server
+
 try:
-    import selenium  # noqa: F401
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 except ImportError:   # pragma: no cover
-    webdriver = None
+    ActionChains = None
 
-CHROMIUM = next((p for p in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if p), None)
-DRIVER = shutil.which("chromedriver")
-pytestmark = pytest.mark.skipif(
-    webdriver is None or CHROMIUM is None or DRIVER is None,
-    reason="needs headless Chromium, its driver and selenium: apt-get install chromium chromium-driver, and "
-           "pip install '.[test]' (selenium)")
+pytestmark = pytest.mark.skipif(ActionChains is None or None in browser_paths(), reason=HOW_TO_GET)
 
 WIDTH, HEIGHT = 200, 150   # small: the final stage of each change comes quickly
 
@@ -51,36 +42,17 @@ def folder(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def server(folder):
-    """`pyjulia4d explore --no-browser --port 0` in a child process; its URL from its first line."""
-    proc = subprocess.Popen([sys.executable, "-m", "pyjulia4d", "explore", "--no-browser", "--port", "0",
-                             "--folder", str(folder), "--set", f"image.width={WIDTH}",
-                             "--set", f"image.height={HEIGHT}", *_device_args()],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    lines: queue.Queue = queue.Queue()
-    threading.Thread(target=lambda: [lines.put(x) for x in proc.stdout], daemon=True).start()
-    try:
-        line = lines.get(timeout=120)
-    except queue.Empty:
-        proc.kill()
-        pytest.fail(f"explore did not start: {proc.stderr.read()}")
-    assert "listening on http://127.0.0.1:" in line, line
-    url = line.split("listening on ")[1].split()[0]
+    """`pyjulia4d explore` in a child process: its address."""
+    proc, url = start_server(["--folder", str(folder), "--set", f"image.width={WIDTH}",
+                              "--set", f"image.height={HEIGHT}", *_device_args()])
+    assert url.startswith("http://127.0.0.1:")
     yield url
-    proc.terminate()
-    try:
-        proc.wait(15)
-    except subprocess.TimeoutExpired:
-        proc.kill()
+    stop_server(proc)
 
 
 @pytest.fixture(scope="module")
 def browser():
-    options = webdriver.ChromeOptions()
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1400,1000"):
-        options.add_argument(arg)
-    options.binary_location = CHROMIUM
-    driver = webdriver.Chrome(service=Service(DRIVER), options=options)
+    driver = headless_chromium()
     yield driver
     driver.quit()
 
