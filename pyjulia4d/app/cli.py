@@ -1,4 +1,4 @@
-"""Command line: ``pyjulia4d render|animate|explore|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
+"""Command line: ``pyjulia4d render|animate|explore|mesh|keys|devices|import-pov`` (also ``python -m pyjulia4d``).
 
 Bad input gets one stderr line, ``pyjulia4d: error: <key or path>: <reason>``, and
 status 2; Ctrl-C status 130, SIGTERM 143 and SIGHUP 129 (128 + the signal number),
@@ -89,6 +89,20 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--channels", metavar="LIST", help="EXR channel groups (as for render)")
     a.add_argument("--force", action="store_true", help="render frames whose work is refused as hopeless")
     _cluster_options(a, "whole frames")
+
+    m = sub.add_parser("mesh", help="the scene's 3D slice of the set as a triangle mesh (.stl, .ply, .obj, .glb)")
+    m.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
+                   help="scene file, or an image pyjulia4d rendered (default: the built-in scene)")
+    m.add_argument("-o", "--output", metavar="OUT",
+                   help="OUT.stl, OUT.ply, OUT.obj or OUT.glb (default: <scene stem>.stl, or julia.stl)")
+    m.add_argument("--resolution", metavar="N", default="128",
+                   help="grid points a side, 8 to 2048 (default 128; 512 takes about a minute here)")
+    m.add_argument("--smooth", metavar="PASSES", default="0",
+                   help="Taubin smoothing passes, 0 to 1000 (default 0: every vertex on the surface)")
+    m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene value, as for render")
+    m.add_argument("--device", metavar="SPEC", help="OpenCL device (as for render)")
+    m.add_argument("--force", action="store_true", help="mesh grids whose sampling is estimated past 6 hours")
 
     e = sub.add_parser("explore", help="explore a scene in the browser: a local page that renders as you drag")
     e.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
@@ -228,6 +242,30 @@ def _scene_of(path: str | None, overrides: Sequence[str]) -> Scene:
     if Path(path).suffix.lower() in IMAGE_SUFFIXES:
         return scene_from_image(path, overrides)
     return Scene.from_toml(path, overrides)
+
+
+def _whole(flag: str, text: str) -> int | str:
+    """A flag's whole number, or its text as given (the checker then names it)."""
+    t = text.strip()
+    return int(t) if t.isascii() and t.lstrip("+-").isdigit() and len(t) < 20 else text
+
+
+def _mesh(args: argparse.Namespace) -> int:
+    """mesh: SCENE -> OUT.stl|ply|obj|glb (app/mesh.py); every argument checked before the device."""
+    from pyjulia4d.app.mesh import build_mesh, check_mesh_path, check_smooth, write_mesh
+    from pyjulia4d.pipeline.mesh_plan import check_resolution
+
+    resolution = check_resolution(_whole("--resolution", args.resolution))
+    smooth = check_smooth(_whole("--smooth", args.smooth))
+    scene = _scene_of(args.scene, args.overrides)
+    stem = "julia" if args.scene is None else Path(args.scene).stem
+    out = check_mesh_path(args.output if args.output is not None else stem + ".stl")
+    device = select_device(args.device)
+    result = build_mesh(scene, resolution, device, smooth, args.force, progress=True,
+                        warn=lambda text: _say(f"pyjulia4d: warning: {text}"))
+    write_mesh(out, result)
+    print(f"wrote {out} in {result.seconds['total']:.2f} s: {result.summary()}")
+    return 0
 
 
 def _explore(args: argparse.Namespace) -> int:
@@ -387,6 +425,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _animate(args)
             if args.command == "explore":
                 return _explore(args)
+            if args.command == "mesh":
+                return _mesh(args)
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
         _say(f"pyjulia4d: error: {one_line(e)}")

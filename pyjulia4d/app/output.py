@@ -37,19 +37,20 @@ def check_directory(shown: str, parent: Path) -> None:
         raise OutputError(f"{shown}: {quoted_path(parent)} is not a directory")
 
 
-def check_output_path(path: str | Path) -> Path:
-    """Fail before rendering if ``path`` cannot take the image: its format, its
-    directory, the length of its name and path (the temp file's too), and a temp
-    file really created (and removed) beside it."""
+def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS) -> Path:
+    """Fail before rendering if ``path`` cannot take the image: its format (one of
+    ``formats``), its directory, the length of its name and path (the temp file's too), and a
+    temp file really created (and removed) beside it."""
     raw = os.fspath(path)
     shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")
     p = Path(raw)
     ext = _suffix(p)
-    if ext not in FORMATS:
+    if ext not in formats:
         got = quoted_path(ext) if ext else "'(none)'"
-        raise OutputError(f"{shown}: unsupported output format {got} (use .png or .exr)")
+        raise OutputError(f"{shown}: unsupported output format {got} (use {', '.join(formats[:-1])} or {formats[-1]})"
+                          if len(formats) > 1 else f"{shown}: unsupported output format {got} (use {formats[0]})")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent

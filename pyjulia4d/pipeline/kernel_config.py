@@ -174,6 +174,15 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
     return KernelConfig(pieces, cfg.defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
 
 
+def mesh_config(scene: Scene) -> KernelConfig:
+    """The mesh's sampling and vertex kernels (kernels/mesh/mesh.cl): the iteration, the
+    scene's refinement (march/refine.cl) and the mesh piece."""
+    defines = precision_defines(scene) + fractal_defines(scene)
+    if scene.march.refine == "itp":
+        defines += ("REFINE_ITP",)
+    return KernelConfig(iteration_pieces(scene) + ("march/refine", "mesh/mesh"), defines)
+
+
 def probe_config(scene: Scene) -> KernelConfig:
     """The iteration alone, wrapped for the tests (kernels/probe.cl)."""
     return KernelConfig(iteration_pieces(scene) + ("probe",), precision_defines(scene) + fractal_defines(scene))

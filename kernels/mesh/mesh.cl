@@ -1,0 +1,80 @@
+/* mesh/mesh.cl: the scene's 3D slice of the set on a grid, and the vertices of its surface
+ * (pyjulia4d/app/mesh.py; twin pyjulia4d/reference/mesh.py).  One point per work-item.
+ *
+ * The grid is the slice's own 3D space (x, y, z), mapped to the world as the camera's points
+ * are (geometry/camera.py to_world): p = x rx + y ry + z rz + offset, rx, ry, rz the slice
+ * rotation's first three columns and offset = distance n/|n|.  A grid point is inside when it
+ * lies in the bounding ball |p| <= radius and in the truncated set (julia_inside: the scene's
+ * own definition, every kind's).  Marching cubes on that mask puts a vertex on each grid edge
+ * whose ends differ; mesh_vertices then moves it onto the surface: onto the ball's sphere where
+ * the ball cuts the set, else to the crossing of the set's surface refined by refine_bracket
+ * (march/refine.cl: ITP on the level function, or bisection), from a bracket [outside end,
+ * inside end] that the mask certified. */
+
+inline real4 mesh_point(real4 origin, real spacing, real4 rx, real4 ry, real4 rz, real4 offset,
+                        int i, int j, int k)
+{
+    real x = origin.x + spacing * (real)i, y = origin.y + spacing * (real)j, z = origin.z + spacing * (real)k;
+    return x * rx + y * ry + z * rz + offset;
+}
+
+/* inside[(k - k0) ny nx + j nx + i] for the grid points (i, j, k), k0 <= k < k0 + n / (nx ny) */
+__kernel void mesh_sample(const int n, const int nx, const int ny, const int k0, const real4 origin,
+                          const real spacing, const real4 rx, const real4 ry, const real4 rz, const real4 offset,
+                          const real radius2, const real4 c, const int max_iter, const real bailout,
+                          __global uchar *inside)
+{
+    size_t g = get_global_id(0);
+    if (g >= (size_t)n)
+        return;
+    int i = (int)(g % (size_t)nx), j = (int)((g / (size_t)nx) % (size_t)ny), k = (int)(g / ((size_t)nx * ny));
+    real4 p = mesh_point(origin, spacing, rx, ry, rz, offset, i, j, k0 + k);
+    julia_params jp = { c, bailout * bailout, 0, max_iter };
+    inside[g] = (dot(p, p) <= radius2 && julia_inside(p, jp)) ? 1 : 0;
+}
+
+/* The vertex on the grid edge between the world points ends_a[g] and ends_b[g], one inside
+ * (ball and set) and one outside, in either order (the mask they came from is not kept: both
+ * are tested again, as mesh_sample tested them): on the sphere |p| = radius where the edge
+ * enters the ball at a point of the set, else within width[g] of the set's crossing (refined
+ * with ``steps`` set tests on the part of the edge in the ball; the vertex is the bracket's
+ * middle).  An edge whose ends agree (none, from marching cubes) gets its midpoint, width -1. */
+inline int mesh_inside(real4 p, real radius2, julia_params jp)
+{
+    return dot(p, p) <= radius2 && julia_inside(p, jp);
+}
+
+__kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global const real4 *ends_b,
+                            const real radius2, const real4 c, const int max_iter, const real bailout,
+                            const int steps, __global real4 *vertex, __global real *width)
+{
+    size_t g = get_global_id(0);
+    if (g >= (size_t)n)
+        return;
+    julia_params jp = { c, bailout * bailout, 0, max_iter };
+    real4 pa = ends_a[g], pb = ends_b[g];
+    int ia = mesh_inside(pa, radius2, jp), ib = mesh_inside(pb, radius2, jp);
+    if (ia == ib) {
+        vertex[g] = (real)0.5 * (pa + pb);
+        width[g] = -1;
+        return;
+    }
+    real4 po = ia ? pb : pa, d = (ia ? pa : pb) - po;
+    real len = length(d);
+    d /= len;
+    real a = 0;
+    if (dot(po, po) > radius2) {   /* where the edge enters the ball: |po + a d| = radius */
+        real b = dot(po, d), e = dot(po, po) - radius2;
+        a = clamp(-b - sqrt(fmax(b * b - e, (real)0)), (real)0, len);
+        real4 pe = po + a * d;
+        if (julia_inside(pe, jp)) {   /* the set reaches the sphere here: the ball's cut face */
+            vertex[g] = pe;
+            width[g] = 0;
+            return;
+        }
+    }
+    real w;
+    real t = refine_bracket(po, d, a, len, 1, steps, jp, &w);
+    vertex[g] = po + (t + (real)0.5 * w) * d;
+    width[g] = w;
+}

@@ -1,0 +1,198 @@
+"""``pyjulia4d mesh``: the scene's 3D slice of the set as a triangle mesh, for 3D printing
+and Blender (STL, PLY, OBJ, glTF binary).
+
+1. The grid of the mesh plan (pipeline/mesh_plan.py) is sampled by the kernel mesh_sample
+   (kernels/mesh/mesh.cl) a block of z-layers at a time, with the set's own inside test.
+2. Marching cubes (PyMCubes; Lorensen & Cline 1987) runs on each block with the layer before
+   it, so only two blocks are held at once; vertices shared across blocks are merged.
+3. Every vertex lies on a grid edge whose ends differ; mesh_vertices moves it onto the
+   surface: the set's crossing refined by ITP on the level function (march/refine.cl), or the
+   bounding ball's sphere where the ball cuts the set - so the mesh is not staircased, and
+   it is closed.
+4. trimesh orients it outwards, computes vertex normals, optionally smooths it (Taubin's
+   lambda|mu filter, which keeps the volume), colours its vertices with shading.color and
+   writes it, atomically.
+
+The mesh is in the slice's own 3D coordinates (the scene units the camera sees)."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from pyjulia4d.pipeline.mesh_plan import MeshPlan, make_mesh_plan
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.model import Scene
+
+FORMATS = {".stl": "stl", ".ply": "ply", ".obj": "obj", ".glb": "glb"}
+MAX_SMOOTH = 1000
+# iterations a second the sampling is assumed to reach for the work estimate: below what
+# benchmarks/mesh_scale.py measured on this project's 2-core CPU, so the estimate errs long
+ESTIMATE_RATE = 3e8
+WARN_SECONDS, REFUSE_SECONDS = 120.0, 6 * 3600.0
+
+
+class MeshError(ValueError):
+    """Unusable mesh output path or settings; the message starts with what is wrong."""
+
+
+@dataclass
+class MeshResult:
+    """The mesh and what making it cost and found."""
+    mesh: Any                    # trimesh.Trimesh, slice coordinates
+    plan: MeshPlan
+    inside_points: int           # grid points inside (the voxel count of the set on the grid)
+    widest_bracket: float        # the widest vertex bracket (slice units)
+    seconds: dict = field(default_factory=dict)   # "sample", "cubes", "vertices", "finish", "total"
+
+    @property
+    def voxel_volume(self) -> float:
+        """The set's volume by counting grid points: inside points times h^3."""
+        return self.inside_points * self.plan.spacing ** 3
+
+    def summary(self) -> str:
+        m = self.mesh
+        vol = f"volume {m.volume:.6g} (grid count {self.voxel_volume:.6g})" if m.is_watertight else "not watertight"
+        return (f"{len(m.faces)} triangles, {len(m.vertices)} vertices, {vol}, vertices within "
+                f"{self.widest_bracket:.2g} of the surface, grid {self.plan.n}^3 at spacing {self.plan.spacing:.4g}")
+
+
+def estimate_seconds(plan: MeshPlan) -> float:
+    """A long-side estimate of the sampling's time: every grid point iterated max_iter times."""
+    return plan.n ** 3 * plan.max_iter / ESTIMATE_RATE
+
+
+def check_mesh_path(path: str | Path) -> Path:
+    """An output path for a mesh: its format (.stl, .ply, .obj, .glb) and the checks of an
+    image path (a temp file really made beside it: app/output.check_output_path)."""
+    from pyjulia4d.app.output import OutputError, check_output_path
+    from pyjulia4d.files import shown_path
+
+    suffix = Path(str(path)).suffix.lower()
+    if suffix not in FORMATS:
+        got = repr(suffix) if suffix else "'(none)'"
+        raise OutputError(f"{shown_path(str(path))}: unsupported mesh format {got} (use .stl, .ply, .obj or .glb)")
+    return check_output_path(path, formats=tuple(FORMATS))
+
+
+def check_smooth(value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_SMOOTH:
+        raise SceneError("--smooth", f"expected a whole number of smoothing passes in [0, {MAX_SMOOTH}], "
+                                     f"got {value!r}"[:120])
+    return value
+
+
+def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: int = 0, force: bool = False,
+               progress: bool = False, executor: str = "opencl", warn: Callable[[str], None] | None = None
+               ) -> MeshResult:
+    """The mesh of ``scene`` on a grid of ``resolution`` points a side (see the module's
+    docstring).  ``executor`` "reference" runs the float64 twins (small grids only).  Work
+    estimated past REFUSE_SECONDS is refused unless ``force``; past WARN_SECONDS ``warn`` is
+    told."""
+    import mcubes
+    import trimesh
+
+    from pyjulia4d.pipeline.progress import Progress
+
+    t0 = time.perf_counter()
+    smooth = check_smooth(smooth)
+    plan = make_mesh_plan(scene, resolution)
+    est = estimate_seconds(plan)
+    if est > REFUSE_SECONDS and not force:
+        raise SceneError("--resolution", f"{plan.n}^3 grid points at max_iter {plan.max_iter}: about "
+                                         f"{est / 3600:.0f} h of sampling; lower it, or --force")
+    if est > WARN_SECONDS and warn is not None:
+        warn(f"about {est / 60:.0f} min of sampling ({plan.n}^3 grid points at max_iter {plan.max_iter})")
+    sample, vertices = _executor(plan, device, executor)
+    seconds = {"sample": 0.0, "cubes": 0.0}
+    parts_v, parts_f, count, prev = [], [], 0, None
+    with Progress(plan.n, "mesh", "layer", enabled=progress) as bar:
+        for k0 in range(0, plan.n, plan.block):
+            nk = min(plan.block, plan.n - k0)
+            t = time.perf_counter()
+            block = sample(k0, nk)
+            seconds["sample"] += time.perf_counter() - t
+            count += int(np.count_nonzero(block))
+            t = time.perf_counter()
+            vol = block if prev is None else np.concatenate([prev[None], block])
+            start = k0 if prev is None else k0 - 1
+            if vol.shape[0] >= 2:
+                v, f = mcubes.marching_cubes(vol, 0.5)
+                if len(f):
+                    v[:, 0] += start
+                    parts_f.append(f.astype(np.int64) + sum(len(p) for p in parts_v))
+                    parts_v.append(v)
+            prev = block[-1]
+            seconds["cubes"] += time.perf_counter() - t
+            bar.update(nk)
+    t = time.perf_counter()
+    if not parts_v:
+        raise SceneError("scene", f"the slice of the set holds no grid point of a {plan.n}^3 grid: nothing to "
+                                  f"mesh (a finer --resolution, or another slice)")
+    # (k, j, i) -> (i, j, k); vertices on shared layers merge (exact halves: no tolerance needed)
+    grid = trimesh.Trimesh(np.concatenate(parts_v)[:, ::-1], np.concatenate(parts_f), process=True)
+    gv = np.asarray(grid.vertices)
+    axis = np.argmax(np.abs(gv - np.round(gv)) > 0.25, axis=1)    # the coordinate at a half
+    lo = gv.copy()
+    lo[np.arange(len(gv)), axis] = np.floor(gv[np.arange(len(gv)), axis])
+    hi = lo.copy()
+    hi[np.arange(len(gv)), axis] += 1.0
+    world, width = vertices(plan.to_world(lo), plan.to_world(hi))
+    seconds["vertices"] = time.perf_counter() - t
+    t = time.perf_counter()
+    # world points -> the slice's coordinates: x = axes (p - offset), axes orthonormal
+    xyz = (world - plan.offset) @ plan.axes.T
+    mesh = trimesh.Trimesh(xyz, np.asarray(grid.faces), process=False)
+    if mesh.is_watertight and mesh.volume < 0:
+        mesh.invert()
+    if smooth:
+        trimesh.smoothing.filter_taubin(mesh, iterations=smooth)
+    _colour(mesh, scene)
+    seconds["finish"] = time.perf_counter() - t
+    seconds["total"] = time.perf_counter() - t0
+    widest = float(np.max(width)) if len(width) else 0.0
+    return MeshResult(mesh, plan, count, widest, seconds)
+
+
+def _executor(plan: MeshPlan, device: Any, executor: str):
+    """(sample(k0, nk), vertices(a, b)) of the OpenCL kernels or of their float64 twins."""
+    if executor == "reference":
+        from pyjulia4d.reference import mesh as twin
+
+        return (lambda k0, nk: twin.mesh_sample(plan, k0, nk)), (lambda a, b: twin.mesh_vertices(plan, a, b))
+    if executor != "opencl":
+        raise SceneError("executor", f"expected 'opencl' or 'reference', got {executor!r}"[:100])
+    from pyjulia4d.opencl.devices import select_device
+    from pyjulia4d.opencl.mesh import MeshRunner
+
+    dev = device if device is not None and not isinstance(device, str) else select_device(device)
+    runner = MeshRunner(plan, dev)
+    return runner.sample, runner.vertices
+
+
+def _colour(mesh: Any, scene: Scene) -> None:
+    """shading.color on every vertex, sRGB-encoded 8-bit (the formats' convention)."""
+    from pyjulia4d.pipeline.colormap import linear_to_srgb
+
+    rgb = np.clip(linear_to_srgb(np.asarray(scene.shading.color, np.float64)), 0, 1)
+    rgba = np.append(np.rint(rgb * 255), 255).astype(np.uint8)
+    mesh.visual.vertex_colors = np.tile(rgba, (len(mesh.vertices), 1))
+
+
+def write_mesh(path: str | Path, result: MeshResult) -> None:
+    """The mesh in the format of ``path``'s suffix, atomically (files.atomic_write)."""
+    from pyjulia4d.app.output import OutputError
+    from pyjulia4d.files import atomic_write
+
+    p = Path(path)
+    data = result.mesh.export(file_type=FORMATS[p.suffix.lower()])
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    try:
+        with atomic_write(p) as tmp:
+            tmp.write_bytes(data)
+    except OSError as e:
+        raise OutputError(f"{p}: cannot write: {e.strerror or e}") from None

@@ -1,0 +1,59 @@
+"""The mesh kernels (kernels/mesh/mesh.cl) on an OpenCL device: a MeshPlan's grid sampled a
+block of z-layers at a time, and the vertices placed on the surface."""
+from __future__ import annotations
+
+import numpy as np
+import pyopencl as cl
+import pyopencl.array as cla
+
+from pyjulia4d.opencl import build
+from pyjulia4d.opencl.executor import Precision, launch, queue_for
+from pyjulia4d.pipeline.mesh_plan import MeshPlan
+
+
+class MeshRunner:
+    """The program of one plan on one device."""
+
+    def __init__(self, plan: MeshPlan, dev: cl.Device):
+        self.plan = plan
+        self.ctx, self.queue = queue_for(dev)
+        prg = build.program(self.ctx, plan.config)
+        self.sample_k = cl.Kernel(prg, "mesh_sample")
+        self.vertex_k = cl.Kernel(prg, "mesh_vertices")
+        pr = self.pr = Precision(plan.double)
+        self.grid = (pr.v4(tuple(plan.origin) + (0.0,)), pr.scalar(plan.spacing),
+                     *(pr.v4(a) for a in plan.axes), pr.v4(plan.offset))
+        self.fractal = (pr.scalar(plan.radius ** 2), pr.v4(plan.c), np.int32(plan.max_iter), pr.scalar(plan.bailout))
+
+    def sample(self, k0: int, nk: int) -> np.ndarray:
+        """The inside mask of grid layers k0 .. k0 + nk - 1: uint8, shape (nk, n, n), [k, j, i]."""
+        n = self.plan.n
+        count = nk * n * n
+        out = cla.empty(self.queue, count, np.uint8)
+        launch(self.queue, self.sample_k, count, np.int32(n), np.int32(n), np.int32(k0), *self.grid,
+               *self.fractal, out.data)
+        return out.get().reshape(nk, n, n)
+
+    def vertices(self, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Vertices (m, 4) on the surface between world points ends_a and ends_b (one inside,
+        one outside, either order), and the width of each one's bracket (0 on the ball's cut
+        face, -1 where the ends agree)."""
+        m = len(ends_a)
+        if m == 0:
+            return np.empty((0, 4)), np.empty(0)
+        pr = self.pr
+        o, i = (cla.to_device(self.queue, _as_vec4(a, pr)) for a in (ends_a, ends_b))
+        vertex = cla.empty(self.queue, m, pr.vec_dtype)
+        width = cla.empty(self.queue, m, pr.scalar)
+        launch(self.queue, self.vertex_k, m, o.data, i.data, *self.fractal, np.int32(self.plan.steps),
+               vertex.data, width.data)
+        v = vertex.get()
+        return np.stack([v[k] for k in ("x", "y", "z", "w")], axis=1).astype(np.float64), width.get().astype(np.float64)
+
+
+def _as_vec4(a: np.ndarray, pr: Precision) -> np.ndarray:
+    """(m, 4) floats as an array of the kernels' real4."""
+    out = np.empty(len(a), pr.vec_dtype)
+    for k, name in enumerate(("x", "y", "z", "w")):
+        out[name] = a[:, k]
+    return out
