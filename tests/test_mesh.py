@@ -1,0 +1,191 @@
+"""Meshes (pyjulia4d/app/mesh.py, kernels/mesh/mesh.cl) against their float64 twin
+(reference/mesh.py) and against the mathematics: the c = 0 set is a ball of known radius,
+a set that fills its bounding ball is cut by the sphere, blocks of layers give the mesh one
+grid gives, every format reads back, and bad input is one line."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+import harness
+from pyjulia4d.app import mesh as mesh_mod
+from pyjulia4d.pipeline import mesh_plan
+from pyjulia4d.pipeline.mesh_plan import make_mesh_plan
+from pyjulia4d.reference import mesh as twin
+from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.model import Scene
+
+pytest.importorskip("mcubes")
+trimesh = pytest.importorskip("trimesh")
+
+BALL = Scene.default().replace(**{"fractal.c": [0.0, 0.0, 0.0, 0.0]})
+# c = 0, q -> q^2: |q_N| = |q|^(2^N) <= bailout, so the truncated set is the ball of radius
+# bailout^(1/2^N) (iterate.cl's definition; bailout 4, N = 12: 1.000338)
+BALL_RADIUS = 4.0 ** (1.0 / 2 ** 12)
+
+SCENES = {
+    "default": Scene.default(),
+    "hypercomplex-sin": Scene.default().replace(**{"fractal.algebra": "hypercomplex", "fractal.function": "sin",
+                                                   "fractal.c": [0.2, 0.6, 0.1, 0.0], "fractal.max_iter": 8}),
+    "cquat-cube": Scene.default().replace(**{"fractal.algebra": "cquat", "fractal.function": "cube",
+                                             "fractal.c": [0.1, 0.3, 0.0, 0.0]}),
+    "mandelbrot-slice": Scene.default().replace(**{"fractal.kind": "mandelbrot", "fractal.max_iter": 10,
+                                                   "slice.normal": [0.0, 0.3, 0.0, 1.0], "slice.distance": 0.1}),
+    "stack": Scene.default().replace(**{"fractal.kind": "julia_stack", "fractal.max_iter": 16}),
+}
+
+
+def runner(plan):
+    from pyjulia4d.opencl.mesh import MeshRunner
+    return MeshRunner(plan, harness.device())
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_the_sampling_kernel_matches_its_twin(name):
+    """float32 against float64: a grid point may be classified differently only where the two
+    precisions' orbits part, within rounding of the surface - at most 0.5 % of the points, each
+    next to a point of the other class in the twin's own mask."""
+    plan = make_mesh_plan(SCENES[name], 24)
+    got = runner(plan).sample(0, plan.n)
+    want = twin.mesh_sample(plan, 0, plan.n)
+    assert got.shape == want.shape == (24, 24, 24)
+    assert 0 < want.sum() < want.size
+    diff = np.argwhere(got != want)
+    assert len(diff) <= 0.005 * want.size, len(diff)
+    pad = np.pad(want, 1, mode="edge")
+    for k, j, i in diff:
+        nb = pad[k:k + 3, j:j + 3, i:i + 3]
+        assert nb.min() != nb.max(), (k, j, i)
+
+
+@pytest.mark.parametrize("name", ["default", "hypercomplex-sin", "stack"])
+def test_the_vertex_kernel_matches_its_twin(name):
+    """The same grid edges through both executors: float32 vertices within 2e-6 of the float64
+    ones (about 16 float32 ulps of a coordinate near 1: the level function's rounding near the
+    surface; measured at most 7e-7), or, where the float32 orbit reads a point differently,
+    within one grid spacing - on at most 2 % of them."""
+    plan = make_mesh_plan(SCENES[name], 24)
+    mask = twin.mesh_sample(plan, 0, plan.n)
+    edges = np.argwhere(mask[:, :, 1:] != mask[:, :, :-1])    # x-edges whose ends differ
+    lo = edges[:, ::-1].astype(float)
+    hi = lo + [1.0, 0.0, 0.0]
+    a, b = plan.to_world(lo), plan.to_world(hi)
+    got, gw = runner(plan).vertices(a, b)
+    want, ww = twin.mesh_vertices(plan, a, b)
+    assert np.all(ww >= 0) and np.all(ww <= plan.spacing / 2 ** (plan.steps - 1))
+    err = np.linalg.norm(got - want, axis=1)
+    assert np.all(err <= plan.spacing * 1.0001)
+    assert np.mean(err > 2e-6) <= 0.02
+
+
+def test_the_c0_set_meshes_to_its_ball():
+    r = mesh_mod.build_mesh(BALL, 48, harness.device())
+    m = r.mesh
+    assert m.is_watertight and m.is_winding_consistent and m.volume > 0
+    radii = np.linalg.norm(m.vertices, axis=1)
+    # every vertex on the sphere to float32's rounding of a point near radius 1 (measured 9e-8)
+    assert np.max(np.abs(radii - BALL_RADIUS)) < 5e-7
+    exact = 4.0 / 3.0 * np.pi * BALL_RADIUS ** 3
+    # an inscribed polyhedron: a little inside, by O(h^2) (h = 0.045 here: 0.3 %)
+    assert 0.995 * exact < m.volume < exact
+    assert abs(r.voxel_volume - exact) < 0.03 * exact
+    # outward normals: a vertex's normal along its position
+    assert np.mean(np.sum(m.vertex_normals * m.vertices, axis=1) / radii > 0.99) > 0.99
+
+
+def test_the_ball_cuts_a_set_that_fills_it():
+    """A set reaching its bounding ball (hypercomplex reciprocal stays bounded almost everywhere,
+    camera.bounding_radius): closed by the sphere, those vertices exactly on it."""
+    scene = Scene.default().replace(**{"fractal.algebra": "hypercomplex", "fractal.function": "reciprocal",
+                                       "fractal.c": [0.1, 0.2, 0.0, 0.0], "fractal.max_iter": 6})
+    r = mesh_mod.build_mesh(scene, 32, harness.device())
+    assert r.mesh.is_watertight
+    world = r.mesh.vertices @ r.plan.axes + r.plan.offset
+    on_sphere = np.abs(np.linalg.norm(world, axis=1) - r.plan.radius) < 1e-5 * r.plan.radius
+    assert np.mean(on_sphere) > 0.05
+
+
+def test_blocks_of_layers_give_the_mesh_of_one_block(monkeypatch):
+    whole = mesh_mod.build_mesh(SCENES["default"], 40, harness.device())
+    monkeypatch.setattr(mesh_plan, "BLOCK_POINTS", 40 * 40 * 3)   # 3 layers a launch
+    blocks = mesh_mod.build_mesh(SCENES["default"], 40, harness.device())
+    assert blocks.plan.block == 3
+    assert len(blocks.mesh.faces) == len(whole.mesh.faces) and blocks.inside_points == whole.inside_points
+    assert np.allclose(np.sort(blocks.mesh.vertices, axis=0), np.sort(whole.mesh.vertices, axis=0), atol=0)
+    assert blocks.mesh.is_watertight == whole.mesh.is_watertight
+
+
+def test_the_reference_executor_meshes_the_same_set():
+    a = mesh_mod.build_mesh(SCENES["default"], 20, harness.device())
+    b = mesh_mod.build_mesh(SCENES["default"], 20, executor="reference")
+    assert abs(len(a.mesh.faces) - len(b.mesh.faces)) <= 0.02 * len(b.mesh.faces)
+    assert abs(a.mesh.volume - b.mesh.volume) <= 0.02 * b.mesh.volume
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".ply", ".obj", ".glb"])
+def test_every_format_reads_back(tmp_path, suffix):
+    r = mesh_mod.build_mesh(BALL, 24, harness.device())
+    out = mesh_mod.check_mesh_path(tmp_path / f"ball{suffix}")
+    mesh_mod.write_mesh(out, r)
+    back = trimesh.load(out, force="mesh")
+    assert len(back.faces) == len(r.mesh.faces)
+    assert back.is_watertight and abs(back.volume - r.mesh.volume) < 1e-5 * r.mesh.volume
+    if suffix in (".ply", ".glb"):   # formats that carry vertex colours
+        assert back.visual.kind == "vertex"
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
+def test_smoothing_keeps_it_closed_and_its_volume():
+    r0 = mesh_mod.build_mesh(SCENES["default"], 40, harness.device())
+    r1 = mesh_mod.build_mesh(SCENES["default"], 40, harness.device(), smooth=10)
+    assert r1.mesh.is_watertight and len(r1.mesh.faces) == len(r0.mesh.faces)
+    assert abs(r1.mesh.volume - r0.mesh.volume) < 0.05 * r0.mesh.volume
+
+
+@pytest.mark.parametrize("args,says", [
+    (["--resolution", "7"], "--resolution: expected a whole number of grid points a side in [8, 2048], got 7"),
+    (["--resolution", "1e3"], "--resolution: expected a whole number"),
+    (["--resolution", "99999999999999999999999"], "--resolution: expected a whole number"),
+    (["--smooth", "1001"], "--smooth: expected a whole number of smoothing passes"),
+    (["-o", "x.fbx"], "x.fbx: unsupported mesh format '.fbx' (use .stl, .ply, .obj or .glb)"),
+    (["-o", "x"], "x: unsupported mesh format '(none)'"),
+    (["-o", "nodir/x.stl"], "x.stl: directory 'nodir' does not exist"),
+    (["--set", "slice.distance=3"], "slice.distance: 3.0 is outside the set's bounding ball"),
+    (["--set", "fractal.c=0,0,0"], "fractal.c"),
+    (["--resolution", "2048", "--set", "fractal.max_iter=100000"], "h of sampling; lower it, or --force"),
+    (["missing.toml"], "missing.toml: cannot read"),
+])
+def test_bad_mesh_input_is_one_line_status_2_and_no_file(tmp_path, capsys, monkeypatch, args, says):
+    from pyjulia4d.app.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["mesh", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pyjulia4d: error: ") and says in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_command_writes_the_mesh_it_reports(tmp_path, capsys, monkeypatch):
+    from pyjulia4d.app.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["mesh", "--resolution", "24", "--set", "fractal.c=0,0,0,0", "-o", "ball.ply"]) == 0
+    line = capsys.readouterr().out
+    back = trimesh.load(tmp_path / "ball.ply", force="mesh")
+    assert line.startswith("wrote ball.ply") and f"{len(back.faces)} triangles" in line
+    assert [p.name for p in tmp_path.iterdir()] == ["ball.ply"]
+
+
+def test_plans_refuse_what_is_no_scene():
+    with pytest.raises(SceneError, match="scene: expected a pyjulia4d.Scene"):
+        make_mesh_plan({"fractal": {}}, 32)
+    for bad in (True, 7, 2049, 32.0, "32", None):
+        with pytest.raises(SceneError, match="--resolution"):
+            make_mesh_plan(Scene.default(), bad)
+
+
+def test_the_grid_covers_the_balls_section_with_a_layer_outside():
+    plan = make_mesh_plan(dataclasses.replace(Scene.default()), 32)
+    r = np.sqrt(plan.radius ** 2 - plan.scene.slice.distance ** 2)
+    assert plan.origin[0] == pytest.approx(-r - plan.spacing)
+    assert plan.origin[0] + plan.spacing * (plan.n - 1) == pytest.approx(r + plan.spacing)
