@@ -82,13 +82,14 @@ def preview(path: Path, overrides: list[str], n: int) -> None:
     v = m.vertices
     fig = plt.figure(figsize=(6, 6))
     ax = fig.add_subplot(111, projection="3d")
-    ax.plot_trisurf(v[:, 0], v[:, 2], v[:, 1], triangles=m.faces, color=(0.95, 0.72, 0.42), shade=True,
+    ax.plot_trisurf(v[:, 0], v[:, 2], v[:, 1], triangles=m.faces, color=m.visual.vertex_colors[0, :3] / 255, shade=True,
                     lightsource=LightSource(azdeg=225, altdeg=45), linewidth=0, antialiased=False)
-    r = float(np.abs(v).max())
-    ax.set_xlim(-r, r), ax.set_ylim(-r, r), ax.set_zlim(-r, r)
+    mid = (v.max(axis=0) + v.min(axis=0)) / 2
+    r = float((v.max(axis=0) - v.min(axis=0)).max()) / 2
+    ax.set_xlim(mid[0] - r, mid[0] + r), ax.set_ylim(mid[2] - r, mid[2] + r), ax.set_zlim(mid[1] - r, mid[1] + r)
     ax.view_init(20, -50)
     ax.set_axis_off()
-    ax.set_box_aspect((1, 1, 1))
+    ax.set_box_aspect((1, 1, 1), zoom=1.4)
     fig.savefig(path, dpi=100, bbox_inches="tight")
 
 

@@ -70,12 +70,13 @@ def test_the_vertex_kernel_matches_its_twin(name):
     lo = edges[:, ::-1].astype(float)
     hi = lo + [1.0, 0.0, 0.0]
     a, b = plan.to_world(lo), plan.to_world(hi)
-    got, gw = runner(plan).vertices(a, b)
-    want, ww = twin.mesh_vertices(plan, a, b)
+    got, gw, gin = runner(plan).vertices(a, b)
+    want, ww, win = twin.mesh_vertices(plan, a, b)
     assert np.all(ww >= 0) and np.all(ww <= plan.spacing / 2 ** (plan.steps - 1))
     err = np.linalg.norm(got - want, axis=1)
     assert np.all(err <= plan.spacing * 1.0001)
     assert np.mean(err > 2e-6) <= 0.02
+    assert np.mean(np.linalg.norm(gin - win, axis=1) > 2e-6) <= 0.02
 
 
 def test_the_c0_set_meshes_to_its_ball():
@@ -189,3 +190,56 @@ def test_the_grid_covers_the_balls_section_with_a_layer_outside():
     r = np.sqrt(plan.radius ** 2 - plan.scene.slice.distance ** 2)
     assert plan.origin[0] == pytest.approx(-r - plan.spacing)
     assert plan.origin[0] + plan.spacing * (plan.n - 1) == pytest.approx(r + plan.spacing)
+
+
+def test_vertex_colours_follow_the_renders_colouring():
+    from pyjulia4d.pipeline.colormap import linear_to_srgb, table
+
+    flat = mesh_mod.build_mesh(SCENES["default"], 24, harness.device())
+    want = np.rint(linear_to_srgb(np.asarray(Scene.default().shading.color)) * 255)
+    assert np.all(flat.mesh.visual.vertex_colors[:, :3] == want)
+    # w over [-R/2, R/2] through the colour map: a slice tilted into w spans colours in order
+    scene = SCENES["default"].replace(**{"shading.coloring": "w", "shading.colormap": "viridis",
+                                         "slice.normal": [0.0, 0.0, 0.6, 1.0]})
+    r = mesh_mod.build_mesh(scene, 24, harness.device())
+    world = r.mesh.vertices @ r.plan.axes + r.plan.offset
+    lo, hi = np.argmin(world[:, 3]), np.argmax(world[:, 3])
+    lut = np.rint(linear_to_srgb(table("viridis")[:, :3].astype(float)) * 255)
+    cols = r.mesh.visual.vertex_colors[:, :3].astype(float)
+    # the lowest w nearer the map's low end than its high end, and the highest the other way
+    d = lambda c, k: np.abs(c - lut[k]).sum()
+    assert d(cols[lo], 0) < d(cols[lo], -1) and d(cols[hi], -1) < d(cols[hi], 0)
+
+
+
+@pytest.mark.parametrize("coloring", ["iteration", "trap"])
+def test_orbit_colourings_take_the_values_the_render_takes(coloring):
+    """The render's colour value at its hits (the smooth escape count or the orbit trap of each
+    bracket's inside end, shade/light.cl) and the mesh's at its vertices span the same range:
+    the same surface, coloured the same way (to 0.02 of the map, for the pixels' and vertices'
+    different sample points)."""
+    from pyjulia4d import render
+    from pyjulia4d.geometry.camera import camera_frame
+    from pyjulia4d.reference.formula import formula_of
+    from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
+
+    scene = Scene.from_dict({"fractal": {"c": [-0.75, 0.11, 0.0, 0.0]}, "image": {"width": 64, "height": 48},
+                             "shading": {"coloring": coloring, "trap": [0.3, 0.2, 0.0, 0.0]}})
+    shot = render(scene, device=harness.device())
+    s = shot.scene
+    hit = np.isfinite(shot.bracket)
+    p = shot.position[hit].astype(float)
+    d = p - camera_frame(s).position
+    pin = p + shot.bracket[hit][:, None] * d / np.linalg.norm(d, axis=1)[:, None]
+    f = s.fractal
+    if coloring == "iteration":
+        seen = orbit_iteration(pin, f.c, f.max_iter, f.bailout, formula_of(f))
+    else:
+        from pyjulia4d.geometry.camera import to_world
+        seen = orbit_trap(pin, f.c, f.max_iter, f.bailout, to_world(s, s.shading.trap), formula_of(f))
+    r = mesh_mod.build_mesh(s, 48, harness.device())
+    world = r.mesh.vertices @ r.plan.axes + r.plan.offset
+    inner = world   # the vertices lie within 1e-8 of their brackets' inside ends
+    got = mesh_mod.colouring_values(s, world, inner)
+    assert got.min() > seen.min() - 0.02 and got.max() < seen.max() + 0.02
+    assert abs(np.median(got) - np.median(seen)) < 0.02

@@ -46,7 +46,8 @@ inline int mesh_inside(real4 p, real radius2, julia_params jp)
 
 __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global const real4 *ends_b,
                             const real radius2, const real4 c, const int max_iter, const real bailout,
-                            const int steps, __global real4 *vertex, __global real *width)
+                            const int steps, __global real4 *vertex, __global real *width,
+                            __global real4 *inside_end)
 {
     size_t g = get_global_id(0);
     if (g >= (size_t)n)
@@ -55,7 +56,7 @@ __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global 
     real4 pa = ends_a[g], pb = ends_b[g];
     int ia = mesh_inside(pa, radius2, jp), ib = mesh_inside(pb, radius2, jp);
     if (ia == ib) {
-        vertex[g] = (real)0.5 * (pa + pb);
+        vertex[g] = inside_end[g] = (real)0.5 * (pa + pb);
         width[g] = -1;
         return;
     }
@@ -68,7 +69,7 @@ __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global 
         a = clamp(-b - sqrt(fmax(b * b - e, (real)0)), (real)0, len);
         real4 pe = po + a * d;
         if (julia_inside(pe, jp)) {   /* the set reaches the sphere here: the ball's cut face */
-            vertex[g] = pe;
+            vertex[g] = inside_end[g] = pe;
             width[g] = 0;
             return;
         }
@@ -77,4 +78,5 @@ __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global 
     real t = refine_bracket(po, d, a, len, 1, steps, jp, &w);
     vertex[g] = po + (t + (real)0.5 * w) * d;
     width[g] = w;
+    inside_end[g] = po + (t + w) * d;   /* verified inside: where the render's colourings start */
 }

@@ -10,8 +10,9 @@ and Blender (STL, PLY, OBJ, glTF binary).
    bounding ball's sphere where the ball cuts the set - so the mesh is not staircased, and
    it is closed.
 4. trimesh orients it outwards, computes vertex normals, optionally smooths it (Taubin's
-   lambda|mu filter, which keeps the volume), colours its vertices with shading.color and
-   writes it, atomically.
+   lambda|mu filter, which keeps the volume), colours its vertices as the render colours its
+   hits (shading.coloring: flat, iteration, trap, w) and writes it, atomically; STL carries
+   no colour, PLY, OBJ and glTF do.
 
 The mesh is in the slice's own 3D coordinates (the scene units the camera sees)."""
 from __future__ import annotations
@@ -140,7 +141,7 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     lo[np.arange(len(gv)), axis] = np.floor(gv[np.arange(len(gv)), axis])
     hi = lo.copy()
     hi[np.arange(len(gv)), axis] += 1.0
-    world, width = vertices(plan.to_world(lo), plan.to_world(hi))
+    world, width, inner = vertices(plan.to_world(lo), plan.to_world(hi))
     seconds["vertices"] = time.perf_counter() - t
     t = time.perf_counter()
     # world points -> the slice's coordinates: x = axes (p - offset), axes orthonormal
@@ -150,7 +151,7 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
         mesh.invert()
     if smooth:
         trimesh.smoothing.filter_taubin(mesh, iterations=smooth)
-    _colour(mesh, scene)
+    mesh.visual.vertex_colors = vertex_colours(scene, world, inner)
     seconds["finish"] = time.perf_counter() - t
     seconds["total"] = time.perf_counter() - t0
     widest = float(np.max(width)) if len(width) else 0.0
@@ -173,13 +174,41 @@ def _executor(plan: MeshPlan, device: Any, executor: str):
     return runner.sample, runner.vertices
 
 
-def _colour(mesh: Any, scene: Scene) -> None:
-    """shading.color on every vertex, sRGB-encoded 8-bit (the formats' convention)."""
-    from pyjulia4d.pipeline.colormap import linear_to_srgb
+def colouring_values(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.ndarray | None:
+    """The colour map's value at each vertex, as the render takes it at a hit
+    (kernels/shade/light.cl): the smooth escape count or the orbit trap of the bracket's
+    inside end ``inner``, or w over [-R/2, R/2] at the vertex ``world``; computed by the float64
+    twins (reference/shade.py).  None for the "flat" colouring."""
+    from pyjulia4d.geometry.camera import march_radius, to_world
+    from pyjulia4d.reference.formula import formula_of
+    from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
 
-    rgb = np.clip(linear_to_srgb(np.asarray(scene.shading.color, np.float64)), 0, 1)
-    rgba = np.append(np.rint(rgb * 255), 255).astype(np.uint8)
-    mesh.visual.vertex_colors = np.tile(rgba, (len(mesh.vertices), 1))
+    sh, f = scene.shading, scene.fractal
+    F, mandelbrot = formula_of(f), f.kind == "mandelbrot"
+    if sh.coloring == "iteration":
+        return orbit_iteration(inner, f.c, f.max_iter, f.bailout, F, mandelbrot)
+    if sh.coloring == "trap":
+        return orbit_trap(inner, f.c, f.max_iter, f.bailout, to_world(scene, sh.trap), F, mandelbrot)
+    if sh.coloring == "w":
+        return np.clip(0.5 + world[:, 3] / march_radius(scene), 0.0, 1.0)
+    return None
+
+
+def vertex_colours(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.ndarray:
+    """(m, 4) uint8 sRGB colours of the vertices, as the render colours a hit (shade/shade.cl):
+    shading.color for "flat", else the colour map at colouring_values."""
+    from pyjulia4d.pipeline.colormap import linear_to_srgb, table
+
+    val = colouring_values(scene, world, inner)
+    if val is None:
+        base = np.broadcast_to(np.asarray(scene.shading.color, np.float64), (len(world), 3))
+    else:
+        lut = table(scene.shading.colormap).astype(np.float64)
+        x = np.clip(val, 0.0, 1.0) * (len(lut) - 1)
+        k = np.minimum(x.astype(int), len(lut) - 2)
+        base = lut[k, :3] + (x - k)[:, None] * (lut[k + 1, :3] - lut[k, :3])
+    rgb = np.rint(linear_to_srgb(np.clip(base, 0.0, 1.0)) * 255)
+    return np.concatenate([rgb, np.full((len(world), 1), 255.0)], axis=1).astype(np.uint8)
 
 
 def write_mesh(path: str | Path, result: MeshResult) -> None:

@@ -34,21 +34,26 @@ class MeshRunner:
                *self.fractal, out.data)
         return out.get().reshape(nk, n, n)
 
-    def vertices(self, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def vertices(self, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Vertices (m, 4) on the surface between world points ends_a and ends_b (one inside,
-        one outside, either order), and the width of each one's bracket (0 on the ball's cut
-        face, -1 where the ends agree)."""
+        one outside, either order), the width of each one's bracket (0 on the ball's cut
+        face, -1 where the ends agree), and the bracket's inside end (m, 4)."""
         m = len(ends_a)
         if m == 0:
-            return np.empty((0, 4)), np.empty(0)
+            return np.empty((0, 4)), np.empty(0), np.empty((0, 4))
         pr = self.pr
         o, i = (cla.to_device(self.queue, _as_vec4(a, pr)) for a in (ends_a, ends_b))
         vertex = cla.empty(self.queue, m, pr.vec_dtype)
+        inner = cla.empty(self.queue, m, pr.vec_dtype)
         width = cla.empty(self.queue, m, pr.scalar)
         launch(self.queue, self.vertex_k, m, o.data, i.data, *self.fractal, np.int32(self.plan.steps),
-               vertex.data, width.data)
-        v = vertex.get()
-        return np.stack([v[k] for k in ("x", "y", "z", "w")], axis=1).astype(np.float64), width.get().astype(np.float64)
+               vertex.data, width.data, inner.data)
+        return _from_vec4(vertex.get()), width.get().astype(np.float64), _from_vec4(inner.get())
+
+
+def _from_vec4(a: np.ndarray) -> np.ndarray:
+    """An array of real4 as (m, 4) float64."""
+    return np.stack([a[k] for k in ("x", "y", "z", "w")], axis=1).astype(np.float64)
 
 
 def _as_vec4(a: np.ndarray, pr: Precision) -> np.ndarray:

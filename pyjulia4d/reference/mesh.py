@@ -18,9 +18,10 @@ def mesh_sample(plan, k0: int, nk: int) -> np.ndarray:
     return _inside(plan, p, formula_of(plan.scene.fractal)).astype(np.uint8).reshape(nk, n, n)
 
 
-def mesh_vertices(plan, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices (m, 4), bracket widths (m,)) on the edges between world points ends_a and
-    ends_b, one inside and one outside in either order; -1 where both ends agree."""
+def mesh_vertices(plan, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices (m, 4), bracket widths (m,), the brackets' inside ends (m, 4)) on the edges
+    between world points ends_a and ends_b, one inside and one outside in either order; width
+    -1 where both ends agree."""
     F = formula_of(plan.scene.fractal)
     pa, pb = np.asarray(ends_a, float), np.asarray(ends_b, float)
     ia, ib = _inside(plan, pa, F), _inside(plan, pb, F)
@@ -36,17 +37,18 @@ def mesh_vertices(plan, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndar
     pe = po + a[:, None] * d
     cut = out_ball.copy()
     cut[out_ball] = julia_inside(pe[out_ball], plan.c, plan.max_iter, plan.bailout, F)
-    vertex, width = pe.copy(), np.zeros(len(po))
+    vertex, width, inner = pe.copy(), np.zeros(len(po)), pe.copy()
     k = ~cut & (ia != ib)
     if np.any(k):
         t, w = refine_bracket(po[k], d[k], a[k], length[k], plan.steps, plan.c, plan.max_iter, plan.bailout,
                               itp=plan.scene.march.refine == "itp", formula=F)
         vertex[k] = po[k] + (t + 0.5 * w)[:, None] * d[k]
+        inner[k] = po[k] + (t + w)[:, None] * d[k]
         width[k] = w
     same = ia == ib
-    vertex[same] = 0.5 * (pa[same] + pb[same])
+    vertex[same] = inner[same] = 0.5 * (pa[same] + pb[same])
     width[same] = -1.0
-    return vertex, width
+    return vertex, width, inner
 
 
 def _inside(plan, p: np.ndarray, F) -> np.ndarray:
