@@ -148,6 +148,8 @@ def test_smoothing_keeps_it_closed_and_its_volume():
     (["--resolution", "1e3"], "--resolution: expected a whole number"),
     (["--resolution", "99999999999999999999999"], "--resolution: expected a whole number"),
     (["--smooth", "1001"], "--smooth: expected a whole number of smoothing passes"),
+    (["--decimate", "0"], "--decimate: expected the share of triangles to keep, in (0, 1], got 0.0"),
+    (["--decimate", "half"], "--decimate: expected the share of triangles to keep, in (0, 1], got 'half'"),
     (["-o", "x.fbx"], "x.fbx: unsupported mesh format '.fbx' (use .stl, .ply, .obj or .glb)"),
     (["-o", "x"], "x: unsupported mesh format '(none)'"),
     (["-o", "nodir/x.stl"], "x.stl: directory 'nodir' does not exist"),
@@ -243,3 +245,14 @@ def test_orbit_colourings_take_the_values_the_render_takes(coloring):
     got = mesh_mod.colouring_values(s, world, inner)
     assert got.min() > seen.min() - 0.02 and got.max() < seen.max() + 0.02
     assert abs(np.median(got) - np.median(seen)) < 0.02
+
+
+def test_decimation_keeps_the_share_asked_and_says_whether_it_is_closed():
+    full = mesh_mod.build_mesh(SCENES["default"], 40, harness.device())
+    half = mesh_mod.build_mesh(SCENES["default"], 40, harness.device(), decimate=0.5)
+    assert abs(len(half.mesh.faces) - 0.5 * len(full.mesh.faces)) <= 0.02 * len(full.mesh.faces)
+    assert len(half.mesh.visual.vertex_colors) == len(half.mesh.vertices)
+    assert ("not watertight" in half.summary()) != half.mesh.is_watertight
+    for bad in (0, 0.0, -0.5, 1.5, float("nan"), True, "0.5"):
+        with pytest.raises(SceneError, match="--decimate"):
+            mesh_mod.check_decimate(bad)

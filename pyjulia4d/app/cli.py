@@ -99,6 +99,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="grid points a side, 8 to 2048 (default 128; 512 takes about a minute here)")
     m.add_argument("--smooth", metavar="PASSES", default="0",
                    help="Taubin smoothing passes, 0 to 1000 (default 0: every vertex on the surface)")
+    m.add_argument("--decimate", metavar="SHARE", default="1",
+                   help="keep this share of the triangles, in (0, 1] (default 1: all; quadric decimation may "
+                        "open the mesh: the closing line says whether it is watertight)")
     m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, as for render")
     m.add_argument("--device", metavar="SPEC", help="OpenCL device (as for render)")
@@ -244,25 +247,34 @@ def _scene_of(path: str | None, overrides: Sequence[str]) -> Scene:
     return Scene.from_toml(path, overrides)
 
 
-def _whole(flag: str, text: str) -> int | str:
+def _whole(text: str) -> int | str:
     """A flag's whole number, or its text as given (the checker then names it)."""
     t = text.strip()
     return int(t) if t.isascii() and t.lstrip("+-").isdigit() and len(t) < 20 else text
 
 
+def _real(text: str) -> float | str:
+    """A flag's finite number, or its text as given (the checker then names it)."""
+    from pyjulia4d.scene.checks import scalar
+
+    value = scalar(text)
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else text
+
+
 def _mesh(args: argparse.Namespace) -> int:
     """mesh: SCENE -> OUT.stl|ply|obj|glb (app/mesh.py); every argument checked before the device."""
-    from pyjulia4d.app.mesh import build_mesh, check_mesh_path, check_smooth, write_mesh
+    from pyjulia4d.app.mesh import build_mesh, check_decimate, check_mesh_path, check_smooth, write_mesh
     from pyjulia4d.pipeline.mesh_plan import check_resolution
 
-    resolution = check_resolution(_whole("--resolution", args.resolution))
-    smooth = check_smooth(_whole("--smooth", args.smooth))
+    resolution = check_resolution(_whole(args.resolution))
+    smooth = check_smooth(_whole(args.smooth))
+    decimate = check_decimate(_real(args.decimate))
     scene = _scene_of(args.scene, args.overrides)
     stem = "julia" if args.scene is None else Path(args.scene).stem
     out = check_mesh_path(args.output if args.output is not None else stem + ".stl")
     device = select_device(args.device)
     result = build_mesh(scene, resolution, device, smooth, args.force, progress=True,
-                        warn=lambda text: _say(f"pyjulia4d: warning: {text}"))
+                        warn=lambda text: _say(f"pyjulia4d: warning: {text}"), decimate=decimate)
     write_mesh(out, result)
     print(f"wrote {out} in {result.seconds['total']:.2f} s: {result.summary()}")
     return 0
@@ -306,8 +318,7 @@ def _import_pov(args: argparse.Namespace) -> int:
     size = []
     for key, value in (("image.width", args.width), ("image.height", args.height)):
         if value is not None:
-            v = value.strip()
-            value = int(v) if v.isascii() and v.lstrip("+-").isdigit() and len(v) < 20 else value
+            value = _whole(value)
             Scene.from_dict({"image": {key.partition(".")[2]: value}})  # render's range errors
         size.append(value)
     imported = import_pov(args.pov, *size)

@@ -10,7 +10,8 @@ and Blender (STL, PLY, OBJ, glTF binary).
    bounding ball's sphere where the ball cuts the set - so the mesh is not staircased, and
    it is closed.
 4. trimesh orients it outwards, computes vertex normals, optionally smooths it (Taubin's
-   lambda|mu filter, which keeps the volume), colours its vertices as the render colours its
+   lambda|mu filter, which keeps the volume), optionally decimates it (quadric error metrics,
+   through fast-simplification), colours its vertices as the render colours its
    hits (shading.coloring: flat, iteration, trap, w) and writes it, atomically; STL carries
    no colour, PLY, OBJ and glTF do.
 
@@ -86,13 +87,21 @@ def check_smooth(value: Any) -> int:
     return value
 
 
+def check_decimate(value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= 1.0:
+        raise SceneError("--decimate", f"expected the share of triangles to keep, in (0, 1], got {value!r}"[:120])
+    return float(value)
+
+
 def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: int = 0, force: bool = False,
-               progress: bool = False, executor: str = "opencl", warn: Callable[[str], None] | None = None
-               ) -> MeshResult:
+               progress: bool = False, executor: str = "opencl", warn: Callable[[str], None] | None = None,
+               decimate: float = 1.0) -> MeshResult:
     """The mesh of ``scene`` on a grid of ``resolution`` points a side (see the module's
     docstring).  ``executor`` "reference" runs the float64 twins (small grids only).  Work
     estimated past REFUSE_SECONDS is refused unless ``force``; past WARN_SECONDS ``warn`` is
-    told."""
+    told.  ``decimate`` below 1 keeps that share of the triangles (quadric decimation,
+    fast-simplification through trimesh; it may open the mesh: summary() says whether it is
+    watertight)."""
     import mcubes
     import trimesh
 
@@ -100,6 +109,7 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
 
     t0 = time.perf_counter()
     smooth = check_smooth(smooth)
+    decimate = check_decimate(decimate)
     plan = make_mesh_plan(scene, resolution)
     est = estimate_seconds(plan)
     if est > REFUSE_SECONDS and not force:
@@ -151,6 +161,9 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
         mesh.invert()
     if smooth:
         trimesh.smoothing.filter_taubin(mesh, iterations=smooth)
+    if decimate < 1.0:   # new vertices: coloured at themselves (within h of the surface)
+        mesh = mesh.simplify_quadric_decimation(percent=1.0 - decimate)
+        world = inner = np.asarray(mesh.vertices) @ plan.axes + plan.offset
     mesh.visual.vertex_colors = vertex_colours(scene, world, inner)
     seconds["finish"] = time.perf_counter() - t
     seconds["total"] = time.perf_counter() - t0
