@@ -50,7 +50,7 @@ BAD_ARGS = {
     "max-iter-0": (["--set", "fractal.max_iter=0"], "fractal.max_iter: must be in [1, 1000000], got 0"),
     "epsilon-0": (["--set", "march.epsilon=0"], "march.epsilon: must be in [1e-12, 1], got 0"),
     "malformed": (["--set", "fractal.c"], "fractal.c: malformed override, expected SECTION.KEY=VALUE"),
-    "bad-ext": (["-o", "out.jpg"], "out.jpg: unsupported output format '.jpg' (use .png or .exr)"),
+    "bad-ext": (["-o", "out.jpg"], "out.jpg: unsupported output format '.jpg' (use .png, .exr, .tif or .tiff)"),
     "no-dir": (["-o", "nowhere/out.png"], "nowhere/out.png: directory 'nowhere' does not exist"),
     "huge-normal": (["--set", "slice.normal=1e300,1e300,1e300,1e300"],
                     "slice.normal: element 0: must be in [-1e6, 1e6], got 1e+300"),

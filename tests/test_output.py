@@ -97,7 +97,7 @@ def test_write_image_dispatch(tmp_path) -> None:
     write_image(tmp_path / "b.exr", res, {"k": "v"})
     assert Image.open(tmp_path / "a.PNG").mode == "RGBA"
     assert OpenEXR.File(str(tmp_path / "b.exr"), header_only=True).header()["k"] == "v"
-    with pytest.raises(OutputError, match=r"unsupported output format '\.jpg' \(use \.png or \.exr\)"):
+    with pytest.raises(OutputError, match=r"unsupported output format '\.jpg' \(use \.png, \.exr, \.tif or \.tiff\)"):
         write_image(tmp_path / "c.jpg", res, {})
     assert not (tmp_path / "c.jpg").exists()
 
@@ -106,7 +106,7 @@ def test_check_output_path(tmp_path) -> None:
     assert check_output_path(tmp_path / "x.exr") == tmp_path / "x.exr"
     with pytest.raises(OutputError) as info:
         check_output_path(tmp_path / "x.jpg")
-    assert str(info.value) == f"{tmp_path / 'x.jpg'}: unsupported output format '.jpg' (use .png or .exr)"
+    assert str(info.value) == f"{tmp_path / 'x.jpg'}: unsupported output format '.jpg' (use .png, .exr, .tif or .tiff)"
     with pytest.raises(OutputError, match="does not exist"):
         check_output_path(tmp_path / "nope" / "x.png")
     (tmp_path / "d.png").mkdir()

@@ -53,12 +53,12 @@ def _parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     r = sub.add_parser("render", help="render a scene to .png or .exr")
-    r.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr",
+    r.add_argument("scene", nargs="?", metavar="SCENE.toml|IMAGE.png|IMAGE.exr|IMAGE.tif",
                    help="scene file, or an image pyjulia4d rendered: its header holds the scene as "
                         "rendered, which is rendered again (default: the built-in scene)")
     r.add_argument("-o", "--output", metavar="OUT",
-                   help="OUT.png or OUT.exr (default: <scene stem>.png, <image stem>-rerender.png for an "
-                        "image, or julia.png)")
+                   help="OUT.png, OUT.tif or OUT.exr (default: <scene stem>.png, <image stem>-rerender.png for an "
+                        "image, or julia.png); image.bits=16 makes a PNG or TIFF 16 bits a channel")
     # kept as text so bad sizes get the same one-line scene error as --set
     r.add_argument("--width", metavar="W", help="image width in pixels (same as --set image.width=W; not both)")
     r.add_argument("--height", metavar="H", help="image height in pixels (same as --set image.height=H; not both)")
@@ -168,7 +168,7 @@ def _size_overrides(args: argparse.Namespace) -> list[str]:
     return overrides
 
 
-IMAGE_SUFFIXES = (".png", ".exr")
+IMAGE_SUFFIXES = (".png", ".exr", ".tif", ".tiff")
 
 
 def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
@@ -340,9 +340,10 @@ CHANNEL_GROUPS = {"RGBA": ("color", "alpha"), "Z": ("depth", "bracket"), "N": ("
 
 def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
     """The render outputs behind --channels (None: all the format holds)."""
-    if out.suffix.lower() == ".png":
+    if out.suffix.lower() != ".exr":
+        kind = "PNG" if out.suffix.lower() == ".png" else "TIFF"
         if channels is not None and channels.strip().upper() != "RGBA":
-            raise SceneError("--channels", f"{channels!r}: a PNG holds RGBA only; write .exr for Z, N or P")
+            raise SceneError("--channels", f"{channels!r}: a {kind} holds RGBA only; write .exr for Z, N or P")
         return ("color", "alpha")
     if channels is None:
         return None

@@ -1,5 +1,5 @@
-"""Image outputs: the checks of an output path before any render, the PNG and EXR writers
-(atomic: pyjulia4d/files.py) and the reader of their headers."""
+"""Image outputs: the checks of an output path before any render, the PNG, TIFF and EXR
+writers (atomic: pyjulia4d/files.py) and the reader of their headers."""
 from __future__ import annotations
 
 import os
@@ -13,7 +13,8 @@ import numpy as np
 from pyjulia4d.files import NAME_MAX, PATH_MAX, RANDOM_CHARS, atomic_write, path_limit, quoted_path, shown_path, \
     signals_held, temp_affixes
 
-FORMATS = (".png", ".exr")
+FORMATS = (".png", ".exr", ".tif", ".tiff")
+TIFF = (".tif", ".tiff")
 
 class OutputError(ValueError):
     """Unusable output path or format; the message starts with the path."""
@@ -96,20 +97,18 @@ def to_u8(x: np.ndarray) -> np.ndarray:
     return np.rint(np.clip(x, 0.0, 1.0) * 255.0).astype(np.uint8)
 
 
-def write_png(
-    path: str | Path,
-    color: np.ndarray,
-    alpha: np.ndarray,
-    text: Mapping[str, str] | None = None,
-) -> None:
-    """8-bit RGBA PNG from ``color`` (H, W, 3), linear light, and ``alpha`` (H, W) in [0, 1].
+def to_levels(x: np.ndarray, bits: int) -> np.ndarray:
+    """Values in [0, 1] (clipped; NaN as 0) as 8- or 16-bit integers, rounded."""
+    if bits == 8:
+        return to_u8(x)
+    x = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0)
+    return np.rint(np.clip(x, 0.0, 1.0) * 65535.0).astype(np.uint16)
 
-    The colour is clipped to [0, 1] and sRGB-encoded (the renderer shades in linear light;
-    an EXR keeps it linear), alpha is linear; both rounded.  ``text`` entries become PNG
-    iTXt chunks.
-    """
-    from PIL import Image, PngImagePlugin
 
+def rgba_levels(color: np.ndarray, alpha: np.ndarray, bits: int = 8) -> np.ndarray:
+    """(H, W, 4) integers of ``bits`` (8 or 16) from ``color`` (H, W, 3), linear light, and
+    ``alpha`` (H, W) in [0, 1]: the colour clipped to [0, 1] and sRGB-encoded (the renderer
+    shades in linear light; an EXR keeps it linear), alpha linear; both rounded."""
     from pyjulia4d.pipeline.colormap import linear_to_srgb
 
     color = np.asarray(color)
@@ -118,16 +117,71 @@ def write_png(
         raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
     # in bands of rows: the float64 temporaries of the transfer function on a whole 3840x2160
     # image took 800 MB (a PNG render's peak was 1.16 GB); a band's are a few MB
-    rgba = np.empty(color.shape[:2] + (4,), np.uint8)
+    rgba = np.empty(color.shape[:2] + (4,), np.uint8 if bits == 8 else np.uint16)
     for r0 in range(0, color.shape[0], PNG_BAND_ROWS):
         band = slice(r0, r0 + PNG_BAND_ROWS)
-        rgba[band, :, :3] = to_u8(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)))
-        rgba[band, :, 3] = to_u8(alpha[band])
-    info = PngImagePlugin.PngInfo()
-    for k, v in (text or {}).items():
-        info.add_itxt(k, str(v))  # iTXt: UTF-8, unlike tEXt's Latin-1
+        rgba[band, :, :3] = to_levels(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)),
+                                      bits)
+        rgba[band, :, 3] = to_levels(alpha[band], bits)
+    return rgba
+
+
+def _itxt(key: str, text: str) -> bytes:
+    """A PNG iTXt chunk's data: keyword, no compression, no language (PNG 1.2, 4.2.3.3)."""
+    return key.encode("latin-1", "replace")[:79] + b"\0\0\0\0\0" + str(text).encode("utf-8")
+
+
+def write_png(
+    path: str | Path,
+    color: np.ndarray,
+    alpha: np.ndarray,
+    text: Mapping[str, str] | None = None,
+    bits: int = 8,
+) -> None:
+    """RGBA PNG of ``bits`` per channel (8 or 16: image.bits) from ``color`` and ``alpha``
+    (rgba_levels).  ``text`` entries become iTXt chunks (UTF-8, unlike tEXt's Latin-1).
+    Pillow writes 8 bits; pypng 16, its chunks with the text added before IEND."""
+    rgba = np.ascontiguousarray(rgba_levels(color, alpha, bits))
+    if bits == 8:
+        from PIL import Image, PngImagePlugin
+
+        info = PngImagePlugin.PngInfo()
+        for k, v in (text or {}).items():
+            info.add_itxt(k, str(v))
+        with atomic_write(path) as tmp:
+            Image.fromarray(rgba).save(tmp, format="PNG", pnginfo=info)
+        return
+    import io
+
+    import png
+
+    h, w = rgba.shape[:2]
+    buf = io.BytesIO()
+    png.Writer(w, h, greyscale=False, alpha=True, bitdepth=16).write_packed(
+        buf, (row.astype(">u2").tobytes() for row in rgba))
+    chunks = list(png.Reader(bytes=buf.getvalue()).chunks())
+    chunks[-1:-1] = [(b"iTXt", _itxt(k, v)) for k, v in (text or {}).items()]
+    with atomic_write(path) as tmp, open(tmp, "wb") as f:
+        png.write_chunks(f, chunks)
+
+
+def write_tiff(
+    path: str | Path,
+    color: np.ndarray,
+    alpha: np.ndarray,
+    text: Mapping[str, str] | None = None,
+    bits: int = 8,
+) -> None:
+    """RGBA TIFF (tifffile) of ``bits`` per channel, as write_png's pixels, deflate-compressed,
+    alpha unassociated; ``text`` as a JSON object in the ImageDescription tag."""
+    import json
+
+    import tifffile
+
+    rgba = np.ascontiguousarray(rgba_levels(color, alpha, bits))
     with atomic_write(path) as tmp:
-        Image.fromarray(np.ascontiguousarray(rgba)).save(tmp, format="PNG", pnginfo=info)
+        tifffile.imwrite(tmp, rgba, photometric="rgb", extrasamples=["unassalpha"], compression="zlib",
+                         description=json.dumps(dict(text or {})), metadata=None)
 
 
 def write_exr(
@@ -158,11 +212,16 @@ def write_exr(
 
 
 def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None) -> None:
-    """Write a RenderResult as .png (colour + alpha) or .exr (``result.exr_channels()``)."""
+    """Write a RenderResult as .png or .tif/.tiff (colour + alpha, 8 or 16 bits a channel by
+    the scene's image.bits) or .exr (``result.exr_channels()``)."""
     p = check_output_path(path)
+    scene = getattr(result, "scene", None)
+    bits = scene.image.bits if scene is not None else 8
     try:
         if _suffix(p) == ".png":
-            write_png(p, result.color, result.alpha, header)
+            write_png(p, result.color, result.alpha, header, bits)
+        elif _suffix(p) in TIFF:
+            write_tiff(p, result.color, result.alpha, header, bits)
         else:
             write_exr(p, result.exr_channels(), header)
     except OSError as e:
@@ -191,6 +250,13 @@ def read_header(path: str | Path) -> dict[str, str] | None:
             import OpenEXR
             hdr = OpenEXR.File(str(path), header_only=True).header()
             return {k: v for k, v in hdr.items() if isinstance(v, str)}
+        if path.suffix.lower() in TIFF:
+            import json
+
+            import tifffile
+            with tifffile.TiffFile(path) as t:
+                text = json.loads(t.pages[0].description or "{}")
+            return {k: v for k, v in text.items() if isinstance(k, str) and isinstance(v, str)}
         from PIL import Image
         with Image.open(path) as im:
             im.load()  # text chunks after the image data too; a truncated file fails here

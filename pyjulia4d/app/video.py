@@ -54,7 +54,7 @@ def check_video_path(path: str | os.PathLike) -> Path:
 
 
 def read_frame(path: str | os.PathLike) -> np.ndarray:
-    """A frame file as (H, W, 3) uint8 sRGB: a PNG's RGB, an EXR's R, G, B encoded as
+    """A frame file as (H, W, 3) uint8 sRGB: a PNG's or TIFF's RGB, an EXR's R, G, B encoded as
     output.write_png encodes them."""
     p = Path(path)
     if p.suffix.lower() == ".exr":
@@ -69,9 +69,14 @@ def read_frame(path: str | os.PathLike) -> np.ndarray:
                               f"(rendered with --channels without RGBA)")
         rgb = np.stack([np.asarray(ch[k].pixels, np.float32) for k in "RGB"], axis=-1)
         return to_u8(linear_to_srgb(np.nan_to_num(rgb, nan=0.0)))
+    if p.suffix.lower() in (".tif", ".tiff"):   # 8 or 16 bits a channel (image.bits)
+        import tifffile
+
+        rgba = tifffile.imread(p)
+        return (rgba[..., :3] >> 8).astype(np.uint8) if rgba.dtype == np.uint16 else rgba[..., :3]
     from PIL import Image
 
-    with Image.open(p) as im:
+    with Image.open(p) as im:   # a 16-bit PNG is read as 8 bits a channel
         return np.asarray(im.convert("RGB"))
 
 

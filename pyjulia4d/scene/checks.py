@@ -143,6 +143,21 @@ class Integer:
         return v
 
 
+class Whole:
+    """One of a few whole numbers (not floats, not bools)."""
+
+    verbatim = False
+
+    def __init__(self, *options: int) -> None:
+        self.options = options
+        self.valid = ", ".join(map(str, options[:-1])) + " or " + str(options[-1])
+
+    def __call__(self, key: str, v: Any) -> int:
+        if isinstance(v, bool) or not isinstance(v, int) or v not in self.options:
+            raise SceneError(key, f"expected {self.valid}, got {show(v)}")
+        return v
+
+
 class Choice:
     """One of a few words."""
 

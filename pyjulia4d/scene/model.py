@@ -19,7 +19,7 @@ from typing import Any, Iterable, Literal, Mapping, Union
 from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS, KINDS
 from pyjulia4d.scene import rules
 from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, Integer, Lights, OrWord, Planes,  # noqa: F401
-                                    Real, SceneError, Vector, show, show_key)
+                                    Real, SceneError, Vector, Whole, show, show_key)
 from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, QUALITIES, auto_values, preset_values
 from pyjulia4d.scene.text import parse_override, read_scene_table, toml_value
 
@@ -192,6 +192,7 @@ class Image:
     height: int = 480
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
+    bits: int = 8         # per channel of a PNG or TIFF (app/output.py); EXR is float32 always
 
     def __post_init__(self) -> None:
         check_section(self, "image")
@@ -316,6 +317,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "height": Integer(1, INT_MAX),
         "samples": Integer(1, 256),
         "adaptive": Bool(),
+        "bits": Whole(8, 16),
     },
     "clip": {
         "planes": Planes(4),

@@ -10,7 +10,7 @@ Requests:
 - ``orbit`` (``yaw``, ``pitch`` degrees), ``turn_w`` (``degrees``), ``zoom`` (``factor``),
   each with ``moving`` (geometry/navigate.py);
 - ``refine``: the control stopped: refine the current scene to its full size;
-- ``save_scene`` (``name``.toml), ``render_file`` (``name``.png or .exr, in a thread, with
+- ``save_scene`` (``name``.toml), ``render_file`` (``name``.png, .tif or .exr, in a thread, with
   ``progress`` messages), ``keyframe`` (``frames`` after the last one; the first is frame 0),
   ``clear_keyframes``, ``save_animation`` (``name``.toml, ``fps``: the keyframed scene
   ``pyjulia4d animate`` renders).
@@ -230,7 +230,7 @@ class Session:
         folder, in a thread, with progress messages; one render at a time."""
         from pyjulia4d.app.output import check_output_path
 
-        path = check_output_path(file_in(self.folder, name, (".png", ".exr")))
+        path = check_output_path(file_in(self.folder, name, (".png", ".exr", ".tif", ".tiff")))
         if self._file_thread is not None and self._file_thread.is_alive():
             raise ExploreError("render: a render to a file is still running; wait for it")
         scene = self.scene
