@@ -200,7 +200,8 @@ def test_keys_section_and_bad_section(capsys) -> None:
     assert cli.main(["keys", "image"]) == 0
     out = capsys.readouterr().out
     assert [ln.split(" = ")[0] for ln in out.splitlines() if not ln.startswith(" ")] == \
-        ["image.width", "image.height", "image.samples", "image.adaptive", "image.bits"]
+        ["image.width", "image.height", "image.samples", "image.adaptive", "image.bits",
+         "image.exr"]
     assert cli.main(["keys", "octonion"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("pyjulia4d: error: octonion: unknown section") and err.count("\n") == 1

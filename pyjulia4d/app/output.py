@@ -206,14 +206,16 @@ def write_exr(
         "compression": OpenEXR.ZIP_COMPRESSION,
         "type": OpenEXR.scanlineimage,
     }
-    hdr.update({k: str(v) for k, v in (header or {}).items()})
+    # strings, and OpenEXR's matrices (worldToCamera, worldToNDC: float32 4x4 -> M44f)
+    hdr.update({k: v if isinstance(v, np.ndarray) else str(v) for k, v in (header or {}).items()})
     with atomic_write(path) as tmp:
         OpenEXR.File(hdr, data).write(str(tmp))
 
 
 def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None) -> None:
     """Write a RenderResult as .png or .tif/.tiff (colour + alpha, 8 or 16 bits a channel by
-    the scene's image.bits) or .exr (``result.exr_channels()``)."""
+    the scene's image.bits) or .exr (the channels of the scene's image.exr layout:
+    exr_layout.py)."""
     p = check_output_path(path)
     scene = getattr(result, "scene", None)
     bits = scene.image.bits if scene is not None else 8
@@ -223,7 +225,11 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
         elif _suffix(p) in TIFF:
             write_tiff(p, result.color, result.alpha, header, bits)
         else:
-            write_exr(p, result.exr_channels(), header)
+            from pyjulia4d.app.exr_layout import exr_output
+
+            layout = scene.image.exr if scene is not None else "pyjulia4d"
+            channels, extra = exr_output(result, scene, layout) if scene is not None else (result.exr_channels(), {})
+            write_exr(p, channels, {**(header or {}), **extra})
     except OSError as e:
         raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
 

@@ -64,6 +64,8 @@ def read_frame(path: str | os.PathLike) -> np.ndarray:
         from pyjulia4d.app.output import to_u8
 
         ch = OpenEXR.File(str(p), separate_channels=True).channels()
+        if all(f"ViewLayer.Combined.{k}" in ch for k in "RGB"):   # image.exr = "compositing": over black
+            ch = {k: ch[f"ViewLayer.Combined.{k}"] for k in "RGB"}
         if not all(k in ch for k in "RGB"):
             raise OutputError(f"{shown_path(str(p))}: no R, G, B channels to make a video of "
                               f"(rendered with --channels without RGBA)")

@@ -67,6 +67,7 @@ MEANINGS = {
     "image.samples": "rays per pixel (stratified); colour and alpha are their mean",
     "image.adaptive": "with samples > 1: supersample only pixels on an edge",
     "image.bits": "bits per channel of a PNG or TIFF (sRGB-encoded); EXR is float32",
+    "image.exr": "an EXR's channels: pyjulia4d's own, or Blender's multilayer passes (premultiplied RGBA, depth, normal, position)",
     "clip.planes": "cut-away half-spaces n . p <= offset that cut the set open",
     "render.float": "single, or double (float64 kernels, devices with cl_khr_fp64)",
     "render.variant": "rays per work-item of the march: scalar (one), packet (16, 8 or 4; 8 or 4 in double) or auto",

@@ -193,6 +193,7 @@ class Image:
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
     bits: int = 8         # per channel of a PNG or TIFF (app/output.py); EXR is float32 always
+    exr: str = "pyjulia4d"   # an EXR's channels: pyjulia4d's own, or the passes compositors read (app/exr_layout.py)
 
     def __post_init__(self) -> None:
         check_section(self, "image")
@@ -318,6 +319,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "samples": Integer(1, 256),
         "adaptive": Bool(),
         "bits": Whole(8, 16),
+        "exr": Choice("pyjulia4d", "compositing"),
     },
     "clip": {
         "planes": Planes(4),
