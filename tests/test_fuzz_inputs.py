@@ -330,7 +330,7 @@ def flag_cases(rng: random.Random) -> list[Case]:
 
 def output_cases(rng: random.Random) -> list[Case]:
     cases = []
-    for i, ext in enumerate([".jpg", ".PNGX", ".tiff", "", ".", ".png.bak", ".exr~", ".pn", ".toml",
+    for i, ext in enumerate([".jpg", ".PNGX", ".tga", "", ".", ".png.bak", ".exr~", ".pn", ".toml",
                              ".png ", ". png", "." + _unicode(rng, 3)]):
         cases.append(Case(f"out-ext-{i}", ["render", "-o", "out" + ext]))
     for i in range(6):
