@@ -133,6 +133,11 @@ def test_every_format_reads_back(tmp_path, suffix):
     assert back.is_watertight and abs(back.volume - r.mesh.volume) < 1e-5 * r.mesh.volume
     if suffix in (".ply", ".glb"):   # formats that carry vertex colours
         assert back.visual.kind == "vertex"
+    raw = out.read_bytes()
+    # vertex normals where the format has them: PLY's nx ny nz, OBJ's vn, glTF's NORMAL
+    marker = {".ply": b"property float nx", ".obj": b"\nvn ", ".glb": b'"NORMAL"'}.get(suffix)
+    if marker is not None:
+        assert marker in raw, suffix
     assert [p.name for p in tmp_path.iterdir()] == [out.name]
 
 

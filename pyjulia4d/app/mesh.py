@@ -230,7 +230,11 @@ def write_mesh(path: str | Path, result: MeshResult) -> None:
     from pyjulia4d.files import atomic_write
 
     p = Path(path)
-    data = result.mesh.export(file_type=FORMATS[p.suffix.lower()])
+    kind = FORMATS[p.suffix.lower()]
+    # vertex normals where the format has them (trimesh writes them only when asked)
+    extra = {"ply": {"vertex_normal": True}, "obj": {"include_normals": True},
+             "glb": {"include_normals": True}}.get(kind, {})
+    data = result.mesh.export(file_type=kind, **extra)
     if isinstance(data, str):
         data = data.encode("utf-8")
     try:
