@@ -360,9 +360,54 @@ def output_cases(rng: random.Random) -> list[Case]:
     return cases
 
 
+def command_cases(rng: random.Random) -> list[Case]:
+    """mesh and explore: their own flags, outputs, folders and ports, and --set values."""
+    cases = []
+    numbers = ["abc", "", " ", "1.5", "1e3", "nan", "inf", "-1", "٨", "0x10", "8,8", "[8]", "10" * 30,
+               _unicode(rng, 4)]
+    for i, v in enumerate(numbers + ["7", "2049", "0"]):
+        cases.append(Case(f"cmd-mesh-resolution-{i}", ["mesh", "--resolution", v]))
+    for i, v in enumerate(numbers[:8] + ["1001", "-5"]):
+        cases.append(Case(f"cmd-mesh-smooth-{i}", ["mesh", "--smooth", v]))
+    for i, v in enumerate(["0", "-0.5", "1.5", "nan", "inf", "", "half", "1e-400", "٠.٥"]):
+        cases.append(Case(f"cmd-mesh-decimate-{i}", ["mesh", "--decimate", v]))
+    for i, ext in enumerate([".png", ".exr", ".jpg", "", ".stl~", ".STLX", ".gltf", ". stl", "." + _unicode(rng, 3)]):
+        cases.append(Case(f"cmd-mesh-out-{i}", ["mesh", "-o", "m" + ext]))
+    cases += [
+        Case("cmd-mesh-out-missing-dir", ["mesh", "-o", "nowhere/m.stl"]),
+        Case("cmd-mesh-out-is-dir", ["mesh", "-o", "d.stl"], {"d.stl": None}),
+        Case("cmd-mesh-out-nul", ["mesh", "-o", "m\x00.stl"], real_argv=False),
+        Case("cmd-mesh-scene-missing", ["mesh", "missing.toml"]),
+        Case("cmd-mesh-scene-dir", ["mesh", "d.toml"], {"d.toml": None}),
+        Case("cmd-mesh-slice-outside", ["mesh", "--set", "slice.distance=1e5"]),
+        Case("cmd-mesh-unknown-flag", ["mesh", "--resolutoin", "8"]),
+        Case("cmd-mesh-missing-value", ["mesh", "--resolution"]),
+        Case("cmd-mesh-two-scenes", ["mesh", "a.toml", "b.toml"]),
+    ]
+    for i, v in enumerate(numbers + ["65536", "99999", "-0"][:-1]):
+        cases.append(Case(f"cmd-explore-port-{i}", ["explore", "--no-browser", "--port", v]))
+    cases += [
+        Case("cmd-explore-folder-missing", ["explore", "--no-browser", "--folder", "nowhere"]),
+        Case("cmd-explore-folder-file", ["explore", "--no-browser", "--folder", "f"], {"f": b"x"}),
+        Case("cmd-explore-folder-nul", ["explore", "--no-browser", "--folder", "a\x00b"], real_argv=False),
+        Case("cmd-explore-scene-missing", ["explore", "--no-browser", "missing.toml"]),
+        Case("cmd-explore-scene-not-toml", ["explore", "--no-browser", "s.toml"], {"s.toml": b"[fractal\n"}),
+        Case("cmd-explore-image-not-image", ["explore", "--no-browser", "i.png"], {"i.png": b"not a png"}),
+        Case("cmd-explore-unknown-flag", ["explore", "--browser"]),
+        Case("cmd-explore-missing-value", ["explore", "--port"]),
+    ]
+    for i in range(24):   # --set's generated bad values through both commands
+        key = rng.choice(KEYS)
+        value = rng.choice(bad_values(rng, key))
+        command = ["mesh"] if i % 2 else ["explore", "--no-browser"]
+        cases.append(Case(f"cmd-set-{i}", command + ["--set", f"{key}={value}"]))
+    return cases
+
+
 def all_cases() -> list[Case]:
     rng = random.Random(SEED)
     cases = set_cases(rng) + scene_cases(rng) + flag_cases(rng) + output_cases(rng)
+    cases += command_cases(random.Random(SEED + 1))
     ids = [c.id for c in cases]
     assert len(ids) == len(set(ids)), "case ids must be unique"
     return cases
@@ -398,6 +443,10 @@ def no_render(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "pyjulia4d.opencl.executor", mod)
     monkeypatch.setattr(pyjulia4d, "render", mod, raising=False)
     monkeypatch.setattr(cli, "select_device", lambda spec: "fake device")
+    from pyjulia4d.app import mesh
+    from pyjulia4d.app.explore import run
+    monkeypatch.setattr(mesh, "build_mesh", _render_reached)
+    monkeypatch.setattr(run, "explore", _render_reached)
 
 
 def _assert_one_error_line(err: str) -> None:
@@ -427,7 +476,7 @@ def test_bad_input_in_process(case: Case, tmp_path, monkeypatch, capsys, no_rend
 def test_case_count() -> None:
     """The generator makes a few hundred cases, every group represented."""
     groups = {c.id.split("-")[0] for c in CASES}
-    assert groups == {"set", "toml", "path", "flag", "out"}
+    assert groups == {"set", "toml", "path", "flag", "out", "cmd"}
     assert 300 <= len(CASES) <= 1600, len(CASES)
 
 
