@@ -261,3 +261,48 @@ def test_decimation_keeps_the_share_asked_and_says_whether_it_is_closed():
     for bad in (0, 0.0, -0.5, 1.5, float("nan"), True, "0.5"):
         with pytest.raises(SceneError, match="--decimate"):
             mesh_mod.check_decimate(bad)
+
+
+def _first_hits(origin, dirs, tri):
+    """Distance along each ray to its first triangle (Moller-Trumbore over every triangle), inf
+    for none."""
+    v0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    out = np.full(len(dirs), np.inf)
+    for k, d in enumerate(dirs):
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = origin - v0
+        u = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        v = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+        if hit.any():
+            out[k] = t[hit].min()
+    return out
+
+
+def test_the_mesh_is_where_the_renderer_sees_the_surface():
+    """Camera rays cast against the mesh meet it at the renderer's certified depth (the proven
+    march, whose space in front of each hit is proven empty): within one grid spacing h on
+    most rays; never more than 2h in front of it (that would be surface where the proof found
+    none); behind it by more than 2h only where the grid missed a part thinner than h (at
+    most 10 % of the rays; measured 4 of 60 at 128^3, 1 of 60 at 256^3)."""
+    from pyjulia4d import render
+    from pyjulia4d.geometry.camera import camera_frame
+    from pyjulia4d.reference.rays import generate_rays
+
+    scene = SCENES["default"].replace(**{"image.width": 40, "image.height": 30, "march.quality": "final"})
+    shot = render(scene, device=harness.device())
+    r = mesh_mod.build_mesh(scene, 128, harness.device())
+    origins, dirs = generate_rays(camera_frame(scene), 40, 30)
+    hit = np.isfinite(shot.bracket).ravel()
+    pick = np.random.default_rng(3).choice(np.nonzero(hit)[0], 60, replace=False)
+    # the default slice: world = scene coordinates, w = 0 on every ray
+    got = _first_hits(origins[0, :3], dirs[pick, :3], r.mesh.vertices[r.mesh.faces])
+    err = (got - shot.depth.ravel()[pick]) / r.plan.spacing   # +inf: the ray missed the mesh
+    assert np.mean(np.abs(err) <= 1.0) >= 0.85
+    assert np.all(err >= -2.0)
+    assert np.mean(err > 2.0) <= 0.10
