@@ -383,6 +383,8 @@ def command_cases(rng: random.Random) -> list[Case]:
         Case("cmd-mesh-unknown-flag", ["mesh", "--resolutoin", "8"]),
         Case("cmd-mesh-missing-value", ["mesh", "--resolution"]),
         Case("cmd-mesh-two-scenes", ["mesh", "a.toml", "b.toml"]),
+        Case("cmd-mesh-walls-too-fine", ["mesh", "--walls", "--resolution", "2048"]),
+        Case("cmd-mesh-walls-value", ["mesh", "--walls=yes"]),
     ]
     for i, v in enumerate(numbers + ["65536", "99999", "-0"][:-1]):
         cases.append(Case(f"cmd-explore-port-{i}", ["explore", "--no-browser", "--port", v]))

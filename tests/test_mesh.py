@@ -306,3 +306,35 @@ def test_the_mesh_is_where_the_renderer_sees_the_surface():
     assert np.mean(np.abs(err) <= 1.0) >= 0.85
     assert np.all(err >= -2.0)
     assert np.mean(err > 2.0) <= 0.10
+
+
+@pytest.mark.parametrize("distance,n", [(0.0, 24), (0.99, 32)])
+def test_the_thinnest_wall_of_a_ball_is_its_diameter(distance, n):
+    """The c = 0 set cut at slice distance d is a ball of radius sqrt(R^2 - d^2): its thinnest
+    wall is its diameter, found to within 3 grid spacings (thinnest_wall's bound)."""
+    scene = BALL.replace(**{"slice.distance": distance})
+    r = mesh_mod.build_mesh(scene, n, harness.device(), walls=True)
+    thick, where = r.wall
+    diameter = 2 * np.sqrt(BALL_RADIUS ** 2 - distance ** 2)
+    assert where is not None and abs(thick - diameter) <= 3 * r.plan.spacing
+    assert np.linalg.norm(where) <= 2 * r.plan.spacing   # about the ball's centre
+    assert "thinnest wall about" in r.summary()
+
+
+def test_no_wall_thinner_than_the_margin_is_said_so():
+    r = mesh_mod.build_mesh(BALL, 96, harness.device(), walls=True)
+    thick, where = r.wall
+    assert where is None and thick == pytest.approx((2 * mesh_mod.WALL_MARGIN - 1) * r.plan.spacing)
+    assert thick < 2 * BALL_RADIUS   # a true statement: the ball is thicker
+
+
+def test_thin_walls_of_a_julia_set_are_found_and_lie_in_the_set():
+    r = mesh_mod.build_mesh(SCENES["default"], 64, harness.device(), walls=True)
+    thick, where = r.wall
+    assert where is not None and r.plan.spacing * 0.5 <= thick <= 4 * r.plan.spacing
+    # the thinnest point is a grid point inside the set (its own inside test, in float64)
+    from pyjulia4d.reference.formula import formula_of
+    from pyjulia4d.reference.iterate import julia_inside
+    p = where @ r.plan.axes + r.plan.offset
+    f = r.plan.scene.fractal
+    assert julia_inside(p[None], f.c, f.max_iter, f.bailout, formula_of(f))[0]

@@ -102,6 +102,8 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--decimate", metavar="SHARE", default="1",
                    help="keep this share of the triangles, in (0, 1] (default 1: all; quadric decimation may "
                         "open the mesh: the closing line says whether it is watertight)")
+    m.add_argument("--walls", action="store_true",
+                   help="also report the thinnest wall, for printing (grids up to 1024 a side)")
     m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, as for render")
     m.add_argument("--device", metavar="SPEC", help="OpenCL device (as for render)")
@@ -263,7 +265,8 @@ def _real(text: str) -> float | str:
 
 def _mesh(args: argparse.Namespace) -> int:
     """mesh: SCENE -> OUT.stl|ply|obj|glb (app/mesh.py); every argument checked before the device."""
-    from pyjulia4d.app.mesh import build_mesh, check_decimate, check_mesh_path, check_smooth, write_mesh
+    from pyjulia4d.app.mesh import (MAX_WALL_RESOLUTION, build_mesh, check_decimate, check_mesh_path, check_smooth,
+                                    write_mesh)
     from pyjulia4d.pipeline.mesh_plan import check_resolution, make_mesh_plan
 
     resolution = check_resolution(_whole(args.resolution))
@@ -271,11 +274,14 @@ def _mesh(args: argparse.Namespace) -> int:
     decimate = check_decimate(_real(args.decimate))
     scene = _scene_of(args.scene, args.overrides)
     make_mesh_plan(scene, resolution)   # a slice outside the set's ball: refused before the device
+    if args.walls and resolution > MAX_WALL_RESOLUTION:
+        raise SceneError("--walls", f"measured on grids up to {MAX_WALL_RESOLUTION}^3 (the whole grid is kept); "
+                                    f"got {resolution}^3")
     stem = "julia" if args.scene is None else Path(args.scene).stem
     out = check_mesh_path(args.output if args.output is not None else stem + ".stl")
     device = select_device(args.device)
     result = build_mesh(scene, resolution, device, smooth, args.force, progress=True,
-                        warn=lambda text: _say(f"pyjulia4d: warning: {text}"), decimate=decimate)
+                        warn=lambda text: _say(f"pyjulia4d: warning: {text}"), decimate=decimate, walls=args.walls)
     write_mesh(out, result)
     print(f"wrote {out} in {result.seconds['total']:.2f} s: {result.summary()}")
     return 0

@@ -18,6 +18,7 @@ and Blender (STL, PLY, OBJ, glTF binary).
 The mesh is in the slice's own 3D coordinates (the scene units the camera sees)."""
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,10 @@ MAX_SMOOTH = 1000
 # benchmarks/mesh_scale.py measured on this project's 2-core CPU, so the estimate errs long
 ESTIMATE_RATE = 3e8
 WARN_SECONDS, REFUSE_SECONDS = 120.0, 6 * 3600.0
+# thinnest_wall: grid points within this many spacings of the outside are measured exactly in a
+# slab of layers with this margin, so walls up to 2 WALL_MARGIN - 1 spacings thick are found
+WALL_MARGIN = 16
+MAX_WALL_RESOLUTION = 1024    # the whole inside mask is kept: n^3 bytes
 
 
 class MeshError(ValueError):
@@ -49,6 +54,9 @@ class MeshResult:
     inside_points: int           # grid points inside (the voxel count of the set on the grid)
     widest_bracket: float        # the widest vertex bracket (slice units)
     seconds: dict = field(default_factory=dict)   # "sample", "cubes", "vertices", "finish", "total"
+    # thinnest_wall's (thickness, where (x, y, z)), or (bound, None): no wall thinner than bound;
+    # None where not asked for
+    wall: tuple | None = None
 
     @property
     def voxel_volume(self) -> float:
@@ -58,8 +66,16 @@ class MeshResult:
     def summary(self) -> str:
         m = self.mesh
         vol = f"volume {m.volume:.6g} (grid count {self.voxel_volume:.6g})" if m.is_watertight else "not watertight"
+        wall = ""
+        if self.wall is not None:
+            thick, where = self.wall
+            h = self.plan.spacing
+            wall = (f"; no wall thinner than {thick:.3g}" if where is None else
+                    f"; thinnest wall about {thick:.3g} (to within 3 grid spacings, {3 * h:.2g}) at "
+                    f"({where[0]:.4g}, {where[1]:.4g}, {where[2]:.4g})")
         return (f"{len(m.faces)} triangles, {len(m.vertices)} vertices, {vol}, vertices within "
-                f"{self.widest_bracket:.2g} of the surface, grid {self.plan.n}^3 at spacing {self.plan.spacing:.4g}")
+                f"{self.widest_bracket:.2g} of the surface, grid {self.plan.n}^3 at spacing "
+                f"{self.plan.spacing:.4g}{wall}")
 
 
 def estimate_seconds(plan: MeshPlan) -> float:
@@ -93,15 +109,50 @@ def check_decimate(value: Any) -> float:
     return float(value)
 
 
+def thinnest_wall(mask: np.ndarray, plan: MeshPlan) -> tuple[float, np.ndarray | None]:
+    """The thinnest wall of the set on the grid, for printing: the local thickness of Hildebrand
+    and Ruegsegger (the diameter of the largest ball inside the set about each point of its
+    medial ridge), from the Euclidean distance transform of the inside ``mask`` [k, j, i].
+
+    Each inside point's distance e to the nearest outside point, in grid spacings; on the
+    ridge (points where e is a local maximum) a wall is about 2 e - 1 spacings thick: exact for
+    a slab an odd number of points thick, one less for an even one; the surface between two
+    grid points and a ridge point off the true medial axis (by up to half a cell's diagonal)
+    put it within 3 spacings of the true thickness.  The distance is taken a
+    slab of layers at a time with WALL_MARGIN layers on each side, exact up to WALL_MARGIN.
+    Returns (thickness, (x, y, z)) in scene units, or (bound, None) where no wall is thinner
+    than the bound, (2 WALL_MARGIN - 1) h.  Parts thinner than the spacing are not on the grid."""
+    from scipy import ndimage
+
+    n, h = mask.shape[0], plan.spacing
+    slab = max(1, (1 << 22) // (n * n))
+    best, where = math.inf, None
+    for k0 in range(0, n, slab):
+        lo, hi = max(0, k0 - WALL_MARGIN), min(n, k0 + slab + WALL_MARGIN)
+        edt = ndimage.distance_transform_edt(mask[lo:hi])
+        ridge = (edt == ndimage.maximum_filter(edt, size=3)) & (edt > 0) & (edt <= WALL_MARGIN)
+        core = slice(k0 - lo, k0 - lo + min(slab, n - k0))
+        e = np.where(ridge[core], edt[core], np.inf)
+        k = int(np.argmin(e))
+        if e.flat[k] < best:
+            best = float(e.flat[k])
+            kk, j, i = np.unravel_index(k, e.shape)
+            where = plan.to_slice(np.array([i, j, kk + k0], float))
+    if where is None:
+        return (2 * WALL_MARGIN - 1) * h, None
+    return (2 * best - 1) * h, where
+
+
 def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: int = 0, force: bool = False,
                progress: bool = False, executor: str = "opencl", warn: Callable[[str], None] | None = None,
-               decimate: float = 1.0) -> MeshResult:
+               decimate: float = 1.0, walls: bool = False) -> MeshResult:
     """The mesh of ``scene`` on a grid of ``resolution`` points a side (see the module's
     docstring).  ``executor`` "reference" runs the float64 twins (small grids only).  Work
     estimated past REFUSE_SECONDS is refused unless ``force``; past WARN_SECONDS ``warn`` is
     told.  ``decimate`` below 1 keeps that share of the triangles (quadric decimation,
     fast-simplification through trimesh; it may open the mesh: summary() says whether it is
-    watertight)."""
+    watertight).  ``walls``: also the thinnest wall (thinnest_wall; grids up to
+    MAX_WALL_RESOLUTION, whose whole mask is kept)."""
     import mcubes
     import trimesh
 
@@ -111,6 +162,9 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     smooth = check_smooth(smooth)
     decimate = check_decimate(decimate)
     plan = make_mesh_plan(scene, resolution)
+    if walls and plan.n > MAX_WALL_RESOLUTION:
+        raise SceneError("--walls", f"measured on grids up to {MAX_WALL_RESOLUTION}^3 (the whole grid is kept); "
+                                    f"got {plan.n}^3")
     est = estimate_seconds(plan)
     if est > REFUSE_SECONDS and not force:
         raise SceneError("--resolution", f"{plan.n}^3 grid points at max_iter {plan.max_iter}: about "
@@ -120,12 +174,15 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     sample, vertices = _executor(plan, device, executor)
     seconds = {"sample": 0.0, "cubes": 0.0}
     parts_v, parts_f, count, prev = [], [], 0, None
+    mask = np.empty((plan.n,) * 3, np.uint8) if walls else None
     with Progress(plan.n, "mesh", "layer", enabled=progress) as bar:
         for k0 in range(0, plan.n, plan.block):
             nk = min(plan.block, plan.n - k0)
             t = time.perf_counter()
             block = sample(k0, nk)
             seconds["sample"] += time.perf_counter() - t
+            if mask is not None:
+                mask[k0:k0 + nk] = block
             count += int(np.count_nonzero(block))
             t = time.perf_counter()
             vol = block if prev is None else np.concatenate([prev[None], block])
@@ -166,9 +223,14 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
         world = inner = np.asarray(mesh.vertices) @ plan.axes + plan.offset
     mesh.visual.vertex_colors = vertex_colours(scene, world, inner)
     seconds["finish"] = time.perf_counter() - t
-    seconds["total"] = time.perf_counter() - t0
     widest = float(np.max(width)) if len(width) else 0.0
-    return MeshResult(mesh, plan, count, widest, seconds)
+    wall = None
+    if mask is not None:
+        t = time.perf_counter()
+        wall = thinnest_wall(mask, plan)
+        seconds["walls"] = time.perf_counter() - t
+    seconds["total"] = time.perf_counter() - t0
+    return MeshResult(mesh, plan, count, widest, seconds, wall)
 
 
 def _executor(plan: MeshPlan, device: Any, executor: str):
