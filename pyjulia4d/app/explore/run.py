@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import errno
+import os
 import sys
 import tempfile
 import threading
@@ -86,9 +87,15 @@ def explore(scene: Scene, device: Any, host: str, port: int, folder: Path, open_
     hosts = tuple(dict.fromkeys(LOCAL_HOSTS + (host.strip("[]"), host)))
     app = make_app(scene, render, folder, hosts if host not in ("0.0.0.0", "::") else ("*",))
 
+    # no display (a server, a container, CI): no browser is started; a console one would take
+    # over the terminal the server prints to
+    headless = sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    opening = open_browser and not headless
+
     def started() -> None:
-        print(f"pyjulia4d explore: listening on {url} (files are saved in {folder}; Ctrl-C stops)", flush=True)
-        if open_browser:
+        note = "" if opening or not open_browser else "; no display here: open the address in a browser"
+        print(f"pyjulia4d explore: listening on {url} (files are saved in {folder}; Ctrl-C stops){note}", flush=True)
+        if opening:
             import webbrowser
 
             threading.Thread(target=webbrowser.open, args=(url,), daemon=True).start()
