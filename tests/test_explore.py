@@ -597,3 +597,21 @@ def test_generated_socket_messages_get_at_most_one_line_each_and_the_socket_stay
         errors = [m for m in seen if isinstance(m, dict) and m.get("type") == "error"]
         assert errors and all("\n" not in m["message"] for m in errors)
         assert len(errors) <= 300
+
+
+def test_frame_places_the_camera_from_the_framing_pass(tmp_path):
+    def render(scene, hook, whole=False):
+        out = fake_result(scene)
+        if scene.camera.fit:
+            out.scene = dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, position=(0.0, 0.0, -7.0, 0.0),
+                                                                                fit=False))
+        return out
+
+    s, got = make_session(tmp_path, render)
+    try:
+        s.handle({"op": "frame"})
+        got.wait(lambda: any(m.get("stage") == "final" for m in got.of("frame")))
+        assert s.scene.camera.position == (0.0, 0.0, -7.0, 0.0) and not s.scene.camera.fit
+        assert got.of("values")[-1]["values"]["camera.position[2]"] == "-7.0"
+    finally:
+        s.close()

@@ -10,6 +10,7 @@ Requests:
 - ``orbit`` (``yaw``, ``pitch`` degrees), ``turn_w`` (``degrees``), ``zoom`` (``factor``),
   each with ``moving`` (geometry/navigate.py);
 - ``refine``: the control stopped: refine the current scene to its full size;
+- ``frame``: place the camera to frame the set (camera.fit: its direction kept);
 - ``save_scene`` (``name``.toml), ``render_file`` (``name``.png, .tif or .exr, in a thread, with
   ``progress`` messages), ``keyframe`` (``frames`` after the last one; the first is frame 0),
   ``clear_keyframes``, ``save_animation`` (``name``.toml, ``fps``: the keyframed scene
@@ -177,6 +178,10 @@ class Session:
             self._move(op, msg, moving)
         elif op == "refine":
             self.loop.request(self.scene, moving=False)
+        elif op == "frame":   # camera.fit: the first stage frames the set, and the page takes its camera
+            with self._lock:
+                self.scene = dataclasses.replace(self.scene, camera=dataclasses.replace(self.scene.camera, fit=True))
+            self.loop.request(self.scene, moving=False)
         elif op == "save_scene":
             self.save_scene(msg.get("name"))
         elif op == "render_file":
@@ -193,7 +198,7 @@ class Session:
                                    f"{show(interpolation)}")
             self.save_animation(msg.get("name"), _number(msg, "fps", 0.1, 1000.0, 24.0), interpolation)
         else:
-            raise ExploreError(f"op: unknown request {show(op)}; one of set, orbit, turn_w, zoom, refine, "
+            raise ExploreError(f"op: unknown request {show(op)}; one of set, orbit, turn_w, zoom, refine, frame, "
                                f"save_scene, render_file, keyframe, clear_keyframes, save_animation")
 
     def _move(self, op: str, msg: dict, moving: bool) -> None:

@@ -267,6 +267,7 @@
     send({ op: "keyframe", frames: Number(byId("keyframe-gap").value) });
   });
   byId("clear-keyframes").addEventListener("click", () => send({ op: "clear_keyframes" }));
+  byId("frame").addEventListener("click", () => { clearError(); send({ op: "frame" }); });
   byId("save-animation").addEventListener("click", () => {
     clearError();
     send({ op: "save_animation", name: byId("animation-name").value, fps: Number(byId("animation-fps").value) });
