@@ -168,8 +168,10 @@ def test_stages_while_moving_are_one_preview_of_the_same_aspect():
     assert abs(s.image.width / s.image.height - 640 / 480) < 0.05
 
 
-def test_a_small_scene_has_no_preview():
+def test_a_small_scene_has_no_preview_at_rest_and_one_while_moving():
     assert [s for s, _ in stages(SMALL, False, 1e5)] == ["final"]
+    moving = stages(SMALL, True, 1e5)
+    assert [s for s, _ in moving] == ["preview"] and moving[0][1].image.width == SMALL.image.width
 
 
 def test_the_latest_request_wins():

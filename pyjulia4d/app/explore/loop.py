@@ -62,11 +62,11 @@ def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str,
         return scene.replace(**{"image.width": max(1, round(w * f)), "image.height": max(1, round(h * f)),
                                 "image.samples": samples, "image.adaptive": False})
 
+    if moving:   # one preview, finished even when the next request comes (RenderLoop)
+        return [("preview", sized(k))]
     out = []
     if k < 1.0:
         out.append(("preview", sized(k)))
-    if moving and out:
-        return out
     if 0.25 * full > 1.5 * k * k * full:   # a half-size stage well above the preview's size
         out.append(("refine", sized(0.5)))
     if s > 1 or scene.image.adaptive:
