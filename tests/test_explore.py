@@ -617,3 +617,11 @@ def test_frame_places_the_camera_from_the_framing_pass(tmp_path):
         assert got.of("values")[-1]["values"]["camera.position[2]"] == "-7.0"
     finally:
         s.close()
+
+
+@pytest.mark.parametrize("device", [5, object(), ["cpu"]])
+def test_the_renderer_refuses_what_is_no_device(device):
+    from pyjulia4d.app.explore.run import device_renderer
+
+    with pytest.raises(SceneError, match="device: expected None, a pyopencl Device"):
+        device_renderer(device)

@@ -338,3 +338,20 @@ def test_thin_walls_of_a_julia_set_are_found_and_lie_in_the_set():
     p = where @ r.plan.axes + r.plan.offset
     f = r.plan.scene.fractal
     assert julia_inside(p[None], f.c, f.max_iter, f.bailout, formula_of(f))[0]
+
+
+@pytest.mark.parametrize("kwargs,says", [
+    ({"device": 5}, "device: expected None, a pyopencl Device"),
+    ({"force": "no"}, "force: expected True or False"),
+    ({"progress": 1}, "progress: expected True or False"),
+    ({"walls": "yes"}, "walls: expected True or False"),
+    ({"warn": "stderr"}, "warn: expected None or a callable"),
+    ({"smooth": 2.0}, "--smooth"),
+    ({"decimate": None}, "--decimate"),
+    ({"executor": "gpu"}, "executor: expected 'opencl' or 'reference'"),
+    ({"resolution": [32]}, "--resolution"),
+])
+def test_build_mesh_refuses_bad_arguments_in_one_line(kwargs, says):
+    with pytest.raises(SceneError, match=says.replace("(", r"\(")) as e:
+        mesh_mod.build_mesh(BALL, **{"resolution": 16, **kwargs})
+    assert "\n" not in str(e.value)

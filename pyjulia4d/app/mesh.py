@@ -158,7 +158,13 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
 
     from pyjulia4d.pipeline.progress import Progress
 
+    from pyjulia4d.pipeline.plan import check_flag
+
     t0 = time.perf_counter()
+    for name, value in (("force", force), ("progress", progress), ("walls", walls)):
+        check_flag(name, value)
+    if warn is not None and not callable(warn):
+        raise SceneError("warn", f"expected None or a callable, got {type(warn).__name__}")
     smooth = check_smooth(smooth)
     decimate = check_decimate(decimate)
     plan = make_mesh_plan(scene, resolution)
@@ -241,10 +247,15 @@ def _executor(plan: MeshPlan, device: Any, executor: str):
         return (lambda k0, nk: twin.mesh_sample(plan, k0, nk)), (lambda a, b: twin.mesh_vertices(plan, a, b))
     if executor != "opencl":
         raise SceneError("executor", f"expected 'opencl' or 'reference', got {executor!r}"[:100])
+    import pyopencl as cl
+
     from pyjulia4d.opencl.devices import select_device
     from pyjulia4d.opencl.mesh import MeshRunner
 
-    dev = device if device is not None and not isinstance(device, str) else select_device(device)
+    if not (device is None or isinstance(device, (str, cl.Device))):
+        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
+                                   f"{type(device).__name__}")
+    dev = device if isinstance(device, cl.Device) else select_device(device)
     runner = MeshRunner(plan, dev)
     return runner.sample, runner.vertices
 

@@ -44,9 +44,8 @@ class Explorer:
         import ipywidgets as w
 
         from pyjulia4d.app.explore.run import device_renderer, warm
-        from pyjulia4d.opencl.devices import select_device
 
-        render = device_renderer(select_device(device) if device is None or isinstance(device, str) else device)
+        render = device_renderer(device)
         scene = warm(_scene(scene), render)
         self.image = w.Image(format="png", layout=w.Layout(width="640px"))
         self.facts = w.HTML()
