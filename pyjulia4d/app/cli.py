@@ -265,8 +265,7 @@ def _real(text: str) -> float | str:
 
 def _mesh(args: argparse.Namespace) -> int:
     """mesh: SCENE -> OUT.stl|ply|obj|glb (app/mesh.py); every argument checked before the device."""
-    from pyjulia4d.app.mesh import (MAX_WALL_RESOLUTION, build_mesh, check_decimate, check_mesh_path, check_smooth,
-                                    write_mesh)
+    from pyjulia4d.app.mesh import build_mesh, check_decimate, check_mesh_path, check_smooth, check_walls, write_mesh
     from pyjulia4d.pipeline.mesh_plan import check_resolution, make_mesh_plan
 
     resolution = check_resolution(_whole(args.resolution))
@@ -274,9 +273,7 @@ def _mesh(args: argparse.Namespace) -> int:
     decimate = check_decimate(_real(args.decimate))
     scene = _scene_of(args.scene, args.overrides)
     make_mesh_plan(scene, resolution)   # a slice outside the set's ball: refused before the device
-    if args.walls and resolution > MAX_WALL_RESOLUTION:
-        raise SceneError("--walls", f"measured on grids up to {MAX_WALL_RESOLUTION}^3 (the whole grid is kept); "
-                                    f"got {resolution}^3")
+    check_walls(args.walls, resolution)
     stem = "julia" if args.scene is None else Path(args.scene).stem
     out = check_mesh_path(args.output if args.output is not None else stem + ".stl")
     device = select_device(args.device)

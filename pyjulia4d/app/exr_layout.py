@@ -60,8 +60,10 @@ def camera_matrices(scene: Any) -> dict[str, np.ndarray] | None:
     return {"worldToCamera": to_cam.astype(np.float32), "worldToNDC": (to_cam @ project).astype(np.float32)}
 
 
-def exr_output(result: Any, scene: Any, layout: str) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-    """(channels, header entries) of ``result`` in ``layout`` (see the module's docstring)."""
+def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    """(channels, header entries) of ``result`` in the scene's image.exr layout (see the
+    module's docstring)."""
+    layout = scene.image.exr
     header: dict[str, Any] = {"pyjulia4d.exr_layout": layout}
     mats = camera_matrices(scene)
     if mats is None:

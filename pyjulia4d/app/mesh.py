@@ -42,10 +42,6 @@ WALL_MARGIN = 16
 MAX_WALL_RESOLUTION = 1024    # the whole inside mask is kept: n^3 bytes
 
 
-class MeshError(ValueError):
-    """Unusable mesh output path or settings; the message starts with what is wrong."""
-
-
 @dataclass
 class MeshResult:
     """The mesh and what making it cost and found."""
@@ -86,14 +82,16 @@ def estimate_seconds(plan: MeshPlan) -> float:
 def check_mesh_path(path: str | Path) -> Path:
     """An output path for a mesh: its format (.stl, .ply, .obj, .glb) and the checks of an
     image path (a temp file really made beside it: app/output.check_output_path)."""
-    from pyjulia4d.app.output import OutputError, check_output_path
-    from pyjulia4d.files import shown_path
+    from pyjulia4d.app.output import check_output_path
 
-    suffix = Path(str(path)).suffix.lower()
-    if suffix not in FORMATS:
-        got = repr(suffix) if suffix else "'(none)'"
-        raise OutputError(f"{shown_path(str(path))}: unsupported mesh format {got} (use .stl, .ply, .obj or .glb)")
-    return check_output_path(path, formats=tuple(FORMATS))
+    return check_output_path(path, tuple(FORMATS), "mesh")
+
+
+def check_walls(walls: bool, resolution: int) -> None:
+    """--walls keeps the whole grid: refused past MAX_WALL_RESOLUTION points a side."""
+    if walls and resolution > MAX_WALL_RESOLUTION:
+        raise SceneError("--walls", f"measured on grids up to {MAX_WALL_RESOLUTION}^3 (the whole grid is kept); "
+                                    f"got {resolution}^3")
 
 
 def check_smooth(value: Any) -> int:
@@ -156,9 +154,8 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     import mcubes
     import trimesh
 
-    from pyjulia4d.pipeline.progress import Progress
-
     from pyjulia4d.pipeline.plan import check_flag
+    from pyjulia4d.pipeline.progress import Progress
 
     t0 = time.perf_counter()
     for name, value in (("force", force), ("progress", progress), ("walls", walls)):
@@ -168,9 +165,7 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     smooth = check_smooth(smooth)
     decimate = check_decimate(decimate)
     plan = make_mesh_plan(scene, resolution)
-    if walls and plan.n > MAX_WALL_RESOLUTION:
-        raise SceneError("--walls", f"measured on grids up to {MAX_WALL_RESOLUTION}^3 (the whole grid is kept); "
-                                    f"got {plan.n}^3")
+    check_walls(walls, plan.n)
     est = estimate_seconds(plan)
     if est > REFUSE_SECONDS and not force:
         raise SceneError("--resolution", f"{plan.n}^3 grid points at max_iter {plan.max_iter}: about "
@@ -247,16 +242,10 @@ def _executor(plan: MeshPlan, device: Any, executor: str):
         return (lambda k0, nk: twin.mesh_sample(plan, k0, nk)), (lambda a, b: twin.mesh_vertices(plan, a, b))
     if executor != "opencl":
         raise SceneError("executor", f"expected 'opencl' or 'reference', got {executor!r}"[:100])
-    import pyopencl as cl
-
-    from pyjulia4d.opencl.devices import select_device
+    from pyjulia4d.opencl.devices import device_of
     from pyjulia4d.opencl.mesh import MeshRunner
 
-    if not (device is None or isinstance(device, (str, cl.Device))):
-        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
-                                   f"{type(device).__name__}")
-    dev = device if isinstance(device, cl.Device) else select_device(device)
-    runner = MeshRunner(plan, dev)
+    runner = MeshRunner(plan, device_of(device))
     return runner.sample, runner.vertices
 
 
@@ -283,35 +272,23 @@ def colouring_values(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.n
 def vertex_colours(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.ndarray:
     """(m, 4) uint8 sRGB colours of the vertices, as the render colours a hit (shade/shade.cl):
     shading.color for "flat", else the colour map at colouring_values."""
-    from pyjulia4d.pipeline.colormap import linear_to_srgb, table
+    from pyjulia4d.pipeline.colormap import linear_to_srgb, lookup, table
 
     val = colouring_values(scene, world, inner)
     if val is None:
         base = np.broadcast_to(np.asarray(scene.shading.color, np.float64), (len(world), 3))
     else:
-        lut = table(scene.shading.colormap).astype(np.float64)
-        x = np.clip(val, 0.0, 1.0) * (len(lut) - 1)
-        k = np.minimum(x.astype(int), len(lut) - 2)
-        base = lut[k, :3] + (x - k)[:, None] * (lut[k + 1, :3] - lut[k, :3])
+        base = lookup(table(scene.shading.colormap).astype(np.float64), val)
     rgb = np.rint(linear_to_srgb(np.clip(base, 0.0, 1.0)) * 255)
     return np.concatenate([rgb, np.full((len(world), 1), 255.0)], axis=1).astype(np.uint8)
 
 
 def write_mesh(path: str | Path, result: MeshResult) -> None:
     """The mesh in the format of ``path``'s suffix, atomically (files.atomic_write)."""
-    from pyjulia4d.app.output import OutputError
-    from pyjulia4d.files import atomic_write
+    from pyjulia4d.app.output import write_file
 
-    p = Path(path)
-    kind = FORMATS[p.suffix.lower()]
+    kind = FORMATS[Path(path).suffix.lower()]
     # vertex normals where the format has them (trimesh writes them only when asked)
     extra = {"ply": {"vertex_normal": True}, "obj": {"include_normals": True},
              "glb": {"include_normals": True}}.get(kind, {})
-    data = result.mesh.export(file_type=kind, **extra)
-    if isinstance(data, str):
-        data = data.encode("utf-8")
-    try:
-        with atomic_write(p) as tmp:
-            tmp.write_bytes(data)
-    except OSError as e:
-        raise OutputError(f"{p}: cannot write: {e.strerror or e}") from None
+    write_file(path, result.mesh.export(file_type=kind, **extra))

@@ -38,10 +38,10 @@ def check_directory(shown: str, parent: Path) -> None:
         raise OutputError(f"{shown}: {quoted_path(parent)} is not a directory")
 
 
-def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS) -> Path:
+def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS, what: str = "output") -> Path:
     """Fail before rendering if ``path`` cannot take the image: its format (one of
-    ``formats``), its directory, the length of its name and path (the temp file's too), and a
-    temp file really created (and removed) beside it."""
+    ``formats``: an unsupported ``what`` format), its directory, the length of its name and path
+    (the temp file's too), and a temp file really created (and removed) beside it."""
     raw = os.fspath(path)
     shown = shown_path(raw)
     if not raw:
@@ -50,8 +50,8 @@ def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS) -> P
     ext = _suffix(p)
     if ext not in formats:
         got = quoted_path(ext) if ext else "'(none)'"
-        raise OutputError(f"{shown}: unsupported output format {got} (use {', '.join(formats[:-1])} or {formats[-1]})"
-                          if len(formats) > 1 else f"{shown}: unsupported output format {got} (use {formats[0]})")
+        names = " or ".join(([", ".join(formats[:-1])] if len(formats) > 1 else []) + [formats[-1]])
+        raise OutputError(f"{shown}: unsupported {what} format {got} (use {names})")
     if raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: names a directory (trailing '/')")
     parent = p.parent
@@ -105,24 +105,27 @@ def to_levels(x: np.ndarray, bits: int) -> np.ndarray:
     return np.rint(np.clip(x, 0.0, 1.0) * 65535.0).astype(np.uint16)
 
 
-def rgba_levels(color: np.ndarray, alpha: np.ndarray, bits: int = 8) -> np.ndarray:
+def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> np.ndarray:
     """(H, W, 4) integers of ``bits`` (8 or 16) from ``color`` (H, W, 3), linear light, and
     ``alpha`` (H, W) in [0, 1]: the colour clipped to [0, 1] and sRGB-encoded (the renderer
-    shades in linear light; an EXR keeps it linear), alpha linear; both rounded."""
+    shades in linear light; an EXR keeps it linear), alpha linear; both rounded.  Without
+    ``alpha`` (None): (H, W, 3), the colour alone."""
     from pyjulia4d.pipeline.colormap import linear_to_srgb
 
     color = np.asarray(color)
-    alpha = np.asarray(alpha)
-    if color.ndim != 3 or color.shape[2] != 3 or alpha.shape != color.shape[:2]:
-        raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and {alpha.shape}")
+    alpha = None if alpha is None else np.asarray(alpha)
+    if color.ndim != 3 or color.shape[2] != 3 or (alpha is not None and alpha.shape != color.shape[:2]):
+        raise ValueError(f"expected color (H, W, 3) and alpha (H, W), got {color.shape} and "
+                         f"{None if alpha is None else alpha.shape}")
     # in bands of rows: the float64 temporaries of the transfer function on a whole 3840x2160
     # image took 800 MB (a PNG render's peak was 1.16 GB); a band's are a few MB
-    rgba = np.empty(color.shape[:2] + (4,), np.uint8 if bits == 8 else np.uint16)
+    rgba = np.empty(color.shape[:2] + (3 if alpha is None else 4,), np.uint8 if bits == 8 else np.uint16)
     for r0 in range(0, color.shape[0], PNG_BAND_ROWS):
         band = slice(r0, r0 + PNG_BAND_ROWS)
         rgba[band, :, :3] = to_levels(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)),
                                       bits)
-        rgba[band, :, 3] = to_levels(alpha[band], bits)
+        if alpha is not None:
+            rgba[band, :, 3] = to_levels(alpha[band], bits)
     return rgba
 
 
@@ -227,11 +230,22 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
         else:
             from pyjulia4d.app.exr_layout import exr_output
 
-            layout = scene.image.exr if scene is not None else "pyjulia4d"
-            channels, extra = exr_output(result, scene, layout) if scene is not None else (result.exr_channels(), {})
+            channels, extra = exr_output(result, scene) if scene is not None else (result.exr_channels(), {})
             write_exr(p, channels, {**(header or {}), **extra})
     except OSError as e:
         raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
+
+
+def write_file(path: str | Path, data: bytes | str) -> None:
+    """``data`` (text as UTF-8) into ``path``, atomically; OutputError naming it when it cannot
+    be written (scene files, meshes)."""
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    try:
+        with atomic_write(path) as tmp:
+            tmp.write_bytes(data)
+    except OSError as e:
+        raise OutputError(f"{path}: cannot write: {e.strerror or e}") from None
 
 
 def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:

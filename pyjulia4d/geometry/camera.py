@@ -183,9 +183,18 @@ def stack_radius(scene: Scene) -> float:
 
 
 def march_radius(scene: Scene) -> float:
-    """Bounding radius for the march: the escape-time bound, plus 4 epsilon for the
+    """Bounding radius for the march: the set's (set_radius), plus 4 epsilon for the
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
     estimate is low by at most a factor of about 4 (Koebe 1/4 theorem)."""
+    r = set_radius(scene)
+    if march_method(scene) == "de":
+        r += 4.0 * scene.march.epsilon
+    return r
+
+
+def set_radius(scene: Scene) -> float:
+    """Radius of a 4-ball about the origin that holds the scene's set: the escape-time bound of
+    its kind (what a mesh of the set samples; the march widens it, march_radius)."""
     f = scene.fractal
     if f.kind == "mandelbrot":
         r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f),
@@ -196,8 +205,6 @@ def march_radius(scene: Scene) -> float:
         r = f.locus_radius * (1.0 + 2.0 ** -20)   # widened so that a scan starts outside
     else:
         r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
-    if march_method(scene) == "de":
-        r += 4.0 * scene.march.epsilon
     return r
 
 

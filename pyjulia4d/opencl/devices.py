@@ -204,6 +204,22 @@ def default_reason(dev: cl.Device) -> str:
     return why
 
 
+def check_device(device) -> None:
+    """A device argument of the Python interface: None (the default), a pyopencl Device, or a
+    --device text (select_device); anything else is one SceneError."""
+    if not (device is None or isinstance(device, (str, cl.Device))):
+        from pyjulia4d.scene.checks import SceneError
+
+        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
+                                   f"{type(device).__name__}")
+
+
+def device_of(device) -> cl.Device:
+    """The device a device argument names (check_device, then select_device for a text or None)."""
+    check_device(device)
+    return device if isinstance(device, cl.Device) else select_device(device)
+
+
 def select_device(spec: str | None = None) -> cl.Device:
     """Pick a device.
 

@@ -20,7 +20,7 @@ from pyjulia4d.pipeline import antialias, colormap
 from pyjulia4d.opencl import build
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.fractal.registry import march_method
-from pyjulia4d.opencl.devices import has_fp64, select_device
+from pyjulia4d.opencl.devices import check_device, device_of, has_fp64
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes
 from pyjulia4d.pipeline.calibrate import Prediction, judge, predict, tile_side, wanted
 from pyjulia4d.pipeline.framing import fit_camera
@@ -356,9 +356,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     t_start = time.perf_counter()
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
-    if not (device is None or isinstance(device, (str, cl.Device))):
-        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
-                                   f"{type(device).__name__}")
+    check_device(device)
     for name, value in (("progress", progress), ("calibrate", calibrate), ("force", force)):
         check_flag(name, value)
     if on_progress is not None and not callable(on_progress):
@@ -366,7 +364,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     if lanes is not None:
         check_lanes(lanes)
     check_tile(tile)
-    dev = device if isinstance(device, cl.Device) else select_device(device)
+    dev = device_of(device)
     plan, prediction = plan_render(scene, dev, lanes, outputs, force, tile, region, calibrate)
     result = run_plan(plan, dev, progress, on_progress)
     result.prediction = prediction

@@ -24,6 +24,15 @@ def linear_to_srgb(x: np.ndarray) -> np.ndarray:
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
 
 
+def lookup(lut: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """(n, 3) linear colours of ``values`` (clipped to [0, 1]) in the table ``lut``, linearly
+    interpolated between its entries as the shade kernel does (shade/shade.cl, -D COLORMAP)."""
+    x = np.clip(values, 0.0, 1.0) * (len(lut) - 1)
+    k = np.minimum(x.astype(int), len(lut) - 2)
+    fr = (x - k)[:, None]
+    return lut[k, :3] * (1 - fr) + lut[k + 1, :3] * fr
+
+
 @lru_cache(maxsize=None)
 def table(name: str, n: int = TABLE_SIZE) -> np.ndarray:
     """(n, 4) float32: the colour map ``name`` at n evenly spaced values, linear RGB, alpha 1."""

@@ -3,7 +3,7 @@ records the mesh kernels (kernels/mesh/mesh.cl) and their float64 twin (referenc
 both take.  No OpenCL here.
 
 The grid covers the ball's section by the slice: the bounding ball |p| <= R about the world
-origin (geometry/camera.py march_radius) meets the slice's hyperplane, at distance d from the
+origin (geometry/camera.py set_radius) meets the slice's hyperplane, at distance d from the
 origin, in a 3D ball of radius r = sqrt(R^2 - d^2) about the slice's own origin.  The grid
 spans [-r - h, r + h] on each axis, N points a side, spacing h = 2 r / (N - 3): its outermost
 layer lies outside the ball, so the mesh is closed where the ball cuts the set."""
@@ -14,8 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyjulia4d.fractal.registry import march_method
-from pyjulia4d.geometry.camera import march_radius, slice_rotation
+from pyjulia4d.geometry.camera import set_radius, slice_rotation
 from pyjulia4d.geometry.vec4 import unit
 from pyjulia4d.pipeline.kernel_config import KernelConfig, mesh_config
 from pyjulia4d.scene.checks import SceneError
@@ -72,8 +71,7 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     n = check_resolution(resolution)
     f = scene.fractal
-    # the escape-time ball (the distance estimate's shell is no part of the set a mesh draws)
-    radius = march_radius(scene) - (4.0 * scene.march.epsilon if march_method(scene) == "de" else 0.0)
+    radius = set_radius(scene)   # the set's ball (the estimate march's shell is no part of the set)
     d = float(scene.slice.distance)
     if abs(d) >= radius:
         raise SceneError("slice.distance", f"{d!r} is outside the set's bounding ball (radius {radius:.4g}): "

@@ -5,6 +5,7 @@ import numpy as np
 
 from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.codes import STATUS_HIT
+from pyjulia4d.pipeline.colormap import lookup
 # imported by the package at its end, once these are defined
 from pyjulia4d.reference.iterate import dot4, julia_distance_formula, julia_inside
 from pyjulia4d.reference.normals import to_camera
@@ -223,10 +224,7 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     vis = terms[hit, 0] if terms is not None else np.ones(len(lam))
     ao = terms[hit, 1] if terms is not None else np.ones(len(lam))
     if lut is not None:
-        x = np.clip(terms[hit, 2], 0.0, 1.0) * (len(lut) - 1)
-        k = np.minimum(x.astype(int), len(lut) - 2)
-        fr = (x - k)[:, None]
-        base = lut[k, :3] * (1 - fr) + lut[k + 1, :3] * fr
+        base = lookup(lut, terms[hit, 2])
     else:
         base = np.asarray(color)[None, :]
     def lit(l, vis):

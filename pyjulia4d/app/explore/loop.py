@@ -79,12 +79,10 @@ def picture_png(color: np.ndarray) -> bytes:
     """(H, W, 3) linear colour -> PNG bytes, sRGB-encoded, fast zlib level (a local page)."""
     from PIL import Image
 
-    from pyjulia4d.app.output import to_u8
-    from pyjulia4d.pipeline.colormap import linear_to_srgb
+    from pyjulia4d.app.output import rgba_levels
 
-    rgb = to_u8(linear_to_srgb(np.nan_to_num(np.asarray(color, np.float32), nan=0.0)))
     buf = io.BytesIO()
-    Image.fromarray(np.ascontiguousarray(rgb)).save(buf, format="PNG", compress_level=1)
+    Image.fromarray(rgba_levels(color, None)).save(buf, format="PNG", compress_level=1)
     return buf.getvalue()
 
 
@@ -117,6 +115,7 @@ class RenderLoop:
         self._cond = threading.Condition()
         self._pending: tuple[int, Scene, bool] | None = None
         self._generation = 0
+        self._moving = False      # whether the newest request's control still moves
         self._closed = False
         self._thread = threading.Thread(target=self._run, name="pyjulia4d-explore", daemon=True)
         self._thread.start()
@@ -133,14 +132,6 @@ class RenderLoop:
     @property
     def generation(self) -> int:
         return self._generation
-
-    def idle(self) -> bool:
-        """Nothing waits and nothing runs."""
-        with self._cond:
-            return self._pending is None and not self._busy
-
-    _busy = False
-    _moving = False
 
     def close(self, timeout: float = 10.0) -> None:
         with self._cond:
@@ -162,12 +153,10 @@ class RenderLoop:
         while True:
             with self._cond:
                 while self._pending is None and not self._closed:
-                    self._busy = False
                     self._cond.wait()
                 if self._closed:
                     return
                 (generation, scene, moving), self._pending = self._pending, None
-                self._busy = True
             self._serve(generation, scene, moving)
 
     def _serve(self, generation: int, scene: Scene, moving: bool) -> None:

@@ -98,15 +98,15 @@ class Explorer:
         style = {"description_width": "120px"}
         if c.widget == "select":
             return w.Dropdown(options=controls.options(c, scene), value=value, description=label, style=style)
-        integer = c.step == 1 and float(value).is_integer()
-        if c.slider:
+        x = float(value)
+        integer = c.step == 1 and x.is_integer()
+        number = int(x) if integer else x
+        if c.slider:   # the span widened to hold the scene's value
             cls = w.IntSlider if integer else w.FloatSlider
-            lo, hi = c.lo, max(c.hi, float(value))
-            return cls(value=type(lo)(float(value)) if not integer else int(float(value)), min=min(lo, float(value)),
-                       max=hi, step=c.step, description=label, style=style, continuous_update=True,
-                       readout_format=".4g" if not integer else "d")
+            return cls(value=number, min=min(c.lo, x), max=max(c.hi, x), step=c.step, description=label, style=style,
+                       continuous_update=True, readout_format="d" if integer else ".4g")
         cls = w.IntText if integer else w.FloatText
-        return cls(value=int(float(value)) if integer else float(value), description=label, style=style)
+        return cls(value=number, description=label, style=style)
 
     def _changed(self, change: dict) -> None:
         if self._quiet:

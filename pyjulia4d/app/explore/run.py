@@ -28,16 +28,10 @@ def device_renderer(device: Any) -> Render:
     """session.Render on an OpenCL device (a pyopencl Device, a --device text, or None: the
     default): a stage in small tiles without the time probe; the file render as ``pyjulia4d
     render`` makes it (probed, every output)."""
-    import pyopencl as cl
-
-    from pyjulia4d.opencl.devices import select_device
+    from pyjulia4d.opencl.devices import device_of
     from pyjulia4d.opencl.executor import render
 
-    if not (device is None or isinstance(device, (str, cl.Device))):
-        raise SceneError("device", f"expected None, a pyopencl Device or a --device text such as 'cpu', got "
-                                   f"{type(device).__name__}")
-    if not isinstance(device, cl.Device):
-        device = select_device(device)
+    device = device_of(device)
 
     def run(scene: Scene, hook: Callable[[int, int], None], whole: bool) -> Any:
         if whole:

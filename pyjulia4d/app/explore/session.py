@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from pyjulia4d.app.explore import controls
+from pyjulia4d.app.output import FORMATS, check_output_path, write_file
 from pyjulia4d.app.explore.loop import Picture, RenderLoop
 from pyjulia4d.geometry import navigate
 from pyjulia4d.geometry.vec4 import Degenerate
@@ -67,6 +68,11 @@ def file_in(folder: Path, name: Any, suffixes: tuple[str, ...]) -> Path:
     if Path(name).suffix.lower() not in suffixes:
         raise ExploreError(f"{show(name)}: expected a name ending in {' or '.join(suffixes)}")
     return folder / name
+
+
+def _toml_path(folder: Path, name: Any) -> Path:
+    """A scene file ``name`` in ``folder`` (file_in), checked as an output path is."""
+    return check_output_path(file_in(folder, name, (".toml",)), (".toml",), "scene")
 
 
 def _number(msg: dict, key: str, lo: float, hi: float, default: float | None = None) -> float:
@@ -223,19 +229,15 @@ class Session:
 
     def save_scene(self, name: Any) -> Path:
         """The current scene, fully resolved, as ``name``.toml in the folder."""
-        from pyjulia4d.interop.povray.writer import check_toml_path, write_toml
-
-        path = check_toml_path(file_in(self.folder, name, (".toml",)), "explore")
-        write_toml(path, self.scene.to_toml())
+        path = _toml_path(self.folder, name)
+        write_file(path, self.scene.to_toml())
         self.say(f"saved {path}")
         return path
 
     def render_file(self, name: Any) -> None:
         """Render the current scene at its full size into ``name`` (.png or .exr) in the
         folder, in a thread, with progress messages; one render at a time."""
-        from pyjulia4d.app.output import check_output_path
-
-        path = check_output_path(file_in(self.folder, name, (".png", ".exr", ".tif", ".tiff")))
+        path = check_output_path(file_in(self.folder, name, FORMATS))
         if self._file_thread is not None and self._file_thread.is_alive():
             raise ExploreError("render: a render to a file is still running; wait for it")
         scene = self.scene
@@ -282,17 +284,15 @@ class Session:
     def save_animation(self, name: Any, fps: float = 24.0, interpolation: str = "catmull-rom") -> Path:
         """The keyframes as a keyframed scene ``name``.toml in the folder (animation_toml),
         checked by reading it back as ``pyjulia4d animate`` does before it is written."""
-        from pyjulia4d.interop.povray.writer import check_toml_path, write_toml
-
         if len(self.keyframes) < 2:
             raise ExploreError("save animation: add at least two keyframes first")
-        path = check_toml_path(file_in(self.folder, name, (".toml",)), "explore")
+        path = _toml_path(self.folder, name)
         text, kept = animation_toml(self.keyframes, fps, interpolation)
         try:
             from_table(scene_table_from_text(text, "the animation"))
         except SceneError as e:
             raise ExploreError(f"save animation: {one_line(e)}") from None
-        write_toml(path, text)
+        write_file(path, text)
         note = f"; kept the first keyframe's {', '.join(kept)} (not interpolated)" if kept else ""
         self.say(f"saved {path}: {len(self.keyframes)} keyframes, {self.keyframes[-1][0] + 1} frames "
                  f"(render: pyjulia4d animate {path.name}){note}")

@@ -122,11 +122,6 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
 
 def write_toml(path: Path, text: str) -> None:
     """Atomically (output.py's temp file beside it, renamed)."""
-    from pyjulia4d.app.output import OutputError
-    from pyjulia4d.files import atomic_write
+    from pyjulia4d.app.output import write_file
 
-    try:
-        with atomic_write(path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    except OSError as e:
-        raise OutputError(f"{path}: cannot write: {e.strerror or e}") from None
+    write_file(path, text)
