@@ -15,19 +15,28 @@ from pyjulia4d.opencl import runtimes
 
 runtimes.register()  # before any OpenCL call: Intel's CPU runtime from PyPI (opencl/runtimes.py)
 
-from pyjulia4d.pipeline.result import RenderResult  # noqa: E402
-from pyjulia4d.scene.model import Scene  # noqa: E402
-from pyjulia4d.scene.checks import SceneError
-
 __version__ = "0.1.0"
 __all__ = ["Scene", "SceneError", "RenderResult", "render", "__version__"]
 
 
 def __getattr__(name: str):
-    """``render``, imported on first use: it brings pyopencl, which the scene model, the
-    reference and the command line's error paths do without."""
+    """The names of ``__all__``, imported on first use: ``render`` brings pyopencl, which the
+    scene model, the reference and the command line's error paths do without, and the others
+    numpy, which the program imports only once it has set its threads (__main__.py)."""
     if name == "render":
         from pyjulia4d.opencl.executor import render
 
         return render
+    if name == "Scene":
+        from pyjulia4d.scene.model import Scene
+
+        return Scene
+    if name == "SceneError":
+        from pyjulia4d.scene.checks import SceneError
+
+        return SceneError
+    if name == "RenderResult":
+        from pyjulia4d.pipeline.result import RenderResult
+
+        return RenderResult
     raise AttributeError(f"module 'pyjulia4d' has no attribute {name!r}")

@@ -1,5 +1,21 @@
-"""``python -m pyjulia4d``."""
-from pyjulia4d.app.cli import main
+"""``python -m pyjulia4d`` and the ``pyjulia4d`` command."""
+import os
+
+
+def run() -> int:
+    """The program: what only a process of its own may set, then the command line (app/cli.py).
+
+    OpenBLAS starts a thread per core when numpy is imported, which cost 0.1 of the 0.5 CPU-s
+    of a tiny render here; the renderer uses no BLAS worth threads (the kernels run in OpenCL),
+    so one thread, unless the user set it.  The default device's runtime may be loaded alone
+    (opencl/default_device.py)."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    from pyjulia4d.app.cli import main
+    from pyjulia4d.opencl import default_device
+
+    default_device.allow()
+    return main()
+
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run())

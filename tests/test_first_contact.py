@@ -132,7 +132,7 @@ def test_cpu_runtime_preference(monkeypatch) -> None:
     pocl, intel, broken = _Device("Portable Computing Language", 1), _Device("Intel(R) OpenCL", 2), \
         _Device("Intel(R) OpenCL", 3)
     rows = [("0:0", None, pocl), ("1:0", None, broken), ("2:0", None, intel)]
-    monkeypatch.setattr(devices, "_indexed", lambda: rows)
+    monkeypatch.setattr(devices, "indexed_devices", lambda: rows)
     monkeypatch.setattr(devices, "device_type", lambda d: "GPU" if d.platform.name == "GPU" else "CPU")
     monkeypatch.setattr(devices, "compile_error", lambda d: "boom" if d is broken else "")
     assert devices.select_device(None) is intel

@@ -198,10 +198,10 @@ def test_closing_line_says_which_device_and_why(tmp_path):
     """The default device is picked by a fixed rule (the first GPU that compiles, else a
     CPU that compiles, Intel's runtime first), and the closing line says which and why; a
     named device needs no why."""
-    from pyjulia4d.opencl.devices import _indexed, default_reason, select_device
+    from pyjulia4d.opencl.devices import indexed_devices, default_reason, select_device
     dev = select_device(None)
     why = default_reason(dev)
-    idx = next(i for i, _, d in _indexed() if d.int_ptr == dev.int_ptr)
+    idx = next(i for i, _, d in indexed_devices() if d.int_ptr == dev.int_ptr)
     assert why.startswith(f"{idx}, the default: ")
     p = cli("--width", "8", "--height", "6", "-o", "a.png", cwd=tmp_path)
     assert p.returncode == 0 and f"({why})" in p.stdout, p.stdout

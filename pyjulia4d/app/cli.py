@@ -151,10 +151,19 @@ def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
 
 
 def select_device(spec: str | None) -> Any:
-    """devices.select_device, imported late: pyopencl is slow to import."""
+    """devices.select_device, imported late: pyopencl is slow to import.  The default device
+    (``spec`` None) is looked up with only its runtime loaded where it was remembered, and
+    remembered where it was not (opencl/default_device.py)."""
+    from pyjulia4d.opencl import default_device, runtimes
+    from pyjulia4d.opencl.devices import default_reason, indexed_devices
     from pyjulia4d.opencl.devices import select_device as select
 
-    return select(spec)
+    if spec is None:
+        default_device.narrow()
+    dev = select(spec)
+    if spec is None and not runtimes.narrowed:
+        default_device.remember(dev, indexed_devices(), default_reason(dev))
+    return dev
 
 
 def _size_overrides(args: argparse.Namespace) -> list[str]:

@@ -15,7 +15,7 @@ class DeviceError(ValueError):
     """No OpenCL device, or none matching the request."""
 
 
-def _indexed() -> list[tuple[str, cl.Platform, cl.Device]]:
+def indexed_devices() -> list[tuple[str, cl.Platform, cl.Device]]:
     """(``"P:D"``, platform, device) for every device; [] without OpenCL."""
     try:
         platforms = cl.get_platforms()
@@ -33,7 +33,7 @@ def _indexed() -> list[tuple[str, cl.Platform, cl.Device]]:
 
 def list_devices() -> list[tuple[cl.Platform, cl.Device]]:
     """Every (platform, device) pair, in platform then device order; [] without OpenCL."""
-    return [(p, d) for _, p, d in _indexed()]
+    return [(p, d) for _, p, d in indexed_devices()]
 
 
 def device_type(device: cl.Device) -> str:
@@ -143,7 +143,7 @@ def device_key(device: cl.Device) -> str:
 def describe_devices() -> str:
     """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``, and
     whether it compiles (a device that cannot is never picked by default)."""
-    rows = _indexed()
+    rows = indexed_devices()
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
     out = []
@@ -185,16 +185,23 @@ def runtime_rank(device: cl.Device) -> int:
 
 def default_reason(dev: cl.Device) -> str:
     """Why select_device(None) picked ``dev``, for the closing line: its index, and the
-    devices passed over before it (a device of the wanted type that cannot compile)."""
-    rows = _indexed()
+    devices passed over before it (a device of the wanted type that cannot compile).  In a
+    process narrowed to the remembered default's runtime, the words remembered with it."""
+    from pyjulia4d.opencl import runtimes
+
+    if runtimes.narrowed and device_key(dev) == runtimes.narrowed["device"]:
+        return str(runtimes.narrowed["reason"])
+    rows = indexed_devices()
     at = next((k for k, (_, _, d) in enumerate(rows) if d.int_ptr == dev.int_ptr), len(rows))
     idx = rows[at][0] if at < len(rows) else "?"
     kind = device_type(dev)
     skipped = [i for i, _, d in rows if device_type(d) == kind and compile_error(d)]
     passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
-    if kind == "CPU" and passed:
+    if kind == "CPU" and passed and runtime_rank(dev) < len(CPU_PREFERENCE):
         why = f"{idx}, the default: no GPU; of the CPU runtimes that compile, {dev.platform.name.strip()} " \
               f"is preferred (faster on every pair measured: benchmarks/cpu_runtimes.py) over {', '.join(passed)}"
+    elif kind == "CPU" and passed:
+        why = f"{idx}, the default: no GPU; the first of the CPU runtimes that compile ({idx}, {', '.join(passed)})"
     else:
         why = f"{idx}, the default: the first {kind} that compiles"
         if kind != "GPU":
@@ -230,11 +237,17 @@ def select_device(spec: str | None = None) -> cl.Device:
     Anything else: the first device whose platform name, platform vendor or
     device name contains it (case-insensitive).
     """
-    rows = _indexed()
+    rows = indexed_devices()
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
     hint = "(run 'pyjulia4d devices' to list them)"
     if spec is None:
+        from pyjulia4d.opencl import runtimes
+
+        # the loader narrowed to the remembered default's runtime (default_device.py)
+        for _, _, d in rows if runtimes.narrowed else ():
+            if device_key(d) == runtimes.narrowed["device"]:
+                return d
         for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
             found = [d for _, _, d in rows if device_type(d) == want and not compile_error(d)]
             if found:

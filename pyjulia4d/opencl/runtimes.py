@@ -28,12 +28,22 @@ from pathlib import Path
 
 from pyjulia4d.resources import cache_dir
 
-_SYSTEM_VENDORS = "/etc/OpenCL/vendors"   # ocl-icd's compiled-in default
+SYSTEM_VENDORS = "/etc/OpenCL/vendors"   # ocl-icd's compiled-in default
 _INTEL_LIB = "libintelocl.so"
 
 # What register() did, for `devices` and the closing line: the library it registered
 # ("" if none) and why not, when it did not.
-registered: dict[str, str] = {"library": "", "why_not": "not yet run"}
+registered: dict[str, str] = {"library": "", "folder": "", "why_not": "not yet run"}
+
+# The remembered default device this process's loader was narrowed to (default_device.py):
+# its record, empty where every runtime is loaded.
+narrowed: dict[str, object] = {}
+
+
+def user_vendors() -> bool:
+    """Whether ``OCL_ICD_VENDORS`` was set by the user rather than by register()."""
+    env = os.environ.get("OCL_ICD_VENDORS", "")
+    return bool(env) and env != registered["folder"] and not narrowed
 
 
 def intel_library() -> Path | None:
@@ -60,7 +70,7 @@ def intel_library() -> Path | None:
 
 def system_icds() -> dict[str, str]:
     """{file name: library line} of the ``.icd`` files the loader would read by default."""
-    folder = Path(os.environ.get("OPENCL_VENDOR_PATH") or _SYSTEM_VENDORS)
+    folder = Path(os.environ.get("OPENCL_VENDOR_PATH") or SYSTEM_VENDORS)
     out = {}
     try:
         names = sorted(p.name for p in folder.iterdir() if p.suffix == ".icd")
@@ -124,4 +134,4 @@ def register() -> None:
         registered["why_not"] = f"cannot write the vendors folder ({e.strerror or e})"
         return
     os.environ["OCL_ICD_VENDORS"] = str(folder)
-    registered.update(library=str(lib), why_not="")
+    registered.update(library=str(lib), folder=str(folder), why_not="")
