@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import OpenEXR
+import OpenImageIO
 import pytest
 from PIL import Image
 
@@ -123,7 +124,7 @@ def test_failed_write_leaves_nothing(tmp_path, monkeypatch, fmt: str, exc: type[
     if fmt == "png":
         monkeypatch.setattr(Image.Image, "save", boom)
     else:
-        monkeypatch.setattr(OpenEXR.File, "write", boom)
+        monkeypatch.setattr(OpenImageIO.ImageOutput, "write_scanlines", boom)
     with pytest.raises(exc):
         write_image(tmp_path / f"out.{fmt}", FakeResult(*_color_alpha()), {})
     assert list(tmp_path.iterdir()) == []
@@ -222,7 +223,8 @@ def test_signal_during_write_leaves_nothing(tmp_path, monkeypatch, fmt: str) -> 
     if fmt == "png":
         monkeypatch.setattr(Image.Image, "save", write_then_signal(Image.Image.save))
     else:
-        monkeypatch.setattr(OpenEXR.File, "write", write_then_signal(OpenEXR.File.write))
+        monkeypatch.setattr(OpenImageIO.ImageOutput, "write_scanlines",
+                            write_then_signal(OpenImageIO.ImageOutput.write_scanlines))
     old = signal.signal(signal.SIGTERM, handler)
     try:
         with pytest.raises(_Signalled):

@@ -80,7 +80,7 @@ def test_device_memory_does_not_grow_with_the_image():
 
 def test_channels_lie_in_planes_for_the_exr_writer():
     """The image's colour, normal and position channels are planes underneath (executor.
-    planar_empty): the result's (H, W, C) arrays are views of them, and every EXR channel is
+    store.ImageStore.empty): the result's (H, W, C) arrays are views of them, and every EXR channel is
     handed over without a copy (an EXR render's peak at 3840x2160: 1.04 GB -> 741 MiB)."""
     r = render(Scene.default().with_overrides(SMALL + ["shading.shadow=none", "shading.ao=0"]))
     assert r.normal.shape[2] == 3 and r.position.shape[2] == 4 and r.color.shape[2] == 3

@@ -218,6 +218,7 @@ def _render(args: argparse.Namespace) -> int:
         default_out = Path(args.scene).stem + ".png"
     out = check_output_path(default_out if args.output is None else args.output)
     outputs = _outputs(args.channels, out)
+    store = None
     if args.workers is not None or args.scheduler is not None:  # tiles on a Dask cluster
         from pyjulia4d.app.cluster import check_workers, render_on_cluster
 
@@ -229,13 +230,16 @@ def _render(args: argparse.Namespace) -> int:
 
         from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
 
-        result = render(scene, device=device, progress=True, force=args.force, outputs=outputs)
+        store = store_for(scene, outputs, out)
+        result = render(scene, device=device, progress=True, force=args.force, outputs=outputs, store=store)
     header, tail = render_header(scene, result)
     rendered = getattr(result, "scene", None) or scene
     if scene.camera.fit and rendered is not scene:
         pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
         tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
-    write_image(out, result, header)
+    if store is not None:
+        store.release()   # the report's arrays, read whole
+    write_image(out, result, header, None if store is None else store.release)
     w, h = scene.image.width, scene.image.height
     why = ""
     if args.device is None and args.workers is None and args.scheduler is None and hasattr(device, "int_ptr"):
@@ -246,6 +250,20 @@ def _render(args: argparse.Namespace) -> int:
         f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     )
     return 0
+
+
+SPILL_BYTES = 256 * 2**20   # a render's host images past this live in a file (pipeline/store.py)
+
+
+def store_for(scene: Scene, outputs, out: Path) -> Any:
+    """Where a render's host images live: in memory, or past SPILL_BYTES in a file beside the
+    output, its rows let go as they are filed and written (pipeline/store.py), so that the
+    peak stays a band and the process rather than the image."""
+    from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore, spill_folder
+    from pyjulia4d.pipeline.workload import OUTPUT_BYTES, resolve_outputs
+
+    size = float(scene.image.width) * scene.image.height * sum(OUTPUT_BYTES[k] for k in resolve_outputs(outputs))
+    return ImageStore(spill_folder(out)) if size > SPILL_BYTES else IN_MEMORY
 
 
 def _scene_of(path: str | None, overrides: Sequence[str]) -> Scene:

@@ -25,7 +25,7 @@ up, z along the view; NDC x from 0 at the image's left edge to 1 at its right, y
 top to 1 at the bottom."""
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -60,9 +60,14 @@ def camera_matrices(scene: Any) -> dict[str, np.ndarray] | None:
     return {"worldToCamera": to_cam.astype(np.float32), "worldToNDC": (to_cam @ project).astype(np.float32)}
 
 
-def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+Band = Callable[[slice], np.ndarray]   # a channel as a function of a band of rows
+
+
+def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray | Band], dict[str, Any]]:
     """(channels, header entries) of ``result`` in the scene's image.exr layout (see the
-    module's docstring)."""
+    module's docstring).  A channel is an (H, W) array, or where the layout computes it, a
+    function of a band of rows giving that band (the writer's bands: a 3840x2160 image's
+    float64 temporaries need not be held whole)."""
     layout = scene.image.exr
     header: dict[str, Any] = {"pyjulia4d.exr_layout": layout}
     mats = camera_matrices(scene)
@@ -78,41 +83,55 @@ def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray], dict[str
     header["pyjulia4d.normal_space"] = "scene: x, y, z (w dropped), 0 on a miss"
     header["pyjulia4d.position_space"] = "scene: x, y, z (w dropped), 0 on a miss"
     header["pyjulia4d.depth"] = f"distance along the view axis; {MISS_DEPTH:g} on a miss"
-    ch: dict[str, np.ndarray] = {}
+    ch: dict[str, np.ndarray | Band] = {}
     if result.color is not None and result.alpha is not None:
-        a = np.asarray(result.alpha, np.float32)
         bg = np.asarray(scene.shading.background, np.float32)
-        premult = np.asarray(result.color, np.float32) - (1.0 - a)[..., None] * bg
+
+        def combined(k: int) -> Band:
+            # premultiplied whatever the background: rgb - (1 - a) background
+            return lambda rows: (np.asarray(result.color[rows, :, k], np.float32)
+                                 - (1.0 - np.asarray(result.alpha[rows], np.float32)) * bg[k])
         for k, name in enumerate("RGB"):
-            ch[f"ViewLayer.Combined.{name}"] = premult[..., k]
-        ch["ViewLayer.Combined.A"] = a
-    hit = np.isfinite(result.bracket) if result.bracket is not None else None
+            ch[f"ViewLayer.Combined.{name}"] = combined(k)
+        ch["ViewLayer.Combined.A"] = result.alpha
     f, r, u, _, _ = frame(scene.camera)
     rot = slice_rotation(scene.slice.normal)
     offset = scene.slice.distance * unit(scene.slice.normal)
     if result.depth is not None:
         # along the view axis: the depth along each pixel's centre ray times the ray's cosine
         # with the view direction, 1 / |forward + u right + v up| (kernels/rays.cl)
-        depth = np.asarray(result.depth, np.float64)
-        h, w = depth.shape
+        h, w = result.depth.shape
         t = np.tan(np.radians(scene.camera.fov) / 2)
         pu = (2 * (np.arange(w) + 0.5) / scene.image.width - 1) * t * scene.image.width / scene.image.height
         pv = (1 - 2 * (np.arange(h) + 0.5) / scene.image.height) * t
-        cos = 1 / np.sqrt(1 + pu[None, :] ** 2 + pv[:, None] ** 2)
-        ch["ViewLayer.Depth.Z"] = np.where(np.isfinite(depth), depth * cos, MISS_DEPTH).astype(np.float32)
+
+        def view_depth(rows: slice) -> np.ndarray:
+            depth = np.asarray(result.depth[rows], np.float64)
+            cos = 1 / np.sqrt(1 + pu[None, :] ** 2 + pv[rows, None] ** 2)
+            return np.where(np.isfinite(depth), depth * cos, MISS_DEPTH).astype(np.float32)
+        ch["ViewLayer.Depth.Z"] = view_depth
     if result.position is not None:
-        p = np.nan_to_num(np.asarray(result.position, np.float64))
-        scene_p = (p - offset) @ rot   # rot^T (p - offset), row by row
-        miss = ~np.all(np.isfinite(np.asarray(result.position)), axis=-1)
+        def position(k: int) -> Band:
+            def band(rows: slice) -> np.ndarray:
+                raw = np.asarray(result.position[rows])
+                scene_p = (np.nan_to_num(raw.astype(np.float64)) - offset) @ rot   # rot^T (p - offset)
+                miss = ~np.all(np.isfinite(raw), axis=-1)
+                return np.where(miss, 0.0, scene_p[..., k]).astype(np.float32)
+            return band
         for k, name in enumerate("XYZ"):
-            ch[f"ViewLayer.Position.{name}"] = np.where(miss, 0.0, scene_p[..., k]).astype(np.float32)
+            ch[f"ViewLayer.Position.{name}"] = position(k)
     if result.normal is not None:
-        n = np.asarray(result.normal, np.float64)
-        # camera coordinates (right, up, towards the eye) -> the scene's
-        scene_n = n[..., :1] * r + n[..., 1:2] * u - n[..., 2:3] * f
+        def normal(k: int) -> Band:
+            # camera coordinates (right, up, towards the eye) -> the scene's
+            axis = np.array([r[k], u[k], -f[k]])
+            return lambda rows: (np.asarray(result.normal[rows], np.float64) @ axis).astype(np.float32)
         for k, name in enumerate("XYZ"):
-            ch[f"ViewLayer.Normal.{name}"] = scene_n[..., k].astype(np.float32)
-    for key, src in (("Bracket", result.bracket), ("Unresolved", result.unresolved)):
-        if src is not None and hit is not None and result.depth is not None:
-            ch[f"ViewLayer.{key}.Z"] = np.where(hit, np.nan_to_num(src, posinf=0.0), 0.0).astype(np.float32)
+            ch[f"ViewLayer.Normal.{name}"] = normal(k)
+    if result.bracket is not None and result.depth is not None:
+        for key, src in (("Bracket", result.bracket), ("Unresolved", result.unresolved)):
+            if src is not None:
+                def reach(rows: slice, src=src) -> np.ndarray:
+                    hit = np.isfinite(result.bracket[rows])
+                    return np.where(hit, np.nan_to_num(src[rows], posinf=0.0), 0.0).astype(np.float32)
+                ch[f"ViewLayer.{key}.Z"] = reach
     return ch, header

@@ -6,7 +6,7 @@ import os
 import stat
 import tempfile
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -187,38 +187,73 @@ def write_tiff(
                          description=json.dumps(dict(text or {})), metadata=None)
 
 
+EXR_BAND_ROWS = 64   # rows written at a time (write_exr)
+# OpenEXR's standard attributes under OpenImageIO's names for them
+_OIIO_NAMES = {"worldToCamera": "worldtocamera", "worldToNDC": "worldToNDC"}
+
+
 def write_exr(
     path: str | Path,
-    channels: Mapping[str, np.ndarray],
-    header: Mapping[str, str] | None = None,
+    channels: Mapping[str, Any],
+    header: Mapping[str, Any] | None = None,
+    release: Callable[[slice], None] | None = None,
+    shape: tuple[int, int] | None = None,
 ) -> None:
-    """Single-part scanline EXR, ZIP-compressed, one float32 channel per entry.
-
-    ``header`` entries are written as string attributes.
-    """
-    import OpenEXR
+    """Single-part scanline EXR, ZIP-compressed, one float32 channel per entry, written in
+    bands of EXR_BAND_ROWS rows by OpenImageIO: a channel is an (H, W) array or a function
+    of a band of rows giving that band (exr_layout.exr_output), so no copy of the whole
+    image is made; ``release(rows)`` is called after each band is written (store.py: the
+    rows' pages let go).  ``header`` entries are written as string attributes, and numpy
+    4x4 matrices as OpenEXR's M44f (worldToCamera, worldToNDC).  ``shape`` (H, W): the
+    image's, where no channel is an array."""
+    import OpenImageIO as oiio
 
     if not channels:
         raise ValueError("no channels to write")
-    # OpenEXR.File replaces the dict's arrays by Channel objects: hand it a fresh dict.
-    data = {name: np.ascontiguousarray(a, dtype=np.float32) for name, a in channels.items()}
-    shapes = {a.shape for a in data.values()}
-    if len(shapes) != 1 or len(next(iter(shapes))) != 2:
+    names = list(channels)
+    shapes = {np.shape(v) for v in channels.values() if not callable(v)}
+    if len(shapes) > 1 or any(len(s) != 2 for s in shapes):
         raise ValueError(f"EXR channels must be 2D and of one shape, got {sorted(shapes)}")
-    hdr: dict[str, Any] = {
-        "compression": OpenEXR.ZIP_COMPRESSION,
-        "type": OpenEXR.scanlineimage,
-    }
-    # strings, and OpenEXR's matrices (worldToCamera, worldToNDC: float32 4x4 -> M44f)
-    hdr.update({k: v if isinstance(v, np.ndarray) else str(v) for k, v in (header or {}).items()})
+    if shape is not None:
+        shapes.add(tuple(shape))
+    if len(shapes) != 1:
+        raise ValueError(f"EXR channels must be of the image's shape {shape}, got {sorted(shapes)}"
+                         if shapes else "EXR channels need an array or a shape to give the image's size")
+    h, w = next(iter(shapes))
+    spec = oiio.ImageSpec(w, h, len(names), "float")
+    spec.channelnames = tuple(names)
+    spec.attribute("compression", "zip")
+    for k, v in (header or {}).items():
+        if isinstance(v, np.ndarray):
+            spec.attribute(_OIIO_NAMES.get(k, k), oiio.TypeDesc("matrix"), tuple(float(x) for x in v.ravel()))
+        else:
+            spec.attribute(k, str(v))
+    band = np.empty((min(EXR_BAND_ROWS, h), w, len(names)), np.float32)
     with atomic_write(path) as tmp:
-        OpenEXR.File(hdr, data).write(str(tmp))
+        out = oiio.ImageOutput.create(str(tmp))
+        if out is None or not out.open(str(tmp), spec):
+            raise OSError(f"OpenImageIO cannot open the EXR: {oiio.geterror() if out is None else out.geterror()}")
+        try:
+            for r0 in range(0, h, EXR_BAND_ROWS):
+                rows = slice(r0, min(h, r0 + EXR_BAND_ROWS))
+                n = rows.stop - r0
+                for c, name in enumerate(names):
+                    v = channels[name]
+                    band[:n, :, c] = v(rows) if callable(v) else v[rows]
+                if not out.write_scanlines(r0, rows.stop, 0, band[:n]):
+                    raise OSError(f"OpenImageIO cannot write the EXR: {out.geterror()}")
+                if release is not None:
+                    release(rows)
+        finally:
+            if not out.close():
+                raise OSError(f"OpenImageIO cannot finish the EXR: {out.geterror()}")
 
 
-def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None) -> None:
+def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None,
+                release: Callable[[slice], None] | None = None) -> None:
     """Write a RenderResult as .png or .tif/.tiff (colour + alpha, 8 or 16 bits a channel by
     the scene's image.bits) or .exr (the channels of the scene's image.exr layout:
-    exr_layout.py)."""
+    exr_layout.py); ``release(rows)`` after each band of an EXR is written (write_exr)."""
     p = check_output_path(path)
     scene = getattr(result, "scene", None)
     bits = scene.image.bits if scene is not None else 8
@@ -231,7 +266,9 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
             from pyjulia4d.app.exr_layout import exr_output
 
             channels, extra = exr_output(result, scene) if scene is not None else (result.exr_channels(), {})
-            write_exr(p, channels, {**(header or {}), **extra})
+            shape = next((np.shape(a)[:2] for a in (result.color, result.alpha, getattr(result, "depth", None))
+                          if a is not None), None)
+            write_exr(p, channels, {**(header or {}), **extra}, release, shape)
     except OSError as e:
         raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
 

@@ -29,6 +29,7 @@ from pyjulia4d.pipeline.plan import (TILE, Plan, Tile, check_flag, check_lanes, 
                                      make_tiles)
 from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
+from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
@@ -339,7 +340,7 @@ def _seconds(events) -> float:
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False, tile: int = TILE, lanes: int | None = None,
            outputs=None, region=None, calibrate: bool = True,
-           on_progress: Callable[[int, int], None] | None = None) -> RenderResult:
+           on_progress: Callable[[int, int], None] | None = None, store: ImageStore = IN_MEMORY) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
@@ -352,7 +353,8 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     so that Ctrl-C is honoured within a tile); False renders in tiles of ``tile``.
     ``on_progress(pixels done, pixels in all)`` is called as each tile is filed (antialiasing's
     passes count again); an exception it raises abandons the render (the explorer's stale
-    previews)."""
+    previews).  ``store``: where the host images live (pipeline/store.py; in memory, or in a
+    file for images larger than memory should hold)."""
     t_start = time.perf_counter()
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
@@ -366,7 +368,9 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     check_tile(tile)
     dev = device_of(device)
     plan, prediction = plan_render(scene, dev, lanes, outputs, force, tile, region, calibrate)
-    result = run_plan(plan, dev, progress, on_progress)
+    if not isinstance(store, ImageStore):
+        raise SceneError("store", f"expected a pyjulia4d.pipeline.store.ImageStore, got {type(store).__name__}")
+    result = run_plan(plan, dev, progress, on_progress, store)
     result.prediction = prediction
     result.seconds = time.perf_counter() - t_start
     return result
@@ -415,22 +419,13 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
     return plan, prediction
 
 
-def planar_empty(shape: tuple, dtype) -> np.ndarray:
-    """An uninitialised image of ``shape``, (H, W) or (H, W, C), whose channels lie in planes
-    underneath ((C, H, W), seen through a transposed view): the EXR writer takes each channel
-    as it is, where interleaved ones were copied, 330 MB of an EXR's 1.04 GB peak at
-    3840x2160."""
-    if len(shape) == 3:
-        return np.empty((shape[2],) + tuple(shape[:2]), dtype).transpose(1, 2, 0)
-    return np.empty(shape, dtype)
-
-
 def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
-             on_progress: Callable[[int, int], None] | None = None) -> RenderResult:
+             on_progress: Callable[[int, int], None] | None = None, store: ImageStore = IN_MEMORY) -> RenderResult:
     """Execute ``plan`` on ``dev``, tile by tile: its pixels through rays, march, normals and
     shading, the antialiasing passes, filed into the image; the counts, guards and kernel
     time go into the result (its ``seconds`` are the kernels' and the filing's).
-    ``on_progress``: as for render."""
+    ``on_progress``: as for render.  The images are ``store``'s (pipeline/store.py), each
+    row of tiles let go once filed."""
     t_start = time.perf_counter()
     scene, lanes = plan.scene, plan.lanes
     runner = TileRunner(plan, dev)
@@ -438,7 +433,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
     keep = plan.outputs
     shapes = {"color": (H, W, 3), "alpha": (H, W), "depth": (H, W), "bracket": (H, W), "unresolved": (H, W),
               "normal": (H, W, 3), "position": (H, W, 4), "status": (H, W), "samples": (H, W)}
-    img = {k: planar_empty(shapes[k], np.int32 if k in ("status", "samples") else np.float32) for k in keep}
+    img = {k: store.empty(shapes[k], np.int32 if k in ("status", "samples") else np.float32) for k in keep}
     counts = {"miss": 0, "hit": 0, "capped": 0}
     guards: dict[str, int] = {}
     kernel_events: list = []
@@ -469,6 +464,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
             img["normal"][dst] = got["normal"][own][..., :3]
         if "position" in keep:
             img["position"][dst] = got["point"][own]
+        if t.x0 + t.w == rx + W:   # the last tile of its row (make_tiles: row by row)
+            store.release(dst[0])
 
     S = scene.image.samples
     aa = S > 1 and bool({"color", "alpha"} & keep)
