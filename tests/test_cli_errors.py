@@ -174,7 +174,7 @@ class FakeRender:
         self.calls: list[tuple] = []
         self.exc: BaseException | None = None
 
-    def __call__(self, scene, device=None, progress=False, force=False, outputs=None) -> FakeResult:
+    def __call__(self, scene, device=None, progress=False, force=False, outputs=None, store=None) -> FakeResult:
         self.calls.append((scene, device, progress))
         if self.exc is not None:
             raise self.exc

@@ -643,7 +643,7 @@ class Result:
     def report(self, stated_p99=None):
         return {}, ""
 
-def render(scene, device=None, progress=False, force=False, outputs=None):
+def render(scene, device=None, progress=False, force=False, outputs=None, store=None):
     if phase == "render":
         print("rendering", file=sys.stderr, flush=True)
         time.sleep(60)

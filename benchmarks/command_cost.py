@@ -1,0 +1,109 @@
+"""What the whole command costs: CPU-seconds, wall time and peak memory of `python -m
+pyjulia4d render`, from start-up to the file written.
+
+Each case is the command in a child process, measured by os.wait4 (user + system CPU of the
+process and its threads, peak resident memory ru_maxrss); cases alternate, --repeats each,
+after one untimed run of each that fills the disk caches (programs, packet widths, the
+remembered default device).  The cases: the start-up (an 8x6 PNG: importing, loading the
+OpenCL runtime, framing, the tiny render and the write), 640x480 PNG, and 3840x2160 PNG and EXR
+(every channel; --force: their work estimate asks for it).  Each is run twice side by side:
+
+* as the command runs (one OpenCL runtime loaded once the default device is remembered,
+  OpenBLAS at one thread: opencl/default_device.py, __main__.py);
+* "every runtime": the same with OCL_ICD_VENDORS set to pyjulia4d's own vendors folder (a
+  user's setting, which the command leaves alone, so every runtime is loaded as before) and
+  OpenBLAS at one thread per core.
+
+Reports medians and the ratio of each case to its "every runtime" twin; writes
+benchmarks/results/command_cost.md (a section per run: device, date, commit).
+
+    python benchmarks/command_cost.py [--repeats 5] [--big 3840x2160] [--no-big]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
+
+
+def run(args: list[str], env: dict[str, str], cwd: str) -> dict:
+    """One command: CPU-s (user + system), wall s, peak MiB; raises if it fails."""
+    t = time.perf_counter()
+    p = subprocess.Popen([sys.executable, "-m", "pyjulia4d", *args], cwd=cwd, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    _, status, ru = os.wait4(p.pid, 0)
+    wall = time.perf_counter() - t
+    out, err = p.stdout.read().decode(), p.stderr.read().decode()
+    p.stdout.close()
+    p.stderr.close()
+    p.returncode = os.waitstatus_to_exitcode(status)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(args)} failed ({p.returncode}): {err.strip().splitlines()[-1:]}")
+    return {"cpu": ru.ru_utime + ru.ru_stime, "wall": wall, "mib": ru.ru_maxrss / 1024, "line": out.strip()}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--big", default="3840x2160", help="the large size (WxH)")
+    ap.add_argument("--no-big", action="store_true", help="leave out the large renders")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    a = ap.parse_args(argv)
+    bw, bh = a.big.split("x")
+    cases = [("start-up, 8x6 PNG", ["--width", "8", "--height", "6", "-o", "s.png"]),
+             ("640x480 PNG", ["--width", "640", "--height", "480", "-o", "m.png"])]
+    if not a.no_big:
+        cases += [(f"{a.big} PNG", ["--width", bw, "--height", bh, "--force", "-o", "b.png"]),
+                  (f"{a.big} EXR, every channel", ["--width", bw, "--height", bh, "--force", "-o", "b.exr"])]
+    import pyjulia4d.opencl.runtimes as runtimes
+
+    runtimes.register()
+    base = {k: v for k, v in os.environ.items() if k not in ("OCL_ICD_VENDORS", "OPENBLAS_NUM_THREADS")}
+    base["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), base.get("PYTHONPATH")]))
+    every = dict(base, OCL_ICD_VENDORS=runtimes.registered["folder"] or runtimes.SYSTEM_VENDORS,
+                 OPENBLAS_NUM_THREADS=str(os.cpu_count() or 1))
+    modes = [("as run", base), ("every runtime", every)]
+    got: dict[tuple[str, str], list[dict]] = {}
+    device = "?"
+    with tempfile.TemporaryDirectory() as tmp:
+        for _, args in cases:                     # fill the caches, remember the device
+            for _, env in modes:
+                run(["render", *args], env, tmp)
+        for k in range(a.repeats):
+            for name, args in cases:
+                order = modes if k % 2 == 0 else modes[::-1]
+                for mode, env in order:
+                    r = run(["render", *args], env, tmp)
+                    got.setdefault((name, mode), []).append(r)
+                    device = r["line"].split(" on ", 1)[-1].split(" (", 1)[0]
+    rows = ["| case | CPU-s | wall s | peak MiB | CPU-s, every runtime | peak MiB, every runtime | CPU ratio | "
+            "memory ratio |", "|---|---|---|---|---|---|---|---|"]
+    for name, _ in cases:
+        m = {mode: {q: statistics.median(r[q] for r in got[name, mode]) for q in ("cpu", "wall", "mib")}
+             for mode, _ in modes}
+        s, e = m["as run"], m["every runtime"]
+        rows.append(f"| {name} | {s['cpu']:.3f} | {s['wall']:.3f} | {s['mib']:.0f} | {e['cpu']:.3f} | "
+                    f"{e['mib']:.0f} | {s['cpu'] / e['cpu']:.2f} | {s['mib'] / e['mib']:.2f} |")
+    table = "\n".join(rows)
+    print(table)
+    section = (f"\n## {utc_now()}, {device}, commit {git_commit()}, median of {a.repeats} alternating runs\n\n"
+               f"{table}\n")
+    append_run(a.out / "command_cost.md",
+               "# What the whole command costs\n\nWritten by `python benchmarks/command_cost.py` (its docstring "
+               "says what is measured).\n", section)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
