@@ -57,8 +57,10 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         r_prev = L_SEL(r, r_prev, gap);
         lreal next = t + step;
         lmask stall = active & (next == t);    /* the step rounded away: one ulp instead */
-        next = L_SEL(next, nextafter(t, (lreal)INFINITY), stall);
-        *flags |= L_SEL((lmask)0, (lmask)GUARD_ULP_STEP, stall);
+        if (L_ANY(stall)) {   /* rare; nextafter on a packet took 16 % of a render on Intel's runtime */
+            next = L_SEL(next, nextafter(t, (lreal)INFINITY), stall);
+            *flags |= L_SEL((lmask)0, (lmask)GUARD_ULP_STEP, stall);
+        }
         /* the bracket's outer end stays the last point whose sphere counted */
         t_prev = L_SEL(t_prev, t, active & !gap);
         t = L_SEL(t, next, active);
