@@ -66,8 +66,11 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
 {
     /* q_n = 0 exactly makes ln -> -inf; the smallest normal number keeps it finite */
     lreal mq = fmax(m2, REAL_MIN);
-    lreal ratio = ldexp(sqrt(mq / fmax(dm2, REAL_MIN)), L_INT(-e / 2));
-    ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
+    lreal ratio = sqrt(mq / fmax(dm2, REAL_MIN));
+    if (L_ANY(e != 0)) {   /* rescaled only past 1e16: a packet's ldexp costs an SVML call */
+        ratio = ldexp(ratio, L_INT(-e / 2));
+        ratio = L_SEL(ratio, ratio * (real)0.70710678118654752, (e & 1) != 0);
+    }
     /* the 1/2 of the lower bound G / (2 |G'|) (Koebe), whatever the degree */
     return ratio * log(mq) / (real)4;
 }
