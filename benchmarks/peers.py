@@ -44,7 +44,7 @@ their PNGs).  POV-Ray and Mandelbulber2 are each skipped with a message where th
 installed (Mandelbulber2's OpenCL rows too where its OpenCL does not start).
 Writes benchmarks/results/peers.md (appends a section per run).
 
-    python benchmarks/peers.py [--size 640x480] [--repeats 3]
+    python benchmarks/peers.py [--size 640x480] [--repeats 3] [--set fractal.max_iter=20]
 """
 from __future__ import annotations
 
@@ -87,6 +87,7 @@ julia_fractal {{
 # The peers trace no shadows and light from the camera: pyjulia4d's default scene with the
 # light at the eye, no shadows and no ambient occlusion (matched lighting).
 MATCHED = ["shading.light=eye", "shading.shadow=none", "shading.ao=0"]
+SCENE_SET: list[str] = []   # --set: more overrides, for all three renderers (e.g. fractal.max_iter=20)
 
 CHILD = r"""
 import json, resource, sys, time, warnings
@@ -167,7 +168,7 @@ VARIANTS = {"pyjulia4d default": [], "pyjulia4d march.quality=draft": ["march.qu
 def pov_scene(w: int, h: int) -> str:
     from pyjulia4d.scene.model import Scene
 
-    s = Scene.default().with_overrides(MATCHED)
+    s = Scene.default().with_overrides(MATCHED + SCENE_SET)
     px, py, pz = s.camera.position[:3]
     hfov = math.degrees(2 * math.atan(math.tan(math.radians(s.camera.fov) / 2) * w / h))
     c = s.fractal.c
@@ -195,7 +196,7 @@ def mb_settings(w: int, h: int) -> str:
     left-handed (x, y, z) -> z-up right-handed (x, z, y), c's i and j swapped)."""
     from pyjulia4d.scene.model import Scene
 
-    s = Scene.default().with_overrides(MATCHED)
+    s = Scene.default().with_overrides(MATCHED + SCENE_SET)
     cam, f = s.camera, s.fractal
     if (f.c[3] != 0 or cam.position[3] != 0 or cam.target[3] != 0 or cam.up[3] != 0
             or tuple(s.slice.normal) != (0, 0, 0, 1) or s.slice.distance != 0 or s.shading.light != "eye"):
@@ -281,10 +282,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="change the scene for all three renderers (fractal.max_iter=20; keys POV-Ray's "
+                         "and Mandelbulber2's translations take: fractal.c, fractal.max_iter, camera.*)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
+    SCENE_SET[:] = a.set
     w, h = (int(x) for x in a.size.split("x"))
-    size = [f"image.width={w}", f"image.height={h}"]
+    size = [f"image.width={w}", f"image.height={h}"] + a.set
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
@@ -321,7 +326,8 @@ def main(argv=None) -> int:
     pov = runs.get("POV-Ray 3.7 julia_fractal (precision 20)")
     pov_rate = rate_of(pov) if pov else None
     pj_rate = rate_of(runs["pyjulia4d default"])
-    lines = [f"\n## {utc_now()}, {w}x{h}, pyjulia4d on {device}, "
+    scene = f", the scene with {', '.join(a.set)}" if a.set else ""
+    lines = [f"\n## {utc_now()}, {w}x{h}{scene}, pyjulia4d on {device}, "
              f"commit {git_commit()}, median of {a.repeats} alternating runs\n",
              "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pyjulia4d default / this "
              "| pixels hit |", "|---|---|---|---|---|---|"]

@@ -17,7 +17,7 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.pipeline import antialias, colormap
-from pyjulia4d.opencl import build
+from pyjulia4d.opencl import build, pool
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.opencl.devices import check_device, device_of, has_fp64
@@ -159,36 +159,12 @@ class TileRunner:
         if plan.normals:
             read.add("normal")
         self.read = read
-        self.slots = []
-        for _ in range(self.SLOTS):
-            bufs = {"depth": cla.empty(self.queue, nmax, pr.scalar),
-                    "bracket": cla.empty(self.queue, nmax, pr.scalar),
-                    "unresolved": cla.empty(self.queue, nmax, pr.scalar),
-                    "point": cla.empty(self.queue, nmax, pr.vec_dtype),
-                    "status": cla.empty(self.queue, nmax, np.int32),
-                    "samples": cla.empty(self.queue, nmax, np.int32),
-                    "flags": cla.empty(self.queue, nmax, np.int32)}
-            if plan.normals:
-                bufs["normal"] = cla.empty(self.queue, nmax, pr.vec_dtype)
-            if plan.shades:
-                bufs["rgba"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
-            if plan.march.cone:   # march/cone.cl: (t_lo, t_last) per block of the tile
-                nb = max(bw * bh for _, _, bw, bh in (t.cone_blocks() for t in plan.tiles))
-                bufs["cone"] = cla.empty(self.queue, nb, pr.cone_dtype)
-            if plan.reflects:   # the reflected rays, their march, normals and colour
-                for k in ("origins", "dirs", "point2", "normal2"):
-                    bufs[k] = cla.empty(self.queue, nmax, pr.vec_dtype)
-                for k in ("depth2", "bracket2", "unresolved2"):
-                    bufs[k] = cla.empty(self.queue, nmax, pr.scalar)
-                for k in ("status2", "samples2", "flags2"):
-                    bufs[k] = cla.empty(self.queue, nmax, np.int32)
-                bufs["refl"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
-            if plan.light_terms:
-                bufs["terms"] = cla.empty(self.queue, nmax, cl.cltypes.float4)
-                bufs["vis_extra"] = cla.empty(self.queue, nmax if "EXTRA_SHADOWS" in plan.config.defines
-                                              else 1, cl.cltypes.float4)
-            stage = {k: np.empty(nmax, bufs[k].dtype) for k in read}
-            self.slots.append((bufs, stage))
+        nb = max(bw * bh for _, _, bw, bh in (t.cone_blocks() for t in plan.tiles)) if plan.march.cone else 0
+        extra = "EXTRA_SHADOWS" in plan.config.defines
+        # slots of these shapes given back by an earlier runner (opencl/pool.py), else new ones
+        self.slot_key = (self.ctx.int_ptr, nmax, plan.double, frozenset(read), plan.normals, plan.shades, nb,
+                         plan.reflects, plan.light_terms, extra)
+        self.slots = pool.take(self.slot_key) or [self.make_slot(nmax, nb, extra) for _ in range(self.SLOTS)]
         # the plan's argument records (pipeline/plan.py), in the order the kernels declare them
         fr, ma, sa, la = plan.frame, plan.march, plan.shade, plan.light_args
         self.eye, self.fwd, self.right, self.up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
@@ -236,6 +212,40 @@ class TileRunner:
             self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
             self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
             self.refl_bias = pr.scalar(la.bias)
+
+    def make_slot(self, nmax: int, nb: int, extra: bool) -> tuple[dict, dict]:
+        """One slot: the device buffers of a tile of up to nmax pixels (nb cone blocks) and
+        the host arrays its outputs are read back into."""
+        plan, pr, q = self.plan, self.pr, self.queue
+        bufs = {"depth": cla.empty(q, nmax, pr.scalar), "bracket": cla.empty(q, nmax, pr.scalar),
+                "unresolved": cla.empty(q, nmax, pr.scalar), "point": cla.empty(q, nmax, pr.vec_dtype),
+                "status": cla.empty(q, nmax, np.int32), "samples": cla.empty(q, nmax, np.int32),
+                "flags": cla.empty(q, nmax, np.int32)}
+        if plan.normals:
+            bufs["normal"] = cla.empty(q, nmax, pr.vec_dtype)
+        if plan.shades:
+            bufs["rgba"] = cla.empty(q, nmax, cl.cltypes.float4)
+        if nb:   # march/cone.cl: (t_lo, t_last) per block of the tile
+            bufs["cone"] = cla.empty(q, nb, pr.cone_dtype)
+        if plan.reflects:   # the reflected rays, their march, normals and colour
+            for k in ("origins", "dirs", "point2", "normal2"):
+                bufs[k] = cla.empty(q, nmax, pr.vec_dtype)
+            for k in ("depth2", "bracket2", "unresolved2"):
+                bufs[k] = cla.empty(q, nmax, pr.scalar)
+            for k in ("status2", "samples2", "flags2"):
+                bufs[k] = cla.empty(q, nmax, np.int32)
+            bufs["refl"] = cla.empty(q, nmax, cl.cltypes.float4)
+        if plan.light_terms:
+            bufs["terms"] = cla.empty(q, nmax, cl.cltypes.float4)
+            bufs["vis_extra"] = cla.empty(q, nmax if extra else 1, cl.cltypes.float4)
+        return bufs, {k: np.empty(nmax, bufs[k].dtype) for k in self.read}
+
+    def close(self) -> None:
+        """Give the slots back for the next runner of the same shapes (opencl/pool.py); once
+        every tile is filed, so nothing still writes them."""
+        if self.slots:
+            pool.give(self.slot_key, self.slots)
+            self.slots = []
 
     def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
                 ) -> tuple[list[cl.Event], list[cl.Event]]:
@@ -407,6 +417,7 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
             events: list = []
             probe = TileRunner(dataclasses.replace(plan, tiles=tiles), dev)
             _run_tiles(probe, tiles, lambda t, got: None, events, silent())
+            probe.close()
             big = max(plan.tiles, key=lambda t: t.n)
             groups = -(-march_items(big.n, big.aw, plan.lanes) // local_size(probe.march_k, dev))
             return _seconds(events) / max(1, min(dev.max_compute_units, groups))
@@ -496,6 +507,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
                   unit_scale=True, hook=on_progress) as bar:
         # the centre of each pixel: every output (depth, normal, position come from it)
         _run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
+        runner.close()
         if aa:
             # image.samples more passes of colour and alpha alone, each through its own
             # stratified sample of every pixel (rays.cl sample_offset); RGBA is their mean
@@ -507,8 +519,9 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
                 ring = tuple(t for box in antialias.ring(plan.region, IW, IH)
                              for t in make_tiles(IW, IH, max(box[2], box[3]), plan.halo, box))
                 if ring:
-                    _run_tiles(TileRunner(dataclasses.replace(cplan, tiles=ring), dev), ring, note,
-                               kernel_events, bar)
+                    ring_runner = TileRunner(dataclasses.replace(cplan, tiles=ring), dev)
+                    _run_tiles(ring_runner, ring, note, kernel_events, bar)
+                    ring_runner.close()
                 flags = antialias.flag_edges(centre_c, centre_a)[ry - ey0:ry - ey0 + H, rx - ex0:rx - ex0 + W]
                 tiles = antialias.block_tiles(flags, plan.region, IW, IH, plan.halo,
                                               max(t.n for t in plan.tiles))
@@ -525,6 +538,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
 
             for k in range(S if tiles else 0):
                 _run_tiles(crunner, tiles, add, kernel_events, bar, sample=k, samples=S)
+            if crunner is not None:
+                crunner.close()
             if flags is None:
                 if acc_c is not None:
                     img["color"] = acc_c / S
