@@ -37,10 +37,26 @@ inline cplx c_exp(cplx z)
 lreal r = exp(z.re);
 return C(r * cos(z.im), ((z.im == (real)0) ? (z.im) : (r * sin(z.im))));
 }
-inline cplx c_log(cplx z) { return C(log(hypot(z.re, z.im)), atan2(z.im, z.re)); }
+inline lreal lane_hypot(lreal x, lreal y)
+{
+lreal s = fma(x, x, y * y);
+lmask plain = ((s >= (real)1e-30) & (s < (real)1e38)) | ((x == (real)0) & (y == (real)0));
+lreal r = sqrt(s);
+if ((!plain)) {
+lreal ax = fabs(x), ay = fabs(y);
+lreal m = fmax(ax, ay), n = fmin(ax, ay);
+lreal q = n / m;
+lreal scaled = m * sqrt(fma(q, q, (real)1));
+scaled = (((m == (real)0) | (m == (real)INFINITY)) ? (m) : (scaled));
+scaled = ((isnan(x) | isnan(y)) ? (x + y) : (scaled));
+r = ((plain) ? (r) : (scaled));
+}
+return r;
+}
+inline cplx c_log(cplx z) { return C(log(lane_hypot(z.re, z.im)), atan2(z.im, z.re)); }
 inline cplx c_sqrt(cplx z)
 {
-lreal t = sqrt((hypot(z.re, z.im) + fabs(z.re)) * (real)0.5);
+lreal t = sqrt((lane_hypot(z.re, z.im) + fabs(z.re)) * (real)0.5);
 lreal u = ((z.re >= (real)0) ? (t) : (fabs(z.im) / ((real)2 * t)));
 lreal v = ((z.re >= (real)0) ? (z.im / ((real)2 * t)) : (copysign(t, z.im)));
 lmask zero = t == (real)0;
@@ -158,8 +174,11 @@ return ((*inside) ? (m2 / jp.bailout2 - (real)1) : (out));
 inline lreal de_value(lreal m2, lreal dm2, lmask e)
 {
 lreal mq = fmax(m2, FLT_MIN);
-lreal ratio = ldexp(sqrt(mq / fmax(dm2, FLT_MIN)), (-e / 2));
+lreal ratio = sqrt(mq / fmax(dm2, FLT_MIN));
+if ((e != 0)) {
+ratio = ldexp(ratio, (-e / 2));
 ratio = (((e & 1) != 0) ? (ratio * (real)0.70710678118654752) : (ratio));
+}
 return ratio * log(mq) / (real)4;
 }
 inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
@@ -253,8 +272,10 @@ omega = ((gap) ? ((lreal)1) : (omega));
 r_prev = ((gap) ? (r_prev) : (r));
 lreal next = t + step;
 lmask stall = active & (next == t);
+if ((stall)) {
 next = ((stall) ? (nextafter(t, (lreal)INFINITY)) : (next));
 *flags |= ((stall) ? ((lmask)4) : ((lmask)0));
+}
 t_prev = ((active & !gap) ? (t) : (t_prev));
 t = ((active) ? (next) : (t));
 }
