@@ -1,0 +1,124 @@
+"""This checkout against an earlier commit, side by side: each kernel's time and a render's
+CPU-seconds, as ratios.
+
+The machine is shared and its speed drifts by a third within minutes, so two runs of a
+benchmark an hour apart compare nothing.  Here the earlier commit (--rev, a git worktree made
+for the run and removed after) and the checkout render the same scene in child processes that
+alternate, --repeats pairs; each child renders once to build and warm, then --renders times,
+and reports the least time of each kernel (its OpenCL events, summed over the tiles) and the
+least CPU-seconds of a whole render (getrusage: the host's work and the kernels' threads).
+Reports the medians over the pairs and checkout / earlier; writes
+benchmarks/results/commit_ratio.md (a section per run: both commits, device, date).
+
+    python benchmarks/commit_ratio.py --rev 6bff021 [--repeats 5] [--set KEY=VALUE ...]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from run_log import append_run, git_commit, utc_now  # noqa: E402
+
+CHILD = r"""
+import collections, json, resource, sys, warnings
+warnings.simplefilter("ignore")
+from pyjulia4d import Scene, render
+import pyjulia4d.opencl.executor as ex
+renders, over = int(sys.argv[1]), sys.argv[2:]
+scene = Scene.default().with_overrides(over)
+events = []
+launch = ex.launch
+def timed(queue, kernel, n, *args, **kw):
+    e = launch(queue, kernel, n, *args, **kw)
+    events.append((kernel.function_name, e))
+    return e
+ex.launch = timed
+render(scene)
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+best, best_cpu, device = {}, float("inf"), "?"
+for _ in range(renders):
+    events.clear()
+    c0 = cpu()
+    r = render(scene)
+    best_cpu = min(best_cpu, cpu() - c0)
+    device = r.device_name
+    per = collections.Counter()
+    for name, e in events:
+        if e is not None:
+            per[name] += (e.profile.end - e.profile.start) * 1e-9
+    for name, s in per.items():
+        best[name] = min(best.get(name, float("inf")), s)
+print(json.dumps({"kernels": best, "cpu": best_cpu, "device": device}))
+"""
+
+
+def child(tree: Path, renders: int, over: list[str]) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    p = subprocess.run([sys.executable, "-c", CHILD, str(renders), *over], cwd=tree, env=env, capture_output=True,
+                       text=True, timeout=3600)
+    if p.returncode != 0:
+        raise SystemExit(f"{tree}: {(p.stderr.strip().splitlines() or ['?'])[-1]}")
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rev", required=True, help="the earlier commit")
+    ap.add_argument("--repeats", type=int, default=5, help="alternating pairs of child processes")
+    ap.add_argument("--renders", type=int, default=8, help="timed renders in each child (the least counts)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--size", default="640x480")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    a = ap.parse_args(argv)
+    w, h = a.size.split("x")
+    over = [f"image.width={w}", f"image.height={h}", *a.set]
+    rev = subprocess.run(["git", "rev-parse", "--short", a.rev], cwd=ROOT, capture_output=True, text=True,
+                         check=True).stdout.strip()
+    runs: dict[str, list[dict]] = {"earlier": [], "checkout": []}
+    with tempfile.TemporaryDirectory() as td:
+        tree = Path(td) / "earlier"
+        subprocess.run(["git", "worktree", "add", "--detach", str(tree), rev], cwd=ROOT, check=True,
+                       capture_output=True)
+        try:
+            for k in range(a.repeats):
+                order = [("earlier", tree), ("checkout", ROOT)]
+                for name, path in order if k % 2 == 0 else order[::-1]:
+                    runs[name].append(child(path, a.renders, over))
+        finally:
+            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, capture_output=True)
+    names = sorted({k for r in runs["checkout"] for k in r["kernels"]},
+                   key=lambda k: -statistics.median(r["kernels"].get(k, 0) for r in runs["checkout"]))
+
+    def med(name: str, key: str) -> float:
+        vals = [r["kernels"].get(key, 0.0) for r in runs[name]] if key != "cpu" else [r["cpu"] for r in runs[name]]
+        return statistics.median(vals)
+    rows = ["| measure | earlier s | checkout s | checkout / earlier |", "|---|---|---|---|"]
+    for key in names + ["cpu"]:
+        e, c = med("earlier", key), med("checkout", key)
+        label = f"kernel {key}" if key != "cpu" else "CPU-s of a render"
+        rows.append(f"| {label} | {e:.4f} | {c:.4f} | {c / e:.2f} |" if e > 0 else f"| {label} | - | {c:.4f} | - |")
+    table = "\n".join(rows)
+    print(table)
+    scene = f", the default scene with {', '.join(a.set)}" if a.set else ", the default scene"
+    section = (f"\n## {utc_now()}, {a.size}{scene}, {runs['checkout'][0]['device']}: commit {git_commit()} "
+               f"against {rev}, medians of {a.repeats} alternating pairs (each the least of {a.renders} renders)\n\n"
+               f"{table}\n")
+    append_run(a.out / "commit_ratio.md", "# This checkout against an earlier commit\n\nWritten by "
+               "`python benchmarks/commit_ratio.py` (its docstring says what is measured).\n", section)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
