@@ -70,7 +70,8 @@ from pyjulia4d.measure import truth
 from pyjulia4d import reference as ref  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
-from pyjulia4d.opencl.executor import STATUS_HIT, Precision, launch_normals, queue_for, render  # noqa: E402
+from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
+from pyjulia4d.opencl.runner import Precision, launch_normals, queue_for  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 
 # name -> (overrides, description).  The first nine: seed 000's figures, POV-Ray's example

@@ -10,7 +10,7 @@ import pyopencl.array as cla
 from pyjulia4d.opencl import build
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.opencl.devices import select_device
-from pyjulia4d.opencl.executor import launch, queue_for
+from pyjulia4d.opencl.runner import launch, queue_for
 
 
 def device():

@@ -7,7 +7,7 @@ from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame, march_radius
-from pyjulia4d.opencl.executor import march_items
+from pyjulia4d.opencl.runner import march_items
 from pyjulia4d.scene.model import Scene
 
 W, H = 48, 36

@@ -11,7 +11,8 @@ from harness import device
 from pyjulia4d.pipeline import workload
 from pyjulia4d.opencl.lanes import lanes_for
 from pyjulia4d.pipeline.plan import TILE, make_plan, make_tiles
-from pyjulia4d.opencl.executor import TileRunner, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.opencl.runner import TileRunner
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 

@@ -145,7 +145,7 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     from harness import device
     from pyjulia4d.opencl import build
     from pyjulia4d.pipeline import kernel_config
-    from pyjulia4d.opencl.executor import queue_for
+    from pyjulia4d.opencl.runner import queue_for
 
     monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
     ctx, _ = queue_for(device())

@@ -7,7 +7,7 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.opencl import build
-from pyjulia4d.opencl.executor import Precision, launch, queue_for
+from pyjulia4d.opencl.runner import Precision, launch, queue_for
 from pyjulia4d.pipeline.mesh_plan import MeshPlan
 
 
