@@ -204,3 +204,24 @@ def test_explore_latency_report_runs(tmp_path):
     md = out.read_text()
     assert "commit" in md and "| page open -> first picture (warm server) |" in md
     assert "previews per second while dragging" in md and "Scene size 64x48" in md
+
+
+@pytest.mark.slow   # eight runs of the whole command, each a process of its own
+def test_command_cost_report_runs(tmp_path):
+    assert load("command_cost").main(["--repeats", "1", "--no-big", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "command_cost.md").read_text()
+    assert "| start-up, 8x6 PNG |" in md and "| 640x480 PNG |" in md
+
+
+@pytest.mark.slow   # a git worktree and a child process per commit
+def test_commit_ratio_report_runs(tmp_path):
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT,
+                                                     capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout")
+    assert load("commit_ratio").main(["--rev", "HEAD", "--repeats", "1", "--renders", "1",
+                                            "--size", "64x48", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "commit_ratio.md").read_text()
+    assert "| kernel march |" in md and "| CPU-s of a render |" in md
