@@ -29,7 +29,7 @@ def test_a_spilled_image_keeps_its_values_and_leaves_no_file(tmp_path: Path) -> 
     a = store.empty((300, 200, 3), np.float32)
     b = store.empty((300, 200), np.int32)
     assert a.shape == (300, 200, 3) and b.shape == (300, 200)
-    assert a[..., 1].flags.c_contiguous          # channels in planes, as in memory
+    assert a[..., 1].flags.c_contiguous and store.mapped == 2   # channels in planes, as in memory
     rng = np.random.default_rng(1)
     want_a, want_b = rng.random(a.shape, np.float32), rng.integers(-9, 9, b.shape, np.int32)
     a[...], b[...] = want_a, want_b
@@ -127,3 +127,19 @@ def test_the_command_spills_a_large_render_to_the_same_exr(tmp_path: Path, monke
         if k.startswith("pyjulia4d.") and "second" not in k and "time" not in k:
             assert ha[k] == hb[k], k
     assert sorted(p.name for p in tmp_path.iterdir()) == ["disk.exr", "mem.exr"]
+
+
+def test_a_folder_without_room_keeps_the_image_in_memory(tmp_path: Path, monkeypatch) -> None:
+    """A full disk would make a sparse file's first unwritable page a SIGBUS: the blocks are
+    taken first, and where they cannot be the image stays in memory."""
+    import errno
+
+    def full(fd, offset, length):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    monkeypatch.setattr(os, "posix_fallocate", full)
+    store = ImageStore(tmp_path)
+    a = store.empty((64, 32, 3), np.float32)
+    a[...] = 2.0
+    store.release()
+    assert np.all(a == 2.0) and store.mapped == 0
+    assert list(tmp_path.iterdir()) == []

@@ -10,7 +10,8 @@ so it never has a name, and it is gone when the process ends however it ends), m
 shared; ``release(rows)`` tells the kernel those rows' pages are no longer needed
 (``madvise(MADV_DONTNEED)``): their contents stay in the file and come back when read, and
 the process holds the rows it is filing or writing, not the image.  ``ImageStore()`` keeps
-them in memory, and its ``release`` does nothing.
+them in memory, and its ``release`` does nothing; so does a spilling store whose folder has no
+room for an image (it is kept in memory instead).
 
 Each image's channels lie in planes ((C, H, W), seen as (H, W, C)), as in memory: the EXR
 writer takes a channel's band without a copy.
@@ -39,21 +40,35 @@ class ImageStore:
         """Whether the images live in a file (else in memory)."""
         return self.folder is not None
 
+    @property
+    def mapped(self) -> int:
+        """How many of its images live in the file."""
+        return len(self._maps)
+
     def empty(self, shape: tuple, dtype) -> np.ndarray:
         """An uninitialised image of ``shape``, (H, W) or (H, W, C), its channels in planes."""
         dtype = np.dtype(dtype)
         planes = shape[2] if len(shape) == 3 else 1
         h, w = shape[0], shape[1]
-        if self.folder is None or h * w == 0:
+        m = self._mapped(planes * h * w * dtype.itemsize) if self.folder is not None and h * w else None
+        if m is None:
             a = np.empty((planes, h, w), dtype)
         else:
-            size = planes * h * w * dtype.itemsize
-            with tempfile.TemporaryFile(dir=self.folder) as f:
-                f.truncate(size)
-                m = mmap.mmap(f.fileno(), size)   # keeps the file open while mapped
             self._maps.append((m, planes, h, w * dtype.itemsize))
             a = np.frombuffer(m, dtype, planes * h * w).reshape(planes, h, w)
         return a.transpose(1, 2, 0) if len(shape) == 3 else a[0]
+
+    def _mapped(self, size: int) -> mmap.mmap | None:
+        """``size`` bytes of an unnamed file in the folder, mapped shared; None where the file
+        cannot be made or its disk has no room (its blocks are taken now: a sparse file on a
+        full disk would kill the process with SIGBUS at the first page it could not write),
+        and the image is then kept in memory."""
+        try:
+            with tempfile.TemporaryFile(dir=self.folder) as f:
+                os.posix_fallocate(f.fileno(), 0, size)
+                return mmap.mmap(f.fileno(), size)   # keeps the file open while mapped
+        except (OSError, ValueError):
+            return None
 
     def release(self, rows: slice | None = None) -> None:
         """Let go of the pages wholly inside ``rows`` (None: all) of every image in a file."""
