@@ -34,6 +34,9 @@ each:
   estimate below one pixel's footprint, about 5e-3 at this distance and size) and a
   constant 1e-3, pyjulia4d's march.epsilon (constant_DE_threshold) - the finer one gives
   nearly pyjulia4d's silhouette;
+* ``--look default``: pyjulia4d's default look (its point light, soft shadows, ambient
+  occlusion) against POV-Ray lit by the same point light with its shadows on (hard shadow
+  rays; POV-Ray traces no occlusion); Mandelbulber2 is left out;
 * pyjulia4d: a child process renders once to build and warm up, then the scene; the CPU
   seconds of that render (user + system of the whole process, PoCL's threads included,
   getrusage) - start-up, imports and the build left out; `march.quality` presets too.
@@ -44,7 +47,7 @@ their PNGs).  POV-Ray and Mandelbulber2 are each skipped with a message where th
 installed (Mandelbulber2's OpenCL rows too where its OpenCL does not start).
 Writes benchmarks/results/peers.md (appends a section per run).
 
-    python benchmarks/peers.py [--size 640x480] [--repeats 3] [--set fractal.max_iter=20]
+    python benchmarks/peers.py [--size 640x480] [--repeats 3] [--set fractal.max_iter=20] [--look default]
 """
 from __future__ import annotations
 
@@ -72,7 +75,7 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 POV_SCENE = """#version 3.7;
 global_settings {{ assumed_gamma 1.0 }}
 camera {{ perspective location <{px}, {py}, {pz}> look_at <0, 0, 0> up y right x*{aspect} angle {hfov} }}
-light_source {{ <{px}, {py}, {pz}> color rgb 1 shadowless }}
+{light}
 julia_fractal {{
   <{c0}, {c1}, {c2}, {c3}>
   quaternion
@@ -88,12 +91,13 @@ julia_fractal {{
 # light at the eye, no shadows and no ambient occlusion (matched lighting).
 MATCHED = ["shading.light=eye", "shading.shadow=none", "shading.ao=0"]
 SCENE_SET: list[str] = []   # --set: more overrides, for all three renderers (e.g. fractal.max_iter=20)
+LOOK = list(MATCHED)        # --look default: [] (pyjulia4d's soft shadows and occlusion, POV-Ray's shadows)
 
 CHILD = r"""
 import json, resource, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
-over = %r + sys.argv[1:]
+over = sys.argv[1:]
 s = Scene.default().with_overrides(over)
 render(s)
 def cpu():
@@ -103,7 +107,7 @@ c0, t0 = cpu(), time.perf_counter()
 r = render(s)
 print(json.dumps({"cpu": cpu() - c0, "wall": time.perf_counter() - t0, "hit": r.hit_fraction,
                   "device": r.device_name}))
-""" % (MATCHED,)
+"""
 
 # Mandelbulber2 2.20 settings ("only modified parameters"; the rest keep their defaults)
 MB_SETTINGS = """# Mandelbulber settings file
@@ -168,11 +172,16 @@ VARIANTS = {"pyjulia4d default": [], "pyjulia4d march.quality=draft": ["march.qu
 def pov_scene(w: int, h: int) -> str:
     from pyjulia4d.scene.model import Scene
 
-    s = Scene.default().with_overrides(MATCHED + SCENE_SET)
+    s = Scene.default().with_overrides(LOOK + SCENE_SET)
     px, py, pz = s.camera.position[:3]
+    if s.shading.light == "eye":   # the matched look: pyjulia4d's light at the eye casts no shadow
+        light = f"light_source {{ <{px}, {py}, {pz}> color rgb 1 shadowless }}"
+    else:                          # the default look: its positioned light, POV-Ray's shadows on
+        lx, ly, lz = s.shading.light[:3]
+        light = f"light_source {{ <{lx}, {ly}, {lz}> color rgb 1 }}"
     hfov = math.degrees(2 * math.atan(math.tan(math.radians(s.camera.fov) / 2) * w / h))
     c = s.fractal.c
-    return POV_SCENE.format(px=px, py=py, pz=pz, aspect=f"{w}/{h}", hfov=f"{hfov:.4f}", c0=c[0], c1=c[1],
+    return POV_SCENE.format(light=light, px=px, py=py, pz=pz, aspect=f"{w}/{h}", hfov=f"{hfov:.4f}", c0=c[0], c1=c[1],
                             c2=c[2], c3=c[3], max_iter=s.fractal.max_iter)
 
 
@@ -271,7 +280,7 @@ def run_mandelbulber(w: int, h: int, tmp: Path, over: str) -> dict:
 
 
 def run_pyjulia4d(over: list[str]) -> dict:
-    p = subprocess.run([sys.executable, "-c", CHILD, *over], capture_output=True, text=True, cwd=ROOT,
+    p = subprocess.run([sys.executable, "-c", CHILD, *LOOK, *over], capture_output=True, text=True, cwd=ROOT,
                        timeout=3600)
     if p.returncode != 0:
         raise RuntimeError((p.stderr.strip().splitlines() or ["?"])[-1])
@@ -285,16 +294,24 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="change the scene for all three renderers (fractal.max_iter=20; keys POV-Ray's "
                          "and Mandelbulber2's translations take: fractal.c, fractal.max_iter, camera.*)")
+    ap.add_argument("--look", choices=("matched", "default"), default="matched",
+                    help="matched: a light at the eye, no shadows or occlusion (all three renderers); default: "
+                         "pyjulia4d's own look (soft shadows, occlusion) against POV-Ray with its shadows on, "
+                         "Mandelbulber2 left out")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     SCENE_SET[:] = a.set
+    LOOK[:] = MATCHED if a.look == "matched" else []
     w, h = (int(x) for x in a.size.split("x"))
     size = [f"image.width={w}", f"image.height={h}"] + a.set
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
-    have_mb = shutil.which("mandelbulber2") is not None
-    if not have_mb:
+    have_mb = shutil.which("mandelbulber2") is not None and a.look == "matched"
+    if a.look != "matched":
+        print("--look default: Mandelbulber2 left out (its settings file is written for the matched look)",
+              file=sys.stderr)
+    elif not have_mb:
         print("mandelbulber2 not installed (Debian: apt-get install mandelbulber2): Mandelbulber2 skipped",
               file=sys.stderr)
     runs: dict[str, list[dict]] = {}
@@ -327,6 +344,9 @@ def main(argv=None) -> int:
     pov_rate = rate_of(pov) if pov else None
     pj_rate = rate_of(runs["pyjulia4d default"])
     scene = f", the scene with {', '.join(a.set)}" if a.set else ""
+    if a.look == "default":
+        scene += (", pyjulia4d's default look (soft shadows, ambient occlusion 0.6) against POV-Ray's "
+                  "shadows from the same point light")
     lines = [f"\n## {utc_now()}, {w}x{h}{scene}, pyjulia4d on {device}, "
              f"commit {git_commit()}, median of {a.repeats} alternating runs\n",
              "| renderer | CPU s (median) | pixels per CPU-second | / POV-Ray | pyjulia4d default / this "
