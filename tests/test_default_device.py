@@ -30,6 +30,17 @@ needs_opencl = pytest.mark.skipif(not _platforms(), reason="no OpenCL platform")
 
 
 def _env(cache: Path, **extra: str) -> dict[str, str]:
+    """The environment of a child with its own cache folder, seeded with this process's
+    answers about the devices (packet widths, compilers: each found by a child of its own,
+    seconds from cold) so that only the remembered default device starts afresh."""
+    import shutil
+
+    from pyjulia4d.resources import cache_dir
+
+    cache.mkdir(parents=True, exist_ok=True)
+    for name in ("lanes.json", "lanes_double.json", "compiles.json"):
+        if (cache_dir() / name).is_file() and not (cache / name).exists():
+            shutil.copy(cache_dir() / name, cache / name)
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [PKG_ROOT, env.get("PYTHONPATH")]))
     env.pop("OCL_ICD_VENDORS", None)   # set by this process's own registration
