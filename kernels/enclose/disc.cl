@@ -28,7 +28,7 @@
 typedef struct { cplx m; lreal r; } cdisc;
 
 inline cdisc D(cplx m, lreal r) { cdisc z = {m, r}; return z; }
-inline lreal c_abs(cplx z) { return hypot(z.re, z.im); }
+inline lreal c_abs(cplx z) { return lane_hypot(z.re, z.im); }
 
 /* a radius raised for its own rounding and for the rounding of a centre of size ``size`` */
 inline lreal enc_radius(lreal r, lreal size, real rel)
@@ -135,7 +135,7 @@ inline cdisc d_log(cdisc z)
     cdisc smooth = d_mean_value_sized(lm, z.r, (lreal)1 / gap, c_abs(lm) + (real)1);
     lreal lo = log(gap) - ENC_ROUND_FN * fabs(log(gap)), hi = log(s + z.r * ENC_UP) + ENC_ROUND_FN * fabs(log(s + z.r));
     lreal mid = (real)0.5 * (lo + hi), hw = (real)0.5 * (hi - lo);
-    cdisc cut = D(C(mid, (lreal)0), enc_radius(hypot(hw, (lreal)ENC_PI), fabs(mid), ENC_ROUND_FN));
+    cdisc cut = D(C(mid, (lreal)0), enc_radius(lane_hypot(hw, (lreal)ENC_PI), fabs(mid), ENC_ROUND_FN));
     lmask meets = d_meets_cut(z);
     lreal r = L_SEL(smooth.r, cut.r, meets);
     r = L_SEL(r, (lreal)INFINITY, gap <= (real)0);

@@ -83,7 +83,7 @@ inline enclosure enc_shift(enclosure e, real4 k)
 inline lmask enc_outside(enclosure e, real bailout2)
 {
     quat m = QUAT(e.a.m.re, e.a.m.im, e.b.m.re, e.b.m.im), v = QUAT(e.a.v.re, e.a.v.im, e.b.v.re, e.b.v.im);
-    lreal l = enc_least_norm(m, v) * ((real)1 - ENC_ROUND) - hypot(e.a.r, e.b.r);   /* enclose/disc.cl */
+    lreal l = enc_least_norm(m, v) * ((real)1 - ENC_ROUND) - lane_hypot(e.a.r, e.b.r);   /* enclose/disc.cl */
     return (l > (real)0) & ((real)0.5 * l * l > bailout2);
 }
 
@@ -95,7 +95,7 @@ inline lreal enc_centre_norm(enclosure e)
 
 inline lreal enc_extent(enclosure e)
 {
-    return hypot(c_abs(e.a.v) + e.a.r, c_abs(e.b.v) + e.b.r) * (real)0.70710678118654752;
+    return lane_hypot(c_abs(e.a.v) + e.a.r, c_abs(e.b.v) + e.b.r) * (real)0.70710678118654752;
 }
 
 inline lreal enc_margin(enclosure e, real bailout) { return (enc_centre_norm(e) - bailout) / enc_extent(e); }

@@ -37,10 +37,26 @@ inline cplx c_exp(cplx z)
 lreal r = exp(z.re);
 return C(r * cos(z.im), ((z.im == (real)0) ? (z.im) : (r * sin(z.im))));
 }
-inline cplx c_log(cplx z) { return C(log(hypot(z.re, z.im)), atan2(z.im, z.re)); }
+__attribute__((noinline)) lreal lane_hypot(lreal x, lreal y)
+{
+lreal s = fma(x, x, y * y);
+lmask plain = ((s >= (real)1e-30) & (s < (real)1e38)) | ((x == (real)0) & (y == (real)0));
+lreal r = sqrt(s);
+if ((!plain)) {
+lreal ax = fabs(x), ay = fabs(y);
+lreal m = fmax(ax, ay), n = fmin(ax, ay);
+lreal q = n / m;
+lreal scaled = m * sqrt(fma(q, q, (real)1));
+scaled = (((m == (real)0) | (m == (real)INFINITY)) ? (m) : (scaled));
+scaled = ((isnan(x) | isnan(y)) ? (x + y) : (scaled));
+r = ((plain) ? (r) : (scaled));
+}
+return r;
+}
+inline cplx c_log(cplx z) { return C(log(lane_hypot(z.re, z.im)), atan2(z.im, z.re)); }
 inline cplx c_sqrt(cplx z)
 {
-lreal t = sqrt((hypot(z.re, z.im) + fabs(z.re)) * (real)0.5);
+lreal t = sqrt((lane_hypot(z.re, z.im) + fabs(z.re)) * (real)0.5);
 lreal u = ((z.re >= (real)0) ? (t) : (fabs(z.im) / ((real)2 * t)));
 lreal v = ((z.re >= (real)0) ? (z.im / ((real)2 * t)) : (copysign(t, z.im)));
 lmask zero = t == (real)0;
