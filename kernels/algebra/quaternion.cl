@@ -79,4 +79,5 @@ inline quat julia_f_jvp(quat q, quat h) { return alg_cube_jvp(q, h); }
 /* enclose/ball.cl: |a b| = |a| |b| */
 #define ALG_ENCLOSE_K 1
 #define ALG_LBOUND(m) QLEN(m)
+#define ALG_LBOUND_IS_LEN     /* enclose/ball.cl: the bound is |m| itself */
 #define ALG_LBOUND_SQR(m) QNORM2(m)

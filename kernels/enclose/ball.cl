@@ -23,7 +23,15 @@
  * associativity).  Every radius is raised for the rounding of the centre and tangent
  * (enclose/disc.cl enc_radius). */
 
-typedef struct { quat m, v; lreal r; } enclosure;
+/* ml = |m| and vl = |v| are carried with the form: the proof's test, margin and hope and the
+ * next step each took them, a square root each, on the march's critical path */
+typedef struct { quat m, v; lreal r, ml, vl; } enclosure;
+
+inline enclosure enc_form(quat m, quat v, lreal r)
+{
+    enclosure e = {m, v, r, QLEN(m), QLEN(v)};
+    return e;
+}
 
 /* the rounding allowance of a step, in the terms' sizes: 4 (enclose/disc.cl's ENC_ROUND
  * times twice their sum); the rotated map (kind/rotate.cl, fractal.theta) turns the centre and
@@ -39,13 +47,16 @@ typedef struct { quat m, v; lreal r; } enclosure;
 inline enclosure enc_segment(quat o, quat d, lreal t0, lreal t1)
 {
     lreal tm = (real)0.5 * (t0 + t1), hw = (real)0.5 * (t1 - t0);
-    enclosure e = {QRAY(o, d, tm), QSCALE(hw, d), enc_radius((lreal)0, QLEN(o) + fabs(tm) * QLEN(d), ENC_ROUND)};
-    return e;
+    return enc_form(QRAY(o, d, tm), QSCALE(hw, d), enc_radius((lreal)0, QLEN(o) + fabs(tm) * QLEN(d), ENC_ROUND));
 }
 
 inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unused here */
 {
-    lreal s = QLEN(e.m), lm = ALG_LBOUND(e.m), sv = QLEN(e.v);
+#ifdef ALG_LBOUND_IS_LEN
+    lreal s = e.ml, lm = e.ml, sv = e.vl;
+#else
+    lreal s = e.ml, lm = ALG_LBOUND(e.m), sv = e.vl;
+#endif
     lreal rho = sv + e.r;
     real K = (real)ALG_ENCLOSE_K;
     /* the terms' sizes: of the centre's products and of the tangent's (J's bound times |v|:
@@ -59,24 +70,20 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     lreal size = K * K * s * s * s + jn * sv;
 #endif
     quat v = julia_f_jvp(e.m, e.v);
-    enclosure out = {julia_f(e.m, c), v, enc_radius(r, ENC_STEP_GAIN * size + (real)2 * length(c), ENC_ROUND)};
-    return out;
+    return enc_form(julia_f(e.m, c), v, enc_radius(r, ENC_STEP_GAIN * size + (real)2 * length(c), ENC_ROUND));
 }
 
 /* the sum of two forms in the same s: the Mandelbrot kind adds the segment's own points
  * (enclose/mandelbrot.cl) */
 inline enclosure enc_add(enclosure a, enclosure b)
 {
-    enclosure out = {QADD(a.m, b.m), QADD(a.v, b.v),
-                     enc_radius(a.r + b.r, QLEN(a.m) + QLEN(b.m) + QLEN(a.v) + QLEN(b.v), ENC_ROUND)};
-    return out;
+    return enc_form(QADD(a.m, b.m), QADD(a.v, b.v), enc_radius(a.r + b.r, a.ml + b.ml + a.vl + b.vl, ENC_ROUND));
 }
 
 /* the form plus a constant k in the algebra's coordinates */
 inline enclosure enc_shift(enclosure e, real4 k)
 {
-    enclosure out = {QADD_UNIFORM(e.m, k), e.v, enc_radius(e.r, QLEN(e.m) + length(k), ENC_ROUND)};
-    return out;
+    return enc_form(QADD_UNIFORM(e.m, k), e.v, enc_radius(e.r, e.ml + length(k), ENC_ROUND));
 }
 
 inline lmask enc_outside(enclosure e, real bailout2)
@@ -87,12 +94,12 @@ inline lmask enc_outside(enclosure e, real bailout2)
 
 /* how many times its extent the centre lies beyond the bailout (<= 0: inside): the march
  * sizes its next segment by it */
-inline lreal enc_margin(enclosure e, real bailout) { return (QLEN(e.m) - bailout) / (QLEN(e.v) + e.r); }
+inline lreal enc_margin(enclosure e, real bailout) { return (e.ml - bailout) / (e.vl + e.r); }
 
 /* whether the form may still prove the segment: an extent past twice the centre's distance
  * plus the bailout grows faster than the centre from here on (the proof only gives up) */
 inline lmask enc_hopeful(enclosure e, real bailout)
 {
-    return QLEN(e.v) + e.r < (real)2 * (QLEN(e.m) + bailout);
+    return e.vl + e.r < (real)2 * (e.ml + bailout);
 }
 
