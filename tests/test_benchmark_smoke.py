@@ -205,6 +205,7 @@ def test_pair_error_vs_time_benchmark_runs(tmp_path, capsys):
     assert len((tmp_path / "pair_error_vs_time.csv").read_text().splitlines()) == 4
 
 
+@pytest.mark.slow   # a server, a headless browser and renders: the explorer's own tests cover the page
 def test_explore_latency_report_runs(tmp_path):
     """benchmarks/explore_latency.py, tiny, with the caches as they are: the table with every
     measure of a start, and the results file with its commit (skipped where no browser is)."""

@@ -596,7 +596,9 @@ def _slow_render_args() -> list[str]:
             "--set", "march.z_resolution=50000"]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+# SIGHUP runs the same handler as SIGTERM (app/cli.py): its real render is in the slow run
+@pytest.mark.parametrize("sig", [signal.SIGTERM, pytest.param(signal.SIGHUP, marks=pytest.mark.slow)],
+                         ids=["SIGTERM", "SIGHUP"])
 def test_signal_during_a_real_render(sig: int, tmp_path) -> None:
     """python -m pyjulia4d, a slow render under way (its progress bar showing): the signal
     ends it with 128 + the signal number and nothing in the output directory."""
