@@ -260,9 +260,9 @@ def store_for(scene: Scene, outputs, out: Path) -> Any:
     output, its rows let go as they are filed and written (pipeline/store.py), so that the
     peak stays a band and the process rather than the image."""
     from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore, spill_folder
-    from pyjulia4d.pipeline.workload import OUTPUT_BYTES, resolve_outputs
+    from pyjulia4d.pipeline.workload import output_bytes_per_pixel
 
-    size = float(scene.image.width) * scene.image.height * sum(OUTPUT_BYTES[k] for k in resolve_outputs(outputs))
+    size = float(scene.image.width) * scene.image.height * output_bytes_per_pixel(outputs)
     return ImageStore(spill_folder(out)) if size > SPILL_BYTES else IN_MEMORY
 
 

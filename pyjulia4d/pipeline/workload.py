@@ -183,10 +183,15 @@ def resolve_outputs(outputs) -> frozenset[str]:
     return frozenset(names | {"bracket", "unresolved"})
 
 
+def output_bytes_per_pixel(outputs=None) -> int:
+    """Bytes a pixel of the host images a render keeping ``outputs`` holds."""
+    return sum(OUTPUT_BYTES[k] for k in resolve_outputs(outputs))
+
+
 def host_bytes_per_pixel(outputs=None) -> int:
     """Host memory per pixel of a render keeping ``outputs``: the arrays themselves, and as
     much again for the copies the PNG/EXR writers make (contiguous channels, 8-bit RGBA)."""
-    return 2 * sum(OUTPUT_BYTES[k] for k in resolve_outputs(outputs))
+    return 2 * output_bytes_per_pixel(outputs)
 
 
 def physical_memory() -> int:
