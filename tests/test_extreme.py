@@ -204,7 +204,7 @@ def test_derivative_beyond_range_is_rescaled(fl):
     assert np.mean(inside.get()) > 0.4
     d64, esc = ref.julia_distance_formula(p, s.fractal.c, 10000, 4.0)
     assert np.all(np.isfinite(d64))
-    R = Runner(kernel_config.scene_config(s.with_overrides(["normals.method=jacobian"])))
+    R = Runner(kernel_config.march_config(s.with_overrides(["normals.method=jacobian"]), 1))
     fr = camera_frame(s)
     out = R.out4(n)
     R("normals_jacobian", (n,), R.buf4(p), R.buf(np.ones(n), np.int32), R.vec(s.fractal.c),

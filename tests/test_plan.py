@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from harness import device
-from pyjulia4d.pipeline import workload
+from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.opencl.lanes import lanes_for
 from pyjulia4d.pipeline.plan import TILE, make_plan, make_tiles
 from pyjulia4d.opencl.executor import render
@@ -169,3 +169,18 @@ def test_one_plan_two_executors(keys):
     tol = k.bracket[hit] + r.bracket[hit] + 1e-5 * (1 + np.abs(r.depth[hit]))
     assert np.mean(np.abs(k.depth[hit] - r.depth[hit]) <= tol) > 0.98
     assert np.median(np.abs(k.color[hit] - r.color[hit])) < 5e-3
+
+
+def test_the_march_is_compiled_once_at_its_width():
+    """kernel_config.shade_config: the scene's program holds no march, no Jacobian normals and no
+    light terms (the march's program has them, at its width), and reads no march switch, so
+    scenes that differ in the march alone share it."""
+    s = Scene.default()
+    for lanes in (1, 4):
+        p = make_plan(s, "CPU", lanes)
+        assert p.config == kernel_config.shade_config(s) and p.march_config == kernel_config.march_config(s, lanes)
+        assert not {"march/march", "march/cone", "normals/jacobian", "shade/light"} & set(p.config.pieces)
+        assert {"march/march", "march/cone", "normals/jacobian", "shade/light"} <= set(p.march_config.pieces)
+    assert "CONE_START" not in p.config.defines and "SPECULAR" not in p.march_config.defines
+    assert kernel_config.shade_config(s.with_overrides(["march.quality=final"])) == p.config
+    assert "normals/gradient" in kernel_config.shade_config(s.with_overrides(["normals.method=gradient"])).pieces

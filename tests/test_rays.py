@@ -17,7 +17,7 @@ from pyjulia4d.scene.checks import SceneError
 @pytest.mark.parametrize("fl,tol", [("single", 2e-6), ("double", 1e-14)])
 def test_generate_rays_matches_reference(over, fl, tol):
     s = Scene.default().with_overrides(over + ["image.width=37", "image.height=23", f"render.float={fl}"])
-    R = Runner(kernel_config.scene_config(s))
+    R = Runner(kernel_config.shade_config(s))
     f = camera_frame(s)
     w, h = 37, 23
     o, d = R.out4(w * h), R.out4(w * h)
@@ -74,7 +74,7 @@ def test_degenerate_camera_names_the_key(over, key):
 def test_tile_of_rays_matches_the_whole_image():
     # render.py renders in tiles: the tile at (x0, y0) is the same rays as that part of the image
     s = Scene.default().with_overrides(["image.width=37", "image.height=23"])
-    R = Runner(kernel_config.scene_config(s))
+    R = Runner(kernel_config.shade_config(s))
     f = camera_frame(s)
     w, h, x0, y0, tw, th = 37, 23, 11, 5, 9, 7
     o, d = R.out4(tw * th), R.out4(tw * th)
@@ -91,7 +91,7 @@ def test_padded_launch_leaves_items_past_n_alone():
     # render.launch pads every launch to whole work-groups of one fixed size (so PoCL builds
     # one work-group function whatever the image size); the kernels must stop at n_items
     s = Scene.default()
-    R = Runner(kernel_config.scene_config(s))
+    R = Runner(kernel_config.shade_config(s))
     f = camera_frame(s)
     w, h = 7, 5                                     # 35 items: not a multiple of the local size
     o = R.buf4(np.full((64 * 2, 4), 123.0))

@@ -25,7 +25,7 @@ from pyjulia4d.scene.model import Scene
 def test_shade_matches_reference(over, fl):
     # shade.cl alone: no light terms (those are test_light_terms_in_render_match_reference's)
     s = Scene.default().with_overrides(["shading.shadow=none", "shading.ao=0"] + over + [f"render.float={fl}"])
-    R = Runner(kernel_config.scene_config(s))
+    R = Runner(kernel_config.shade_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(5)
     n = 4000
@@ -198,7 +198,7 @@ def test_reflect_kernels_match_reference(light, fl):
     reflected rays to float rounding of their precision, the bounce's colour to float32."""
     s = Scene.default().with_overrides([f"shading.light={light}", "shading.reflection=0.5",
                                         "shading.sky=0.3,0.5,0.9", f"render.float={fl}"])
-    R = Runner(kernel_config.scene_config(s))
+    R = Runner(kernel_config.shade_config(s))
     fr = camera_frame(s)
     rng = np.random.default_rng(7)
     n = 3000

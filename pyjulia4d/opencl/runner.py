@@ -135,8 +135,7 @@ class TileRunner:
         self.plan = plan
         self.ctx, self.queue = queue_for(dev)
         self.prg = build.program(self.ctx, plan.config)
-        self.march_prg = (self.prg if plan.march_config == plan.config
-                          else build.program(self.ctx, plan.march_config))
+        self.march_prg = build.program(self.ctx, plan.march_config)
         self.pr = pr = Precision(plan.double)
         nmax = max(t.n for t in plan.tiles)
         read = {"status", "flags", "depth", "bracket", "unresolved"} | {b for k in plan.outputs for b in _READ[k]}
@@ -173,9 +172,8 @@ class TileRunner:
                           if planes else ())
         self.clip_k = cl.Kernel(self.prg, "clip_normals") if planes and plan.normals else None
         self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
-        # shade/light.cl: in the march's packets where the march has them (kernel_config.march_config)
-        self.light_k = (cl.Kernel(self.march_prg if plan.lanes > 1 else self.prg, "light_terms")
-                        if plan.light_terms else None)
+        # shade/light.cl: in the march's program, in its packets (kernel_config.march_config)
+        self.light_k = cl.Kernel(self.march_prg, "light_terms") if plan.light_terms else None
         self.light_const = ((pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
                              self.right, self.up, self.fwd, pr.v4(sa.light), pr.scalar(ma.radius),
                              pr.scalar(la.step), pr.scalar(la.bias), pr.scalar(la.softness), np.int32(la.max_steps),

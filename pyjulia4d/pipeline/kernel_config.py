@@ -80,7 +80,8 @@ def cone_start(scene: Scene) -> bool:
 
 
 def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
-    """The pieces and switches of one scene's render program.  The march makes its rays
+    """Every piece and switch a scene uses, which march_config and shade_config divide between
+    a render's two programs (the tests build it whole to reach any kernel).  The march makes its rays
     from the camera; ``ray_buffers`` (-D RAYS_FROM_BUFFERS) builds it to read given rays
     instead (the tests' and benchmarks' arbitrary rays)."""
     m = scene.march
@@ -129,6 +130,21 @@ def scene_config(scene: Scene, ray_buffers: bool = False) -> KernelConfig:
     return KernelConfig(tuple(pieces), tuple(defines))
 
 
+def shade_config(scene: Scene) -> KernelConfig:
+    """The scene's program beside its march's (march_config): the iteration (for the gradient
+    normal), rays.cl, the normals but the Jacobian, the cut faces' normals, shading and the
+    mirror bounce, with the switches those read.  The march, the Jacobian normals and the
+    light terms are the march's program's alone: compiled once, at its width (the one-ray
+    march in this program too had taken three quarters of its build)."""
+    cfg = scene_config(scene)
+    keep = {"march/clip", "rays", "shade/reflect", "shade/shade"} | {f"normals/{m}" for m in ("gradient", "zbuffer")}
+    pieces = iteration_pieces(scene) + tuple(p for p in cfg.pieces if p in keep)
+    switches = SHADE_SWITCHES | {"LIGHT_POINT", "EXTRA_LIGHTS", "EXTRA_SHADOWS", "CLIP"}
+    defines = precision_defines(scene) + fractal_defines(scene) + tuple(
+        d for d in cfg.defines if d.split("=")[0] in switches)
+    return KernelConfig(pieces, defines)
+
+
 def light_defines(scene: Scene) -> tuple[str, ...]:
     """The switches of shade/light.cl a scene uses (none: the piece is not compiled)."""
     sh = scene.shading
@@ -158,20 +174,32 @@ def packet_block(lanes: int) -> tuple[int, int]:
 
 
 def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
-    """The march - and the Jacobian normals, when the scene uses them - with ``lanes`` rays
-    per work-item (-D LANES, kernels/common/lanes.cl): the same pieces as scene_config up to
-    march/march.cl; rays, shading and the other normals stay one per work-item in the scene's
-    program."""
+    """The march's program: the march, its cone, the Jacobian normals when the scene uses them and
+    the light terms, with ``lanes`` rays per work-item (-D LANES, kernels/common/lanes.cl; 1:
+    one ray); the same pieces as scene_config up to march/march.cl.  The other normals and
+    shading are shade_config's, one pixel per work-item."""
     cfg = scene_config(scene, ray_buffers)
     pieces = cfg.pieces[: cfg.pieces.index("march/march") + 1]
     if scene.normals.method == "jacobian":
         pieces += ("normals/jacobian",)
-    if "shade/light" in cfg.pieces:
+    light = "shade/light" in cfg.pieces
+    if light:
         pieces += ("shade/light",)
+    # only the switches its pieces read: scenes that differ in shade.cl's alone share the
+    # march's program (the costliest build: the iteration inlined at every call, in packets)
+    defines = tuple(d for d in cfg.defines if d not in SHADE_SWITCHES
+                    and (light or d.split("=")[0] not in LIGHT_SWITCHES and not d.startswith("SHADOW_")
+                         and not d.startswith("COLOR_")))
     if lanes == 1:
-        return KernelConfig(pieces, cfg.defines)
+        return KernelConfig(pieces, defines)
     bw, bh = packet_block(lanes)
-    return KernelConfig(pieces, cfg.defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
+    return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
+
+
+# the switches read by shade/shade.cl and shade/reflect.cl alone, and those shade/light.cl reads
+# besides (with SHADOW_* and COLOR_*): left out of programs without those pieces
+SHADE_SWITCHES = frozenset({"SPECULAR", "FOG", "REFLECTION", "LIGHT_TERMS", "COLORMAP"})
+LIGHT_SWITCHES = frozenset({"LIGHT_POINT", "EXTRA_LIGHTS", "EXTRA_SHADOWS", "AO"})
 
 
 def mesh_config(scene: Scene) -> KernelConfig:

@@ -193,8 +193,8 @@ class Plan:
     double: bool
     lanes: int                    # rays per work-item of the march (lanes.lanes_for)
     outputs: frozenset[str]
-    config: kernel_config.KernelConfig         # the scene's kernels: rays, normals (but the packet Jacobian), shading
-    march_config: kernel_config.KernelConfig
+    config: kernel_config.KernelConfig         # normals but the Jacobian, shading (kernel_config.shade_config)
+    march_config: kernel_config.KernelConfig   # the march, the Jacobian normals, the light terms
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
@@ -226,7 +226,7 @@ class Plan:
     @property
     def light_terms(self) -> bool:
         """Whether shade/light.cl runs (shadows, ambient occlusion, a colour map): only for shading."""
-        return self.shades and "shade/light" in self.config.pieces
+        return self.shades and "shade/light" in self.march_config.pieces
 
     @property
     def reflects(self) -> bool:
@@ -236,9 +236,7 @@ class Plan:
     @property
     def reflect_config(self) -> kernel_config.KernelConfig:
         """The march of the reflected rays: this plan's march reading given rays."""
-        if self.lanes > 1:
-            return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
-        return kernel_config.scene_config(self.scene, ray_buffers=True)
+        return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
 
     @property
     def normals_in_march_config(self) -> bool:
@@ -311,8 +309,8 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
         scene=scene, frame=frame, march=args["march"], clip=args["clip"],
         normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
-        config=kernel_config.scene_config(scene),
-        march_config=kernel_config.march_config(scene, lanes) if lanes > 1 else kernel_config.scene_config(scene),
+        config=kernel_config.shade_config(scene),
+        march_config=kernel_config.march_config(scene, lanes),
         tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height),
         estimate=est)
