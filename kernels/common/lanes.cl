@@ -129,3 +129,24 @@ inline quat QSEL(quat a, quat b, lmask m)
     return QUAT(select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m), select(a.w, b.w, m));
 }
 #endif
+
+#if LANES > 1
+/* The pixels of work-item g's packet, the g-th BLOCK_W x BLOCK_H block of a tile tile_w wide
+ * and n_items / tile_w high, in rows of blocks: lane_index[k] is lane k's pixel, n_items for
+ * a lane past the tile's edge; 0 where the block lies below the tile (a padded launch).  Lane
+ * 0's pixel is always in the tile. */
+inline int block_lanes(size_t g, int n_items, int tile_w, size_t *lane_index)
+{
+    int tile_h = n_items / tile_w;
+    int blocks_x = (tile_w + BLOCK_W - 1) / BLOCK_W;
+    int bx = (int)(g % (size_t)blocks_x) * BLOCK_W;
+    int by = (int)(g / (size_t)blocks_x) * BLOCK_H;
+    if (by >= tile_h)
+        return 0;
+    for (int k = 0; k < LANES; ++k) {
+        int x = bx + k % BLOCK_W, y = by + k / BLOCK_W;
+        lane_index[k] = x < tile_w && y < tile_h ? (size_t)y * tile_w + x : (size_t)n_items;
+    }
+    return 1;
+}
+#endif

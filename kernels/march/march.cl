@@ -65,19 +65,11 @@ __kernel void march(const int n_items, const int tile_w, RAY_ARGS,
     if (i0 >= (size_t)n_items)
         return;
 #else
-    int tile_h = n_items / tile_w;
-    int blocks_x = (tile_w + BLOCK_W - 1) / BLOCK_W;
-    int bx = (int)(get_global_id(0) % (size_t)blocks_x) * BLOCK_W;
-    int by = (int)(get_global_id(0) / (size_t)blocks_x) * BLOCK_H;
-    if (by >= tile_h)
-        return;
-    size_t i0 = (size_t)by * tile_w + bx;
     size_t lane_index[LANES];
-    for (int k = 0; k < LANES; ++k) {
-        int x = bx + k % BLOCK_W, y = by + k / BLOCK_W;
-        /* a lane past the tile's edge repeats the block's first pixel and is not written */
-        lane_index[k] = x < tile_w && y < tile_h ? (size_t)y * tile_w + x : (size_t)n_items;
-    }
+    if (!block_lanes(get_global_id(0), n_items, tile_w, lane_index))
+        return;
+    /* a lane past the tile's edge repeats the block's first pixel and is not written */
+    size_t i0 = lane_index[0];
 #endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i0) };
     quat o, d;

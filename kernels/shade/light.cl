@@ -128,7 +128,7 @@ inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 /* terms[i] = (visibility, ambient factor, colour value, 0) of hit i (normal in camera
  * coordinates: right, up, towards the eye; turned back into 4D with the camera frame;
  * the inside end of the bracket is point + bracket along the ray from the eye). */
-__kernel void light_terms(const int n_items, __global const real4 *point, __global const real4 *normal,
+__kernel void light_terms(const int n_items, const int tile_w, __global const real4 *point, __global const real4 *normal,
                           __global const int *status, __global const real *bracket, const real4 eye, const real4 c, const int max_iter, const real bailout,
                           const real epsilon, const real4 right, const real4 up, const real4 forward,
                           const real4 light_pos, const real radius, const real step, const real bias,
@@ -137,9 +137,15 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
                           __global const float4 *lights_rgb, __global float4 *terms,
                           __global float4 *vis_extra)
 {
-    size_t i0 = get_global_id(0) * LANES;
+#if LANES == 1
+    size_t i0 = get_global_id(0);
     if (i0 >= (size_t)n_items)
         return;
+#else
+    size_t lane_index[LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
+    if (!block_lanes(get_global_id(0), n_items, tile_w, lane_index))
+        return;
+#endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
     quat p, nw, pin;
     lmask hit;
@@ -154,9 +160,9 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
     nw = nc.x * right + nc.y * up - nc.z * forward;
     pin = p + bracket[i0] * normalize(p - eye);
 #else
-    for (int k = 0; k < LANES; ++k) {   /* gather; a miss or a lane past the end takes item 0's point */
-        size_t i = min(i0 + k, (size_t)n_items - 1);
-        int h = status[i] == STATUS_HIT;
+    for (int k = 0; k < LANES; ++k) {   /* gather; a miss or a lane past the edge takes the origin */
+        size_t i = lane_index[k] < (size_t)n_items ? lane_index[k] : lane_index[0];
+        int h = lane_index[k] < (size_t)n_items && status[i] == STATUS_HIT;
         real4 pk = h ? point[i] : (real4)(0);
         real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
         real4 nk = nc.x * right + nc.y * up - nc.z * forward;
@@ -164,7 +170,7 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
         ((real *)&pin.x)[k] = ik.x; ((real *)&pin.y)[k] = ik.y; ((real *)&pin.z)[k] = ik.z; ((real *)&pin.w)[k] = ik.w;
         ((real *)&p.x)[k] = pk.x; ((real *)&p.y)[k] = pk.y; ((real *)&p.z)[k] = pk.z; ((real *)&p.w)[k] = pk.w;
         ((real *)&nw.x)[k] = nk.x; ((real *)&nw.y)[k] = nk.y; ((real *)&nw.z)[k] = nk.z; ((real *)&nw.w)[k] = nk.w;
-        ((mask_t *)&hit)[k] = h && i0 + k < (size_t)n_items ? -1 : 0;
+        ((mask_t *)&hit)[k] = h ? -1 : 0;
     }
 #endif
     lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;
@@ -216,8 +222,10 @@ __kernel void light_terms(const int n_items, __global const real4 *point, __glob
     vis_extra[i0] = (float4)((float)ve[0], (float)ve[1], (float)ve[2], 0.0f);
 #endif
 #else
-    for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
-        size_t i = i0 + k;
+    for (int k = 0; k < LANES; ++k) {   /* scatter */
+        size_t i = lane_index[k];
+        if (i >= (size_t)n_items)
+            continue;
         terms[i] = status[i] == STATUS_HIT
                        ? (float4)((float)((real *)&vis)[k], (float)((real *)&amb)[k], (float)((real *)&val)[k], 0.0f)
                        : (float4)(1, 1, 0, 0);

@@ -261,10 +261,10 @@ class TileRunner:
         if plan.reflects:
             kernels += self.enqueue_reflection(tile, bufs)
         if plan.light_terms:
-            kernels.append(launch(q, self.light_k, n, bufs["point"].data, bufs["normal"].data,
+            kernels.append(launch(q, self.light_k, n, np.int32(tile.aw), bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
                                   self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
-                                  bufs["vis_extra"].data, lanes=plan.lanes))
+                                  bufs["vis_extra"].data, items=march_items(n, tile.aw, plan.lanes)))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
