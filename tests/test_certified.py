@@ -11,6 +11,7 @@ import pytest
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.pipeline.result import percentiles
 from pyjulia4d.scene.model import Scene
 
 W, H = 40, 30
@@ -107,3 +108,15 @@ def test_de_without_shell_stop_finds_the_truncated_surface():
     assert np.percentile(err, 99) <= max(2e-6, 2 * np.percentile(res.bracket[both], 99))
     st = res.bracket_stats()
     assert st["p50"] <= st["p99"] <= st["max"] < 1e-3
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 7, 100, 1001])
+def test_percentiles_are_numpys(n):
+    """result.percentiles (np.partition, sparing the command numpy.ma's import) gives
+    np.percentile's linear interpolation to the last bits of float64, odd sizes, ties and
+    float32 values included."""
+    rng = np.random.default_rng(n)
+    for v in (rng.lognormal(size=n), rng.integers(0, 3, n).astype(np.float32), np.full(n, 2.5)):
+        got = percentiles(v, (0, 50, 99, 99.9, 100))
+        want = np.percentile(v.astype(np.float64), [0, 50, 99, 99.9, 100])
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
