@@ -161,8 +161,8 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
     pin = p + bracket[i0] * normalize(p - eye);
 #else
     for (int k = 0; k < LANES; ++k) {   /* gather; a miss or a lane past the edge takes the origin */
-        size_t i = lane_index[k] < (size_t)n_items ? lane_index[k] : lane_index[0];
-        int h = lane_index[k] < (size_t)n_items && status[i] == STATUS_HIT;
+        size_t i = lane_index[k];
+        int h = i < (size_t)n_items && status[i] == STATUS_HIT;
         real4 pk = h ? point[i] : (real4)(0);
         real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
         real4 nk = nc.x * right + nc.y * up - nc.z * forward;

@@ -187,7 +187,6 @@ class TileRunner:
         # shadows are traced (-D EXTRA_SHADOWS)
         self.lights_geo = cla.to_device(self.queue, np.array([pr.v4(g) for g in sa.lights_geo]))
         self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in sa.lights_rgb]))
-        self.extra_shadows = "EXTRA_SHADOWS" in plan.config.defines
         if plan.reflects:
             self.refl_prg = build.program(self.ctx, plan.reflect_config)
             self.refl_march_k = cl.Kernel(self.refl_prg, "march")

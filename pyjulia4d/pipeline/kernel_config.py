@@ -137,12 +137,33 @@ def shade_config(scene: Scene) -> KernelConfig:
     light terms are the march's program's alone: compiled once, at its width (the one-ray
     march in this program too had taken three quarters of its build)."""
     cfg = scene_config(scene)
-    keep = {"march/clip", "rays", "shade/reflect", "shade/shade"} | {f"normals/{m}" for m in ("gradient", "zbuffer")}
+    keep = {"march/clip", "rays", "shade/reflect", "shade/shade", "normals/gradient", "normals/zbuffer"}
     pieces = iteration_pieces(scene) + tuple(p for p in cfg.pieces if p in keep)
-    switches = SHADE_SWITCHES | {"LIGHT_POINT", "EXTRA_LIGHTS", "EXTRA_SHADOWS", "CLIP"}
-    defines = precision_defines(scene) + fractal_defines(scene) + tuple(
-        d for d in cfg.defines if d.split("=")[0] in switches)
-    return KernelConfig(pieces, defines)
+    return KernelConfig(pieces, read_by(cfg.defines, {"shade"}))
+
+
+# The programs' pieces that read each -D switch (a name, or a prefix ending in "_"), for the
+# switches not every program's pieces read: a program leaves out those none of its pieces
+# reads, so that scenes differing there alone share it.  "shade": shade/shade.cl,
+# shade/reflect.cl, march/clip.cl; "light": shade/light.cl; "march": the march's pieces (the
+# functions' enclosures, march/*.cl).  The rest (precision, the fractal's) every program reads.
+SWITCH_READERS = {
+    "SPECULAR": {"shade"}, "FOG": {"shade"}, "REFLECTION": {"shade"}, "LIGHT_TERMS": {"shade"},
+    "COLORMAP": {"shade"},
+    "LIGHT_POINT": {"shade", "light"}, "EXTRA_LIGHTS": {"shade", "light"}, "EXTRA_SHADOWS": {"shade", "light"},
+    "AO": {"light"}, "SHADOW_": {"light"}, "COLOR_": {"light"},
+    "CLIP": {"shade", "march"}, "ENCLOSE": {"march"}, "REFINE_ITP": {"march"}, "CONE_START": {"march"},
+    "RAYS_FROM_BUFFERS": {"march"},
+}
+
+
+def read_by(defines, readers: set[str]) -> tuple[str, ...]:
+    """The switches of ``defines`` that a program of ``readers`` (SWITCH_READERS' names) reads."""
+    def wanted(d: str) -> bool:
+        name = d.split("=")[0]
+        key = next((k for k in SWITCH_READERS if name == k or (k.endswith("_") and name.startswith(k))), None)
+        return key is None or bool(SWITCH_READERS[key] & readers)
+    return tuple(d for d in defines if wanted(d))
 
 
 def light_defines(scene: Scene) -> tuple[str, ...]:
@@ -185,21 +206,14 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
     light = "shade/light" in cfg.pieces
     if light:
         pieces += ("shade/light",)
-    # only the switches its pieces read: scenes that differ in shade.cl's alone share the
-    # march's program (the costliest build: the iteration inlined at every call, in packets)
-    defines = tuple(d for d in cfg.defines if d not in SHADE_SWITCHES
-                    and (light or d.split("=")[0] not in LIGHT_SWITCHES and not d.startswith("SHADOW_")
-                         and not d.startswith("COLOR_")))
+    # scenes that differ in shading alone share this program, the costliest build (the
+    # iteration inlined at every call, in packets)
+    defines = read_by(cfg.defines, {"march", "light"} if light else {"march"})
     if lanes == 1:
         return KernelConfig(pieces, defines)
     bw, bh = packet_block(lanes)
     return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
 
-
-# the switches read by shade/shade.cl and shade/reflect.cl alone, and those shade/light.cl reads
-# besides (with SHADOW_* and COLOR_*): left out of programs without those pieces
-SHADE_SWITCHES = frozenset({"SPECULAR", "FOG", "REFLECTION", "LIGHT_TERMS", "COLORMAP"})
-LIGHT_SWITCHES = frozenset({"LIGHT_POINT", "EXTRA_LIGHTS", "EXTRA_SHADOWS", "AO"})
 
 
 def mesh_config(scene: Scene) -> KernelConfig:
