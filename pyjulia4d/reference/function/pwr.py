@@ -12,8 +12,9 @@ def cfun(z, p):
 
 
 def cfun_d(z, p):
+    """p z^(p-1) as p z^p / z (the kernel shares z^p's log and exp with cfun); 0 at 0."""
     with np.errstate(all="ignore"):
-        r = p * np.exp((p - 1) * np.log(z))
+        r = p * cfun(z, p) / z
     return np.where(z == 0, 0, r)
 
 
@@ -27,8 +28,9 @@ def FUNC_M2(m, rho, p):
     disc; none (inf) where it meets log's cut or 0 (kernels/function/pwr.cl)."""
     qr, qi = p.real - 2, p.imag
     with np.errstate(all="ignore"):
-        lo, hi = np.log(np.abs(m) - rho), np.log(np.abs(m) + rho)
-        e = np.maximum(qr * lo, qr * hi) + abs(qi) * D.ENC_PI
+        # max(qr ln s) over s in [|m| - rho, |m| + rho]: one end by qr's sign
+        e = (qr * np.log(np.abs(m) + rho) if qr > 0 else qr * np.log(np.abs(m) - rho) if qr < 0
+             else np.zeros(np.shape(m))) + abs(qi) * D.ENC_PI
         if qi == 0 and float(p.real).is_integer():   # analytic across the cut (PWR_INTEGER)
             e = np.where(qr == 0, 0.0, e)
             bad = (qr < 0) & ~(np.abs(m) > rho)
