@@ -38,15 +38,16 @@ class Precision:
     def __init__(self, double: bool):
         self.scalar = np.float64 if double else np.float32
         self.vec_dtype = cl.cltypes.double4 if double else cl.cltypes.float4
-        self.vec = cl.cltypes.make_double4 if double else cl.cltypes.make_float4
         self.cone_dtype = cl.cltypes.double2 if double else cl.cltypes.float2
 
     def v4(self, v) -> np.ndarray:
-        return self.vec(*[float(x) for x in v])
+        """A real4 argument (cltypes' make_float4 compiles a lambda with eval at every call:
+        a millisecond of each render's set-up)."""
+        return np.array(tuple(float(x) for x in v), self.vec_dtype)
 
 
 def _float4(v3, w=0.0):
-    return cl.cltypes.make_float4(*[float(x) for x in v3], float(w))
+    return np.array((*(float(x) for x in v3), float(w)), cl.cltypes.float4)
 
 
 # The floor of normals.step = "auto": a central difference of the estimate over a step h
@@ -104,7 +105,7 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
     n = w * h
     c = pr.v4(f.c)
     eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
-    kernel = cl.Kernel(prg, f"normals_{method}")
+    kernel = build.kernel(prg, f"normals_{method}")
     if method == "jacobian":
         return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
                       pr.scalar(f.bailout), right, up, fwd, normal.data, lanes=lanes)
@@ -161,8 +162,8 @@ class TileRunner:
                             _float4(sa.sky), np.float32(sa.ambient), np.float32(sa.diffuse), np.float32(sa.specular),
                             np.float32(sa.shininess))
         self.fog = (np.float32(sa.fog), np.float32(sa.fog_start))
-        self.march_k = cl.Kernel(self.march_prg, "march")
-        self.cone_k = cl.Kernel(self.march_prg, "cone_starts") if plan.march.cone else None
+        self.march_k = build.kernel(self.march_prg, "march")
+        self.cone_k = build.kernel(self.march_prg, "cone_starts") if plan.march.cone else None
         self.cone_const = (pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.radius),
                            pr.scalar(ma.near), pr.scalar(ma.far), np.int32(ma.max_steps))
         planes = plan.clip.planes
@@ -170,10 +171,10 @@ class TileRunner:
         self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
                           (pr.v4([planes[k][1] if k < len(planes) else 0.0 for k in range(4)]),)
                           if planes else ())
-        self.clip_k = cl.Kernel(self.prg, "clip_normals") if planes and plan.normals else None
-        self.shade_k = cl.Kernel(self.prg, "shade") if plan.shades else None
+        self.clip_k = build.kernel(self.prg, "clip_normals") if planes and plan.normals else None
+        self.shade_k = build.kernel(self.prg, "shade") if plan.shades else None
         # shade/light.cl: in the march's program, in its packets (kernel_config.march_config)
-        self.light_k = cl.Kernel(self.march_prg, "light_terms") if plan.light_terms else None
+        self.light_k = build.kernel(self.march_prg, "light_terms") if plan.light_terms else None
         self.light_const = ((pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
                              self.right, self.up, self.fwd, pr.v4(sa.light), pr.scalar(ma.radius),
                              pr.scalar(la.step), pr.scalar(la.bias), pr.scalar(la.softness), np.int32(la.max_steps),
@@ -189,9 +190,9 @@ class TileRunner:
         self.lights_rgb = cla.to_device(self.queue, np.array([_float4(c[:3], c[3]) for c in sa.lights_rgb]))
         if plan.reflects:
             self.refl_prg = build.program(self.ctx, plan.reflect_config)
-            self.refl_march_k = cl.Kernel(self.refl_prg, "march")
-            self.reflect_rays_k = cl.Kernel(self.prg, "reflect_rays")
-            self.reflect_color_k = cl.Kernel(self.prg, "reflect_color")
+            self.refl_march_k = build.kernel(self.refl_prg, "march")
+            self.reflect_rays_k = build.kernel(self.prg, "reflect_rays")
+            self.reflect_color_k = build.kernel(self.prg, "reflect_color")
             self.refl_bias = pr.scalar(la.bias)
 
     def make_slot(self, nmax: int, nb: int, extra: bool) -> tuple[dict, dict]:

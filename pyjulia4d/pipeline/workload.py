@@ -24,7 +24,7 @@ import os
 import warnings
 from dataclasses import dataclass
 
-from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.geometry.camera import march_radius, to_world
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method
@@ -138,7 +138,7 @@ def check_numerics(scene: Scene) -> None:
                             f"bailout, above {REAL_MAX[scene.render.float]:.1e}); use at most "
                             f"{lim:.2g}{alt}")
     if march_method(scene) == "de" and scene.render.float == "single":
-        t_far = float(sum(x * x for x in camera_frame(scene).position)) ** 0.5 + march_radius(scene)
+        t_far = float(sum(x * x for x in to_world(scene, scene.camera.position))) ** 0.5 + march_radius(scene)
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:
             warnings.warn(f"march.epsilon: {m.epsilon:g} is below half the float32 spacing of the "
