@@ -163,6 +163,41 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     assert binary.read_bytes() != b"not a program"
 
 
+def test_kernels_made_once_per_thread():
+    # build.kernel: one kernel object per (program, name) and thread - a kernel holds its
+    # arguments from set to enqueue, so two threads rendering at once must not share one -
+    # and threads rendering at once give the image of one thread alone
+    import threading
+    from harness import device
+    from pyjulia4d.opencl import build
+    from pyjulia4d.opencl.runner import queue_for
+    from pyjulia4d.pipeline import kernel_config
+
+    ctx, _ = queue_for(device())
+    prg = build.program(ctx, kernel_config.shade_config(Scene.default()))
+    k = build.kernel(prg, "shade")
+    names = prg.get_info(cl.program_info.KERNEL_NAMES).split(";")
+    assert build.kernel(prg, "shade") is k
+    assert all(build.kernel(prg, n) is not k for n in names if n != "shade")
+    other = []
+    t = threading.Thread(target=lambda: other.append(build.kernel(prg, "shade")))
+    t.start()
+    t.join()
+    assert other[0] is not k and other[0].function_name == "shade"
+
+    scene = Scene.default().with_overrides(["image.width=48", "image.height=36"])
+    want = render(scene).color
+    got = [None] * 3
+    def run(i, s):
+        got[i] = render(s).color
+    threads = [threading.Thread(target=run, args=(i, scene)) for i in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(g is not None and np.array_equal(g, want) for g in got)
+
+
 @pytest.mark.parametrize("over", [["clip.planes=0,0,-1,0"], ["clip.planes=-1,0,-1,0;0,1,0,0.3", "march.method=fixed"],
                                   ["clip.planes=0,0,-1,0.1", "fractal.algebra=hypercomplex",
                                    "fractal.c=-0.123,0,-0.745,0", "camera.position=1.7,5.7,-5.7"]])
