@@ -44,6 +44,12 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask live, julia_params jp,
 }
 #endif
 
+/* A hit whose normal points away from a light (n . l <= 0, l towards the light from the hit)
+ * gets none of its diffuse or specular light (shade/shade.cl: both weigh by max(n . l, 0)): it
+ * is its own shadow, visibility 0, and traces no shadow ray - a fifth of the default scene's
+ * hits, an eighth of its shadow steps (float64 twin, 160x120). */
+#define LIGHT_FACES(nw, lv) (QDOT((nw), (lv)) > (real)0)
+
 /* 1 - strength * occlusion, occlusion = sum_i w_i max(h_i - 2 d(p + h_i n), 0) / h_i / sum w_i
  * at h_i = i dist / 5, w_i = 2^-i (seed 004's ambient occlusion from the estimate; 2 d:
  * the estimate without its 1/2 factor); without an estimate, the share of the five points
@@ -176,12 +182,13 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
     lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
     {
+        quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
         quat o = QRAY(p, nw, (lreal)bias);     /* off the surface, outside */
-        quat lv = QADD(QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w),
-                       QSCALE((lreal)-1, o));
+        quat lv = QADD(lp, QSCALE((lreal)-1, o));
         lreal dist = QLEN(lv);
         quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
-        vis = shadow_ray(o, l, dist, hit, jp, radius, step, softness, max_steps);
+        lmask facing = hit & LIGHT_FACES(nw, QADD(lp, QSCALE((lreal)-1, p)));
+        vis = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
     }
 #endif
 #ifdef EXTRA_SHADOWS
@@ -192,17 +199,20 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
         quat o = QRAY(p, nw, (lreal)bias);
         for (int j = 0; j < EXTRA_LIGHTS; ++j) {
             real4 g = lights_geo[j];
-            quat lv;
+            quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
+            quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
             lreal dist;
             if (lights_rgb[j].w != 0.0f) {
-                lv = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
+                lv = to = gq;
                 dist = (lreal)INFINITY;
             } else {
-                lv = QADD(QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w), QSCALE((lreal)-1, o));
+                lv = QADD(gq, QSCALE((lreal)-1, o));
+                to = QADD(gq, QSCALE((lreal)-1, p));
                 dist = QLEN(lv);
             }
             quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
-            ve[j] = shadow_ray(o, l, dist, hit, jp, radius, step, softness, max_steps);
+            lmask facing = hit & LIGHT_FACES(nw, to);
+            ve[j] = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
         }
     }
 #endif

@@ -132,8 +132,12 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
         o = p + bias * nw
         lv = np.asarray(light_pos, np.float64) - o
         dist = np.linalg.norm(lv, axis=-1)
-        out[k, 0] = shadow_ray(o, lv / np.maximum(dist, 1e-300)[:, None], dist, c, max_iter, bailout, radius,
-                               step, softness, max_steps, shadow == "soft", F)
+        # a hit facing away from the light is its own shadow, and traces none (shade/light.cl LIGHT_FACES)
+        f = dot4(nw, np.asarray(light_pos, np.float64) - p) > 0
+        vis = np.zeros(len(k))
+        vis[f] = shadow_ray(o[f], lv[f] / np.maximum(dist[f], 1e-300)[:, None], dist[f], c, max_iter, bailout,
+                            radius, step, softness, max_steps, shadow == "soft", F)
+        out[k, 0] = vis
     if ao:
         out[k, 1] = ambient_occlusion(p + bias * nw, nw, c, max_iter, bailout, ao_distance, ao_strength, F)
     if coloring == "iteration":
@@ -163,13 +167,17 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
     o = point[k] + bias * nw
     for j in range(len(geo)):
         if rgb[j, 3] != 0:
-            lv = np.broadcast_to(np.asarray(geo[j], np.float64), o.shape)
+            lv = to = np.broadcast_to(np.asarray(geo[j], np.float64), o.shape)
             dist = np.full(len(k), np.inf)
         else:
             lv = np.asarray(geo[j], np.float64) - o
+            to = np.asarray(geo[j], np.float64) - point[k]
             dist = np.linalg.norm(lv, axis=-1)
         l = lv / np.maximum(np.linalg.norm(lv, axis=-1), 1e-300)[:, None]
-        out[k, j] = shadow_ray(o, l, dist, c, max_iter, bailout, radius, step, softness, max_steps, soft, F)
+        f = dot4(nw, to) > 0   # facing the light (shade/light.cl LIGHT_FACES); else its own shadow
+        vis = np.zeros(len(k))
+        vis[f] = shadow_ray(o[f], l[f], dist[f], c, max_iter, bailout, radius, step, softness, max_steps, soft, F)
+        out[k, j] = vis
     return out
 
 
