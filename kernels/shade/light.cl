@@ -166,10 +166,14 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
     nw = nc.x * right + nc.y * up - nc.z * forward;
     pin = p + bracket[i0] * normalize(p - eye);
 #else
-    for (int k = 0; k < LANES; ++k) {   /* gather; a miss or a lane past the edge takes the origin */
+    /* a miss or a lane past the edge takes a point whose orbit leaves the bailout ball at once,
+     * as do its occlusion points: at the origin (inside many sets) its estimates ran to max_iter
+     * and held its packet's loops that long */
+    real4 away = (real4)((real)4 * (bailout + radius + ao_distance), 0, 0, 0);
+    for (int k = 0; k < LANES; ++k) {   /* gather */
         size_t i = lane_index[k];
         int h = i < (size_t)n_items && status[i] == STATUS_HIT;
-        real4 pk = h ? point[i] : (real4)(0);
+        real4 pk = h ? point[i] : away;
         real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
         real4 nk = nc.x * right + nc.y * up - nc.z * forward;
         real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
@@ -180,52 +184,56 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
     }
 #endif
     lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;
+#ifdef EXTRA_SHADOWS
+    lreal ve[3] = {(lreal)1, (lreal)1, (lreal)1};
+#endif
+    if (L_ANY(hit)) {   /* a block of misses (the background) has nothing to light */
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
-    {
-        quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
-        quat o = QRAY(p, nw, (lreal)bias);     /* off the surface, outside */
-        quat lv = QADD(lp, QSCALE((lreal)-1, o));
-        lreal dist = QLEN(lv);
-        quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
-        lmask facing = hit & LIGHT_FACES(nw, QADD(lp, QSCALE((lreal)-1, p)));
-        vis = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
-    }
+        {
+            quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
+            quat o = QRAY(p, nw, (lreal)bias);     /* off the surface, outside */
+            quat lv = QADD(lp, QSCALE((lreal)-1, o));
+            lreal dist = QLEN(lv);
+            quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
+            lmask facing = hit & LIGHT_FACES(nw, QADD(lp, QSCALE((lreal)-1, p)));
+            vis = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
+        }
 #endif
 #ifdef EXTRA_SHADOWS
-    /* shading.lights: the same shadow ray towards each (a distant one: along its direction,
-     * out of the bounding ball) */
-    lreal ve[3] = {(lreal)1, (lreal)1, (lreal)1};
-    {
-        quat o = QRAY(p, nw, (lreal)bias);
-        for (int j = 0; j < EXTRA_LIGHTS; ++j) {
-            real4 g = lights_geo[j];
-            quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
-            quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
-            lreal dist;
-            if (lights_rgb[j].w != 0.0f) {
-                lv = to = gq;
-                dist = (lreal)INFINITY;
-            } else {
-                lv = QADD(gq, QSCALE((lreal)-1, o));
-                to = QADD(gq, QSCALE((lreal)-1, p));
-                dist = QLEN(lv);
+        /* shading.lights: the same shadow ray towards each (a distant one: along its direction,
+         * out of the bounding ball) */
+        {
+            quat o = QRAY(p, nw, (lreal)bias);
+            for (int j = 0; j < EXTRA_LIGHTS; ++j) {
+                real4 g = lights_geo[j];
+                quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
+                quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
+                lreal dist;
+                if (lights_rgb[j].w != 0.0f) {
+                    lv = to = gq;
+                    dist = (lreal)INFINITY;
+                } else {
+                    lv = QADD(gq, QSCALE((lreal)-1, o));
+                    to = QADD(gq, QSCALE((lreal)-1, p));
+                    dist = QLEN(lv);
+                }
+                quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
+                lmask facing = hit & LIGHT_FACES(nw, to);
+                ve[j] = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
             }
-            quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
-            lmask facing = hit & LIGHT_FACES(nw, to);
-            ve[j] = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
         }
-    }
 #endif
 #ifdef AO
-    amb = ambient_occlusion(QRAY(p, nw, (lreal)bias), nw, jp, ao_distance, ao_strength);
+        amb = ambient_occlusion(QRAY(p, nw, (lreal)bias), nw, jp, ao_distance, ao_strength);
 #endif
 #if defined(COLOR_ITERATION)
-    val = orbit_value(pin, jp);
+        val = orbit_value(pin, jp);
 #elif defined(COLOR_TRAP)
-    val = orbit_value(p, jp, trap);
+        val = orbit_value(p, jp, trap);
 #elif defined(COLOR_W)
-    val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
+        val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
 #endif
+    }
 #if LANES == 1
     terms[i0] = (float4)((float)vis, (float)amb, (float)val, 0.0f);
 #ifdef EXTRA_SHADOWS
