@@ -83,10 +83,18 @@ def main(argv=None) -> int:
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    w, h = a.size.split("x")
+    try:
+        w, h = (int(v) for v in a.size.split("x"))
+    except ValueError:
+        print(f"commit_ratio.py: --size: expected WIDTHxHEIGHT, got {a.size!r}", file=sys.stderr)
+        return 2
     over = [f"image.width={w}", f"image.height={h}", *a.set]
-    rev = subprocess.run(["git", "rev-parse", "--short", a.rev], cwd=ROOT, capture_output=True, text=True,
-                         check=True).stdout.strip()
+    got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{a.rev}^{{commit}}"], cwd=ROOT,
+                         capture_output=True, text=True)
+    if got.returncode != 0:
+        print(f"commit_ratio.py: --rev: {a.rev!r} is no commit of this repository", file=sys.stderr)
+        return 2
+    rev = got.stdout.strip()
     runs: dict[str, list[dict]] = {"earlier": [], "checkout": []}
     with tempfile.TemporaryDirectory() as td:
         tree = Path(td) / "earlier"
