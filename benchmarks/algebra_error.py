@@ -20,7 +20,6 @@ and algebra_error.csv (this run's rows).
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -32,6 +31,7 @@ for p in (ROOT, ROOT / "benchmarks"):
     if str(p) not in sys.path:
         sys.path.insert(0, str(p))
 
+from bench_args import Parser, size_of  # noqa: E402
 from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 
 from pyjulia4d.measure import truth  # noqa: E402
@@ -91,14 +91,14 @@ def settings(scene: Scene) -> list[tuple[str, list[str]]]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--size", default="64x48")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore", RuntimeWarning)
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     dev = select_device(None)
     t_all = time.perf_counter()
     rows, truths = [], {}

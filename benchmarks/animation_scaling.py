@@ -13,7 +13,6 @@ all), with one worker, so nothing overlaps.  Writes benchmarks/results/animation
 """
 from __future__ import annotations
 
-import argparse
 import logging
 import os
 import sys
@@ -27,6 +26,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 
 def _frames_run(client, anim, frames, out: Path):
@@ -61,7 +61,7 @@ def _median(fn, repeats: int = 3) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240", help="frame size of the animation")
     ap.add_argument("--frames", type=int, default=48, help="frames timed per configuration")
     ap.add_argument("--big", default="1920x1080", help="size of the one frame rendered whole and in tiles")
@@ -77,7 +77,7 @@ def main(argv=None) -> int:
     from pyjulia4d.opencl.devices import select_device
     from pyjulia4d.app.output import write_image
 
-    w, h = (int(x) for x in args.size.split("x"))
+    w, h = size_of(args.size, "--size")
     anim = keyframes.load(ROOT / "examples" / "c_morph.toml", [f"image.width={w}", f"image.height={h}"])
     frames = [round(k * (anim.frames - 1) / max(args.frames - 1, 1)) for k in range(args.frames)]
     frames = list(dict.fromkeys(frames))
@@ -111,7 +111,7 @@ def main(argv=None) -> int:
                 if n == 1:
                     overhead = (wall - work) / len(frames)
                 if n == 2:
-                    bw, bh = (int(x) for x in args.big.split("x"))
+                    bw, bh = size_of(args.big, "--big")
                     big = anim.scene(frames[-1]).replace(**{"image.width": bw, "image.height": bh})
                     png = ("color", "alpha")
                     whole_local = _median(lambda: render(big, device=dev, outputs=png))

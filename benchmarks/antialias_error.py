@@ -21,7 +21,6 @@ also writes each mode's PNG, to look at.
 """
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import warnings
@@ -34,6 +33,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
 from pyjulia4d.pipeline import antialias
@@ -87,7 +87,7 @@ def timed(s: Scene, repeats: int):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--scenes", nargs="*", default=list(SCENES), choices=list(SCENES))
@@ -97,7 +97,7 @@ def main(argv=None) -> int:
                     help="denominators d: also 4-sample adaptive with threshold 1/d")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     device = "?"
     sections = []
     for name in a.scenes:

@@ -21,7 +21,6 @@ benchmarks/results/command_cost.md (a section per run: device, date, commit).
 """
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import subprocess
@@ -35,6 +34,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 
 def run(args: list[str], env: dict[str, str], cwd: str) -> dict:
@@ -54,13 +54,13 @@ def run(args: list[str], env: dict[str, str], cwd: str) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--big", default="3840x2160", help="the large size (WxH)")
     ap.add_argument("--no-big", action="store_true", help="leave out the large renders")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    bw, bh = a.big.split("x")
+    bw, bh = (str(v) for v in size_of(a.big, "--big"))
     cases = [("start-up, 8x6 PNG", ["--width", "8", "--height", "6", "-o", "s.png"]),
              ("640x480 PNG", ["--width", "640", "--height", "480", "-o", "m.png"])]
     if not a.no_big:

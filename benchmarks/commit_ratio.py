@@ -14,7 +14,6 @@ benchmarks/results/commit_ratio.md (a section per run: both commits, device, dat
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -28,6 +27,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 CHILD = r"""
 import collections, json, resource, sys, warnings
@@ -75,7 +75,7 @@ def child(tree: Path, renders: int, over: list[str]) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--rev", required=True, help="the earlier commit")
     ap.add_argument("--repeats", type=int, default=5, help="alternating pairs of child processes")
     ap.add_argument("--renders", type=int, default=8, help="timed renders in each child (the least counts)")
@@ -83,11 +83,7 @@ def main(argv=None) -> int:
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    try:
-        w, h = (int(v) for v in a.size.split("x"))
-    except ValueError:
-        print(f"commit_ratio.py: --size: expected WIDTHxHEIGHT, got {a.size!r}", file=sys.stderr)
-        return 2
+    w, h = size_of(a.size, "--size")
     over = [f"image.width={w}", f"image.height={h}", *a.set]
     got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{a.rev}^{{commit}}"], cwd=ROOT,
                          capture_output=True, text=True)

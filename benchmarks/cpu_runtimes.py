@@ -16,7 +16,6 @@ benchmarks/results/cpu_runtimes.md (a section per run, with commit, devices and 
 """
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
 import statistics
@@ -32,6 +31,7 @@ for p in (ROOT / "benchmarks", ROOT):
 
 from gallery import COMMON, SCENES  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 CHILD = r"""
 import json, statistics, sys, time, warnings
@@ -95,13 +95,13 @@ def run_child(spec: str, overrides: list[str], repeats: int, lanes_file: Path | 
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240", help="image size WxH (default 320x240)")
     ap.add_argument("--repeats", type=int, default=3, help="renders after the first, per pair and device")
     ap.add_argument("--only", nargs="*", default=[], help="pair names, e.g. hypercomplex_sin")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    w, h = (int(x) for x in a.size.lower().split("x"))
+    w, h = size_of(a.size, "--size")
 
     from pyjulia4d.opencl.devices import remembered_path, select_device
     from pyjulia4d.opencl.lanes import lanes_for

@@ -45,7 +45,6 @@ error_vs_time.png, seed_claim.md and truth.json (the ground-truth convergence re
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as _dt
 import json
@@ -58,9 +57,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+for _p in (ROOT, ROOT / "benchmarks"):
+    if str(_p) not in sys.path:
+        sys.path.insert(0, str(_p))
 
+from bench_args import Parser  # noqa: E402
 import pyopencl.array as cla  # noqa: E402
 
 from pyjulia4d.opencl import build  # noqa: E402
@@ -908,7 +909,7 @@ def choose_presets(rows: list[dict], bounds=PRESET_BOUNDS) -> dict:
 # ------------------------------------------------------------------ main
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="CI smoke run: 2 scenes, 4 settings, tiny image")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     ap.add_argument("--width", type=int, default=None)

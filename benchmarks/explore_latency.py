@@ -25,7 +25,6 @@ previews per second on the default scene.
 """
 from __future__ import annotations
 
-import argparse
 import os
 import shutil
 import statistics
@@ -41,6 +40,7 @@ for p in (ROOT / "benchmarks", ROOT):
         sys.path.insert(0, str(p))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser  # noqa: E402
 
 from pyjulia4d.app.explore.drive import headless_chromium, start_server, stop_server  # noqa: E402
 
@@ -189,7 +189,7 @@ def table(r: dict, changes: int, drag_seconds: float) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--changes", type=int, default=10)
     ap.add_argument("--drag-seconds", type=float, default=3.0)
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")

@@ -19,7 +19,6 @@ Writes benchmarks/results/extreme_cases.md and extreme_cases.csv.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as _dt
 import math
@@ -35,6 +34,7 @@ for _p in (ROOT, ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
+from bench_args import Parser  # noqa: E402
 from pyjulia4d.measure import catalogue as cat  # noqa: E402
 from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
 
@@ -151,7 +151,7 @@ def markdown(rows, args) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--scale", type=int, default=2, help="multiply the catalogue's image sizes")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--only", nargs="*", help="case names")

@@ -23,7 +23,6 @@ pick both algebras).
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 import time
@@ -39,6 +38,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 # Keys every scene shares (a scene's own keys come after and win); the shading keys are
 # pinned so that a change of the scene defaults does not change the gallery.  The march is
@@ -231,7 +231,7 @@ def sheet(paths: dict[str, Path], out: Path, tile_w: int, tile_h: int, cols: int
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240", help="picture size WxH (default 320x240)")
     ap.add_argument("--only", nargs="+", default=[], metavar="NAME", help="render only these scenes")
     ap.add_argument("--ss", type=int, default=3,
@@ -239,7 +239,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     try:
-        w, h = (int(x) for x in a.size.lower().split("x"))
+        w, h = size_of(a.size, "--size")
     except ValueError:
         ap.error(f"--size {a.size}: expected WxH, e.g. 320x240")
     if w < 1 or h < 1 or a.ss < 1:

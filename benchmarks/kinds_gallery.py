@@ -22,7 +22,6 @@ kinds_error.md (a section per run: device, date, commit).
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -34,6 +33,7 @@ for p in (ROOT, ROOT / "benchmarks"):
     if str(p) not in sys.path:
         sys.path.insert(0, str(p))
 
+from bench_args import Parser, size_of  # noqa: E402
 from error_vs_time import measure_settings, write_error_tables  # noqa: E402
 
 from pyjulia4d.measure import truth  # noqa: E402
@@ -128,7 +128,7 @@ def sheet(out: Path, names: list[str], cell=(320, 240), cols=3) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="64x48", help="error table image size")
     ap.add_argument("--picture", default="480x360", help="gallery picture size")
     ap.add_argument("--repeats", type=int, default=3)
@@ -141,7 +141,7 @@ def main(argv=None) -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     t_all = time.perf_counter()
     if not a.skip_gallery:
-        pw, ph = (int(x) for x in a.picture.split("x"))
+        pw, ph = size_of(a.picture, "--picture")
         for name, (over, desc) in GALLERY.items():
             s = Scene.default().with_overrides(over + [f"image.width={pw}", f"image.height={ph}"])
             r = render(s, device=dev)
@@ -151,7 +151,7 @@ def main(argv=None) -> int:
         sheet(a.out, list(GALLERY))
     if a.skip_error:
         return 0
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     rows, truths = [], {}
     for name, (over, desc) in ERROR.items():
         base = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",

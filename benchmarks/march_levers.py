@@ -34,7 +34,6 @@ Writes benchmarks/results/march_levers.md (appends a section per run).
 """
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from pathlib import Path
@@ -52,6 +51,7 @@ from pyjulia4d.reference.march import DE_OVER_RELAX  # noqa: E402
 from pyjulia4d.reference.rays import generate_rays  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 LANES, BLOCK = 16, 4
 
@@ -163,11 +163,11 @@ def coarse_to_fine(its, ts, ds, W: int, H: int, side: int, pixel: float) -> tupl
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    W, H = (int(x) for x in a.size.split("x"))
+    W, H = size_of(a.size, "--size")
     scene = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}"])
     its, ts, ds = record(scene)
     total = int(its.sum())

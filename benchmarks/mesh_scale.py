@@ -14,7 +14,6 @@ section per run, with commit, device and date).
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
@@ -28,6 +27,7 @@ for p in (ROOT / "benchmarks", ROOT):
         sys.path.insert(0, str(p))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "mesh_scale.md"
 
@@ -94,7 +94,7 @@ def preview(path: Path, overrides: list[str], n: int) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--resolutions", default="128,512")
     ap.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-twin", action="store_true", help="skip the float64 count of the grid")

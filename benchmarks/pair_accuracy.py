@@ -26,7 +26,6 @@ benchmarks/results/pair_accuracy.md (a section per run, with commit, device and 
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -45,6 +44,7 @@ from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
 from pyjulia4d.measure.truth import brute_force_depth, refine_depth  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 SILHOUETTE_MOST, STEPPED_MOST, BRACKET_FACTOR = 0.005, 0.001, 2.0
 
@@ -132,7 +132,7 @@ def compare(r, truth: np.ndarray) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="80x60")
     ap.add_argument("--only", nargs="*", default=[], help="pairs as algebra_function, e.g. hypercomplex_sin")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="on every pair's scene")
@@ -141,7 +141,7 @@ def main(argv=None) -> int:
     ap.add_argument("--random", type=int, default=0, metavar="N", help="N scenes of one's own per pair, besides the defaults")
     ap.add_argument("--seed", type=int, default=2026)
     a = ap.parse_args(argv)
-    w, h = (int(x) for x in a.size.lower().split("x"))
+    w, h = size_of(a.size, "--size")
     dev = select_device(a.device)
     todo = [p for p in pairs() if not a.only or f"{p[0]}_{p[1]}" in a.only]
     head = ("| pair | march | stated p99 error | measured p99 error | silhouette wrong | stepped over | "

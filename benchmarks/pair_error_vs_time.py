@@ -32,7 +32,6 @@ table per pair and a summary per setting), .csv (a row per pair, scene and setti
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import statistics
 import sys
@@ -52,6 +51,7 @@ from pyjulia4d.fractal.registry import has_distance_estimate  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pair_accuracy import compare, pairs, random_overrides, refine_truth, truth_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 SETTINGS = {"default": [],   # march.quality "auto": what a scene that names no march key gets
             "fixed 250": ["march.method=fixed", "march.z_resolution=250"],
@@ -157,7 +157,7 @@ def plot(rows: list[dict], path: Path) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="64x48")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--only", nargs="*", default=[], help="pairs as algebra_function, e.g. hypercomplex_sin")
@@ -167,7 +167,7 @@ def main(argv=None) -> int:
     ap.add_argument("--device", default=None)
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    w, h = (int(x) for x in a.size.lower().split("x"))
+    w, h = size_of(a.size, "--size")
     dev = select_device(a.device)
     rng = np.random.default_rng(a.seed)
     names = [n for n in SETTINGS if n in a.settings]

@@ -51,7 +51,6 @@ Writes benchmarks/results/peers.md (appends a section per run).
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -71,6 +70,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 POV_SCENE = """#version 3.7;
 global_settings {{ assumed_gamma 1.0 }}
@@ -288,7 +288,7 @@ def run_pyjulia4d(over: list[str]) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
@@ -302,7 +302,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     SCENE_SET[:] = a.set
     LOOK[:] = MATCHED if a.look == "matched" else []
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     size = [f"image.width={w}", f"image.height={h}"] + a.set
     have_pov = shutil.which("povray") is not None
     if not have_pov:

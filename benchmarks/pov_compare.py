@@ -39,7 +39,6 @@ message, where ``povray`` is not installed.
 """
 from __future__ import annotations
 
-import argparse
 import math
 import re
 import resource
@@ -59,6 +58,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 HEAD = """#version 3.7;
 global_settings {{ assumed_gamma 1.0 }}
@@ -177,7 +177,7 @@ def cos_stats(cos, truth_cos, mask) -> Stat:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480", help="image size of the timed renders")
     ap.add_argument("--truth-size", default="160x120", help="image size of the silhouette and normal comparison")
     ap.add_argument("--repeats", type=int, default=3)
@@ -187,8 +187,8 @@ def main(argv=None) -> int:
     warnings.simplefilter("ignore")
     from pyjulia4d import render
 
-    w, h = (int(v) for v in a.size.split("x"))
-    tw, th = (int(v) for v in a.truth_size.split("x"))
+    w, h = size_of(a.size, "--size")
+    tw, th = size_of(a.truth_size, "--truth-size")
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped, pyjulia4d alone "

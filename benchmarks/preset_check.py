@@ -39,7 +39,6 @@ Writes benchmarks/results/preset_check.csv and .md (device, date, commit, comman
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import datetime as _dt
 import math
@@ -54,6 +53,7 @@ for p in (ROOT, ROOT / "benchmarks"):
     if str(p) not in sys.path:
         sys.path.insert(0, str(p))
 
+from bench_args import Parser  # noqa: E402
 from error_vs_time import SLACK_ULPS, git_head  # noqa: E402
 from pyjulia4d.measure import truth  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
@@ -266,7 +266,7 @@ def write(out: Path, rows: list[dict], scenes: list[dict], meta: dict, timing: l
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=24, help="number of scenes")
     ap.add_argument("--seeds", default=",".join(map(str, SEEDS)), help="comma-separated; --n scenes from each")
     ap.add_argument("--width", type=int, default=64)

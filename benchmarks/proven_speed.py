@@ -19,7 +19,6 @@ Writes benchmarks/results/proven_speed.md (a section per run: commit, device, da
 """
 from __future__ import annotations
 
-import argparse
 import importlib
 import statistics
 import sys
@@ -39,6 +38,7 @@ from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
 from pyjulia4d.reference.formula import formula_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 SCENES = {"hypercomplex sin": {"algebra": "hypercomplex", "function": "sin"},
           "hypercomplex cosh": {"algebra": "hypercomplex", "function": "cosh"},
@@ -92,14 +92,14 @@ def run(scene: Scene, dev, repeats: int, lanes: int | None = None) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--device", default=None)
     ap.add_argument("--only", nargs="*", default=[], help="scenes by name, e.g. 'hypercomplex sin'")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    w, h = (int(x) for x in a.size.lower().split("x"))
+    w, h = size_of(a.size, "--size")
     dev = select_device(a.device)
     head = ("| scene | march | kernel s | x the fixed scan | tests per ray | stated p99 error | unresolved pixels | "
             "enclosures that proved |\n|---|---|---|---|---|---|---|---|\n")

@@ -9,7 +9,6 @@ and git commit; with no --set it also saves default.png, README's picture.
 """
 from __future__ import annotations
 
-import argparse
 import datetime
 import statistics
 import sys
@@ -22,10 +21,11 @@ from pyjulia4d import Scene, render  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.app.output import write_png  # noqa: E402
 from run_log import append_run, git_commit  # noqa: E402
+from bench_args import Parser  # noqa: E402
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--device", default=None)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")

@@ -13,7 +13,6 @@ Writes benchmarks/results/scaling.md (appends a section per run: device, date, c
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
@@ -24,6 +23,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser  # noqa: E402
 
 CHILD = r"""
 import json, resource, sys, time, warnings
@@ -46,7 +46,7 @@ print(json.dumps({"seconds": sec, "kernel_seconds": r.kernel_seconds, "peak": pe
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="160x120,320x240,640x480,1280x960,1920x1080,3840x2160")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--outputs", default="all", help="comma-separated render outputs kept (default all)")

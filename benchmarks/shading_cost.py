@@ -11,7 +11,6 @@ benchmarks/results/shading_cost.md (a section per run: device, date, commit).
 """
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import warnings
@@ -22,6 +21,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
 
@@ -51,13 +51,13 @@ VARIANTS = {
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     rows, base, device = [], None, "?"
     for name, over in VARIANTS.items():
         s = Scene.default().with_overrides(PLAIN + over + [f"image.width={w}", f"image.height={h}"])

@@ -9,7 +9,6 @@ render time to benchmarks/results/shading.md.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -20,6 +19,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
 
@@ -45,14 +45,14 @@ SCENES = {
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
     from PIL import Image, ImageDraw
 
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     folder = a.out / "shading"
     folder.mkdir(parents=True, exist_ok=True)
     rows, tiles = [], []

@@ -24,7 +24,6 @@ Writes benchmarks/results/throughput.md (appends a section per run: device, date
 """
 from __future__ import annotations
 
-import argparse
 import json
 import statistics
 import subprocess
@@ -50,6 +49,7 @@ from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
 from pyjulia4d.opencl.runner import Precision, launch, march_items, queue_for  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
 
 FLOPS_PER_ITERATION = 20
 SCENES = {
@@ -180,14 +180,14 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--device", default=None)
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--widths", default="1,4,8,16")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
-    w, h = (int(x) for x in a.size.split("x"))
+    w, h = size_of(a.size, "--size")
     dev = select_device(a.device)
     lines = [f"\n## {utc_now()}, {dev.name.strip()} "
              f"({dev.platform.name.strip()} {dev.platform.version.strip()}), commit {git_commit()}, {w}x{h}\n",

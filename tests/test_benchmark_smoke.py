@@ -1,6 +1,8 @@
 """CI smoke run of benchmarks/error_vs_time.py --quick, so the benchmark cannot rot."""
 import csv
 import importlib.util
+import subprocess
+import sys
 from pathlib import Path
 import pytest
 
@@ -241,3 +243,21 @@ def test_commit_ratio_report_runs(tmp_path):
                                             "--size", "64x48", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "commit_ratio.md").read_text()
     assert "| kernel march |" in md and "| CPU-s of a render |" in md
+
+
+@pytest.mark.parametrize("script,args", [
+    ("peers.py", ["--size", "640x"]),
+    ("commit_ratio.py", ["--rev", "no-such-commit"]),
+    ("command_cost.py", ["--big", "0x480"]),
+    ("scaling.py", ["--repeats", "3"]),
+    ("throughput.py", ["--size", "axb"]),
+    ("pov_compare.py", ["--repeats", "many"]),
+])
+def test_bad_flags_are_one_line_and_exit_2(script, args, tmp_path):
+    # benchmarks/bench_args.py: a bad flag is one line naming it, exit status 2, no traceback
+    # and nothing written
+    p = subprocess.run([sys.executable, str(ROOT / "benchmarks" / script), *args, "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1 and script in lines[0], p.stderr
+    assert "Traceback" not in p.stderr and not list(tmp_path.iterdir())
