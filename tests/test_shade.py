@@ -97,6 +97,9 @@ LIGHT_SCENES = {
     "three-lights-soft": ["shading.light=-3,4,-2", "shading.shadow=soft", "shading.sky=0.5,0.6,1",
                           "shading.lights=position 3,2,-1 color 0.3,0.5,1 intensity 0.8; direction 0,-1,0.2 "
                           "color 1,0.5,0.2 intensity 0.4"],
+    # a distant light along limbo has no direction in the rays' 3D space: shade.cl lights along
+    # the view instead, so its shadow rays are traced from every hit
+    "limbo-light": ["shading.light=eye", "shading.shadow=hard", "shading.lights=direction 0,0,0,1 intensity 0.8"],
     "eye-and-lights-hard-fixed": ["march.method=fixed", "shading.light=eye", "shading.shadow=hard",
                                   "shading.lights=position -2,3,-3 intensity 0.7; direction 1,1,-1,0.2"],
     "reflection": ["shading.reflection=0.5", "shading.background=0.2,0.3,0.5"],

@@ -218,7 +218,11 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
                     dist = QLEN(lv);
                 }
                 quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
-                lmask facing = hit & LIGHT_FACES(nw, to);
+                /* a light with no direction in the rays' 3D space: shade.cl lights along the
+                 * view instead, which every hit faces */
+                lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
+                             (QDOT_UNIFORM(to, forward) == (real)0);
+                lmask facing = hit & (LIGHT_FACES(nw, to) | flat);
                 ve[j] = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
             }
         }

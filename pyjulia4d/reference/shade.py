@@ -174,7 +174,9 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
             to = np.asarray(geo[j], np.float64) - point[k]
             dist = np.linalg.norm(lv, axis=-1)
         l = lv / np.maximum(np.linalg.norm(lv, axis=-1), 1e-300)[:, None]
-        f = dot4(nw, to) > 0   # facing the light (shade/light.cl LIGHT_FACES); else its own shadow
+        # facing the light (shade/light.cl LIGHT_FACES), or lit along the view where the light has
+        # no direction in the rays' 3D space (shade.cl); else its own shadow
+        f = (dot4(nw, to) > 0) | np.all(to_camera(to, frame) == 0, axis=-1)
         vis = np.zeros(len(k))
         vis[f] = shadow_ray(o[f], l[f], dist[f], c, max_iter, bailout, radius, step, softness, max_steps, soft, F)
         out[k, j] = vis
