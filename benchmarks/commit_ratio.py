@@ -88,8 +88,7 @@ def main(argv=None) -> int:
     got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{a.rev}^{{commit}}"], cwd=ROOT,
                          capture_output=True, text=True)
     if got.returncode != 0:
-        print(f"commit_ratio.py: --rev: {a.rev!r} is no commit of this repository", file=sys.stderr)
-        return 2
+        ap.error(f"--rev: {a.rev!r} is no commit of this repository")
     rev = got.stdout.strip()
     runs: dict[str, list[dict]] = {"earlier": [], "checkout": []}
     with tempfile.TemporaryDirectory() as td:

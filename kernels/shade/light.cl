@@ -10,9 +10,10 @@
  * inside; soft shadows (seed 004's penumbra) take min(k d / t) over the way, d the
  * estimate without its 1/2 (Koebe) factor.  Without one: samples every `step` (the
  * scan's own spacing), 0 at the first inside - hard shadows, whichever was asked for.  At most max_steps points: a ray still
- * going there keeps what it has (lit). */
+ * going there keeps what it has (lit).  Lanes outside ``lit`` trace nothing and get 0: no hit, or
+ * a hit facing away from the light (LIGHT_FACES below), its own shadow. */
 #if defined(SHADOW_HARD) || defined(SHADOW_SOFT)
-inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask live, julia_params jp, real radius, real step,
+inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, real radius, real step,
                         real softness, int max_steps)
 {
     lreal b = QDOT(o, l);
@@ -21,8 +22,8 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask live, julia_params jp,
     lreal s = sqrt(fmax(disc, (real)0));
     lreal t = fmax(-b - s, (lreal)step);
     lreal t1 = fmin(-b + s, tmax);
-    lmask active = live & (disc > (real)0) & (t1 > t);
-    lreal vis = (lreal)1;
+    lmask active = lit & (disc > (real)0) & (t1 > t);
+    lreal vis = L_SEL((lreal)0, (lreal)1, lit);
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         quat x = QRAY(o, l, t);
 #ifdef ALG_HAS_DE
@@ -196,7 +197,7 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
             lreal dist = QLEN(lv);
             quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
             lmask facing = hit & LIGHT_FACES(nw, QADD(lp, QSCALE((lreal)-1, p)));
-            vis = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
+            vis = shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps);
         }
 #endif
 #ifdef EXTRA_SHADOWS
@@ -223,7 +224,7 @@ __kernel void light_terms(const int n_items, const int tile_w, __global const re
                 lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
                              (QDOT_UNIFORM(to, forward) == (real)0);
                 lmask facing = hit & (LIGHT_FACES(nw, to) | flat);
-                ve[j] = L_SEL((lreal)0, shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps), facing);
+                ve[j] = shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps);
             }
         }
 #endif

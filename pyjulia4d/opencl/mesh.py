@@ -18,8 +18,8 @@ class MeshRunner:
         self.plan = plan
         self.ctx, self.queue = queue_for(dev)
         prg = build.program(self.ctx, plan.config)
-        self.sample_k = cl.Kernel(prg, "mesh_sample")
-        self.vertex_k = cl.Kernel(prg, "mesh_vertices")
+        self.sample_k = build.kernel(prg, "mesh_sample")
+        self.vertex_k = build.kernel(prg, "mesh_vertices")
         pr = self.pr = Precision(plan.double)
         self.grid = (pr.v4(tuple(plan.origin) + (0.0,)), pr.scalar(plan.spacing),
                      *(pr.v4(a) for a in plan.axes), pr.v4(plan.offset))

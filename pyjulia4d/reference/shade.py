@@ -13,10 +13,16 @@ from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 
 
 def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,
-               F: Formula = QUATERNION_SQR):
+               F: Formula = QUATERNION_SQR, lit=None):
     """Visibility of the light along o + t l (shade/light.cl shadow_ray): steps of max(d, step)
     by the estimate where F has one (soft: min(k 2d / t)), else samples every step; 0 at the
-    first inside point; the ray clipped to the bounding ball and to tmax."""
+    first inside point; the ray clipped to the bounding ball and to tmax.  Rays outside ``lit``
+    (a hit facing away from the light: its own shadow) trace nothing and get 0."""
+    if lit is not None:
+        vis = np.zeros(len(o))
+        vis[lit] = shadow_ray(o[lit], l[lit], np.asarray(tmax)[lit], c, max_iter, bailout, radius, step, softness,
+                              max_steps, soft, F)
+        return vis
     n = len(o)
     b = dot4(o, l)
     perp = o - b[:, None] * l
@@ -134,10 +140,8 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
         dist = np.linalg.norm(lv, axis=-1)
         # a hit facing away from the light is its own shadow, and traces none (shade/light.cl LIGHT_FACES)
         f = dot4(nw, np.asarray(light_pos, np.float64) - p) > 0
-        vis = np.zeros(len(k))
-        vis[f] = shadow_ray(o[f], lv[f] / np.maximum(dist[f], 1e-300)[:, None], dist[f], c, max_iter, bailout,
-                            radius, step, softness, max_steps, shadow == "soft", F)
-        out[k, 0] = vis
+        out[k, 0] = shadow_ray(o, lv / np.maximum(dist, 1e-300)[:, None], dist, c, max_iter, bailout, radius,
+                               step, softness, max_steps, shadow == "soft", F, lit=f)
     if ao:
         out[k, 1] = ambient_occlusion(p + bias * nw, nw, c, max_iter, bailout, ao_distance, ao_strength, F)
     if coloring == "iteration":
@@ -177,9 +181,7 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
         # facing the light (shade/light.cl LIGHT_FACES), or lit along the view where the light has
         # no direction in the rays' 3D space (shade.cl); else its own shadow
         f = (dot4(nw, to) > 0) | np.all(to_camera(to, frame) == 0, axis=-1)
-        vis = np.zeros(len(k))
-        vis[f] = shadow_ray(o[f], l[f], dist[f], c, max_iter, bailout, radius, step, softness, max_steps, soft, F)
-        out[k, j] = vis
+        out[k, j] = shadow_ray(o, l, dist, c, max_iter, bailout, radius, step, softness, max_steps, soft, F, lit=f)
     return out
 
 
