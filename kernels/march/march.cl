@@ -49,7 +49,7 @@
 #define CONE_ARGS
 #endif
 
-__kernel void march(const int n_items, const int tile_w, RAY_ARGS,
+PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
                     const int z_resolution, const int post_steps, const int max_steps,

@@ -112,7 +112,7 @@ inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *
 }
 
 /* LANES hit points per work-item (common/lanes.cl), like the march. */
-__kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
+PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real4 right, const real4 up, const real4 forward,
                                __global real4 *normal)

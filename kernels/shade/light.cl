@@ -135,7 +135,7 @@ inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 /* terms[i] = (visibility, ambient factor, colour value, 0) of hit i (normal in camera
  * coordinates: right, up, towards the eye; turned back into 4D with the camera frame;
  * the inside end of the bracket is point + bracket along the ray from the eye). */
-__kernel void light_terms(const int n_items, const int tile_w, __global const real4 *point, __global const real4 *normal,
+PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global const real4 *point, __global const real4 *normal,
                           __global const int *status, __global const real *bracket, const real4 eye, const real4 c, const int max_iter, const real bailout,
                           const real epsilon, const real4 right, const real4 up, const real4 forward,
                           const real4 light_pos, const real radius, const real step, const real bias,
