@@ -7,6 +7,10 @@ for the run and removed after) and the checkout render the same scene in child p
 alternate, --repeats pairs; each child renders once to build and warm, then --renders times,
 and reports the least time of each kernel (its OpenCL events, summed over the tiles) and the
 least CPU-seconds of a whole render (getrusage: the host's work and the kernels' threads).
+Each child starts with empty program caches (pyjulia4d's programs, pyopencl's and PoCL's
+caches in a folder of its own; the remembered default device and probes copied in), so its
+first render's wall time is the build of the scene's programs plus one render: what a new
+scene costs a user, as in the explorer.
 Reports the medians over the pairs and checkout / earlier; writes
 benchmarks/results/commit_ratio.md (a section per run: both commits, device, date).
 
@@ -16,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -27,10 +32,11 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
+from pyjulia4d.resources import cache_dir  # noqa: E402
 from bench_args import Parser, size_of  # noqa: E402
 
 CHILD = r"""
-import collections, json, resource, sys, warnings
+import collections, json, resource, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
 import pyjulia4d.opencl.executor as ex
@@ -44,7 +50,9 @@ def timed(queue, kernel, n, *args, **kw):
     events.append((kernel.function_name, e))
     return e
 home.launch = timed
+t_first = time.perf_counter()
 render(scene)
+first = time.perf_counter() - t_first
 def cpu():
     r = resource.getrusage(resource.RUSAGE_SELF)
     return r.ru_utime + r.ru_stime
@@ -61,14 +69,20 @@ for _ in range(renders):
             per[name] += (e.profile.end - e.profile.start) * 1e-9
     for name, s in per.items():
         best[name] = min(best.get(name, float("inf")), s)
-print(json.dumps({"kernels": best, "cpu": best_cpu, "device": device}))
+print(json.dumps({"kernels": best, "cpu": best_cpu, "first": first, "device": device}))
 """
 
 
 def child(tree: Path, renders: int, over: list[str]) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(tree))
-    p = subprocess.run([sys.executable, "-c", CHILD, str(renders), *over], cwd=tree, env=env, capture_output=True,
-                       text=True, timeout=3600)
+    """One child process in ``tree``, its program caches empty (the module docstring)."""
+    with tempfile.TemporaryDirectory() as cache:
+        for item in cache_dir().iterdir() if cache_dir().is_dir() else ():
+            if item.name != "programs":
+                (shutil.copytree if item.is_dir() else shutil.copy2)(item, Path(cache) / item.name)
+        env = dict(os.environ, PYTHONPATH=str(tree), PYJULIA4D_CACHE=cache, XDG_CACHE_HOME=str(Path(cache) / "xdg"),
+                   POCL_CACHE_DIR=str(Path(cache) / "pocl"))
+        p = subprocess.run([sys.executable, "-c", CHILD, str(renders), *over], cwd=tree, env=env,
+                           capture_output=True, text=True, timeout=3600)
     if p.returncode != 0:
         raise SystemExit(f"{tree}: {(p.stderr.strip().splitlines() or ['?'])[-1]}")
     return json.loads(p.stdout.strip().splitlines()[-1])
@@ -106,12 +120,13 @@ def main(argv=None) -> int:
                    key=lambda k: -statistics.median(r["kernels"].get(k, 0) for r in runs["checkout"]))
 
     def med(name: str, key: str) -> float:
-        vals = [r["kernels"].get(key, 0.0) for r in runs[name]] if key != "cpu" else [r["cpu"] for r in runs[name]]
+        vals = [r[key] for r in runs[name]] if key in ("cpu", "first") else [r["kernels"].get(key, 0.0) for r in runs[name]]
         return statistics.median(vals)
     rows = ["| measure | earlier s | checkout s | checkout / earlier |", "|---|---|---|---|"]
-    for key in names + ["cpu"]:
+    labels = {"cpu": "CPU-s of a render", "first": "first render from empty program caches, wall s"}
+    for key in names + ["cpu", "first"]:
         e, c = med("earlier", key), med("checkout", key)
-        label = f"kernel {key}" if key != "cpu" else "CPU-s of a render"
+        label = labels.get(key, f"kernel {key}")
         rows.append(f"| {label} | {e:.4f} | {c:.4f} | {c / e:.2f} |" if e > 0 else f"| {label} | - | {c:.4f} | - |")
     table = "\n".join(rows)
     print(table)
