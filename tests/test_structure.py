@@ -162,3 +162,26 @@ def test_degree_is_the_pieces_own(name: str) -> None:
     text = (kernel_dir() / "function" / f"{name}.cl").read_text()
     m = re.search(r"^#define FUNC_POWER (\d+)", text, re.M)
     assert (int(m.group(1)) if m else None) == registry.FUNCTIONS_TABLE[name].degree
+
+
+def _kernels() -> dict[str, tuple[str, str]]:
+    """Every kernel in kernels/: name -> (its declaration's qualifier, its body)."""
+    out = {}
+    for path in sorted(kernel_dir().rglob("*.cl")):
+        text = path.read_text()
+        heads = list(re.finditer(r"^(__kernel|PACKET_KERNEL) void (\w+)\(", text, re.M))
+        for i, m in enumerate(heads):
+            end = heads[i + 1].start() if i + 1 < len(heads) else len(text)
+            out[m.group(2)] = (m.group(1), text[m.end():end])
+    return out
+
+
+def test_packet_kernels_say_so() -> None:
+    """A kernel whose work-items each take LANES rays or blocks (common/lanes.cl) is declared
+    PACKET_KERNEL, whose vec_type_hint keeps Intel's compiler from vectorising it a second
+    time (half its build); any other keeps __kernel, which the runtime vectorises."""
+    kernels = _kernels()
+    assert {"march", "light_terms", "normals_jacobian", "cone_starts", "shade"} <= set(kernels)
+    for name, (qualifier, body) in kernels.items():
+        packet = "block_lanes(get_global_id(0)" in body or "get_global_id(0) * LANES" in body
+        assert qualifier == ("PACKET_KERNEL" if packet else "__kernel"), name

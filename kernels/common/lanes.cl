@@ -132,7 +132,7 @@ inline quat QSEL(quat a, quat b, lmask m)
 }
 #endif
 
-/* A kernel whose work-items each run a packet (march, light terms, Jacobian normals):
+/* A kernel whose work-items each run a packet (march, cone, light terms, Jacobian normals):
  * vec_type_hint says that it is vectorized by hand, so Intel's CPU compiler spends no time on
  * vectorizing it again across work-items: the default scene's march program of 16 lanes
  * built in 1.0-1.2 s instead of 1.8-2.1 s on Intel's CPU runtime, and every kernel ran as fast

@@ -20,7 +20,7 @@
 #define CONE_BLOCK 4
 #define CONE_SPREAD ((real)2.8285)    /* 2 sqrt(2), rounded up: pixels from the block's centre */
 
-__kernel void cone_starts(const int n_items, const int blocks_w, const int bx0, const int by0,
+PACKET_KERNEL void cone_starts(const int n_items, const int blocks_w, const int bx0, const int by0,
                           const real4 eye, const real4 forward, const real4 right, const real4 up,
                           const real tan_half_fov, const int image_w, const int image_h,
                           const real4 c, const int max_iter, const real bailout, const real radius,
