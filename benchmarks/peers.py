@@ -102,7 +102,8 @@ warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
 over = sys.argv[1:]
 s = Scene.default().with_overrides(over)
-PNG = ("color", "alpha")   # what `render -o picture.png` keeps (app/cli.py)
+from pyjulia4d.app.cli import CHANNEL_GROUPS
+PNG = CHANNEL_GROUPS["RGBA"]   # what `render -o picture.png` keeps
 render(s, outputs=PNG)
 def cpu():
     r = resource.getrusage(resource.RUSAGE_SELF)

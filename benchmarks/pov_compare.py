@@ -11,7 +11,8 @@ file: ``+FE File_Gamma=1.0``), which lets the normals be compared too.
 * Time: POV-Ray's own "Trace Time ... CPU-seconds total" (parsing and start-up left out,
   its threads summed) and its process's wall time; pyjulia4d's render in this process
   after a first one that builds the programs (CPU seconds of the process, PoCL's threads
-  included, and wall), at ``--size`` (default 640x480), median of ``--repeats``.
+  included, and wall), at ``--size`` (default 640x480), median of ``--repeats``; it keeps
+  what ``render -o picture.png`` keeps (colour and alpha), as POV-Ray writes a picture alone.
 * Silhouettes at ``--truth-size`` (default 160x120): the truth is
   ``reference.render`` (float64 numpy) of the converted scene with ``march.method=fixed``,
   ``z_resolution=2000``, ``post_steps=20``; agreement = share of pixels whose hit/miss
@@ -186,6 +187,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
     from pyjulia4d import render
+    from pyjulia4d.app.cli import CHANNEL_GROUPS
 
     w, h = size_of(a.size, "--size")
     tw, th = size_of(a.truth_size, "--truth-size")
@@ -207,11 +209,13 @@ def main(argv=None) -> int:
             truth_s = time.perf_counter() - t0
             # pyjulia4d: timed at the full size, compared at the truth's
             big = scene_of(text, w, h, tmp)
-            render(big)  # builds (or loads) the programs
+            # what `render -o picture.png` keeps, as POV-Ray writes a picture alone
+            png = CHANNEL_GROUPS["RGBA"]
+            render(big, outputs=png)  # builds (or loads) the programs
             runs = []
             for _ in range(a.repeats):
                 c0, t0 = _cpu(), time.perf_counter()
-                r = render(big)
+                r = render(big, outputs=png)
                 runs.append((_cpu() - c0, time.perf_counter() - t0, r.kernel_seconds))
                 device = r.device_name
             pj = render(small)
