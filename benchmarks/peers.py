@@ -100,10 +100,10 @@ CHILD = r"""
 import json, resource, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
-over = sys.argv[1:]
-s = Scene.default().with_overrides(over)
 from pyjulia4d.app.cli import CHANNEL_GROUPS
 PNG = CHANNEL_GROUPS["RGBA"]   # what `render -o picture.png` keeps
+over = sys.argv[1:]
+s = Scene.default().with_overrides(over)
 render(s, outputs=PNG)
 def cpu():
     r = resource.getrusage(resource.RUSAGE_SELF)

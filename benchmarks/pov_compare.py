@@ -189,6 +189,8 @@ def main(argv=None) -> int:
     from pyjulia4d import render
     from pyjulia4d.app.cli import CHANNEL_GROUPS
 
+    png = CHANNEL_GROUPS["RGBA"]   # what `render -o picture.png` keeps, as POV-Ray writes a picture alone
+
     w, h = size_of(a.size, "--size")
     tw, th = size_of(a.truth_size, "--truth-size")
     have_pov = shutil.which("povray") is not None
@@ -209,8 +211,6 @@ def main(argv=None) -> int:
             truth_s = time.perf_counter() - t0
             # pyjulia4d: timed at the full size, compared at the truth's
             big = scene_of(text, w, h, tmp)
-            # what `render -o picture.png` keeps, as POV-Ray writes a picture alone
-            png = CHANNEL_GROUPS["RGBA"]
             render(big, outputs=png)  # builds (or loads) the programs
             runs = []
             for _ in range(a.repeats):

@@ -189,10 +189,10 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     lreal ve[3] = {(lreal)1, (lreal)1, (lreal)1};
 #endif
     if (L_ANY(hit)) {   /* a block of misses (the background) has nothing to light */
+        quat o = QRAY(p, nw, (lreal)bias);   /* off the surface, outside: where shadow rays and occlusion start */
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
         {
             quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
-            quat o = QRAY(p, nw, (lreal)bias);     /* off the surface, outside */
             quat lv = QADD(lp, QSCALE((lreal)-1, o));
             lreal dist = QLEN(lv);
             quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
@@ -204,7 +204,6 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
         /* shading.lights: the same shadow ray towards each (a distant one: along its direction,
          * out of the bounding ball) */
         {
-            quat o = QRAY(p, nw, (lreal)bias);
             for (int j = 0; j < EXTRA_LIGHTS; ++j) {
                 real4 g = lights_geo[j];
                 quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
@@ -229,7 +228,7 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
         }
 #endif
 #ifdef AO
-        amb = ambient_occlusion(QRAY(p, nw, (lreal)bias), nw, jp, ao_distance, ao_strength);
+        amb = ambient_occlusion(o, nw, jp, ao_distance, ao_strength);
 #endif
 #if defined(COLOR_ITERATION)
         val = orbit_value(pin, jp);

@@ -375,7 +375,7 @@ def _outputs(channels: str | None, out: Path) -> tuple[str, ...] | None:
         kind = "PNG" if out.suffix.lower() == ".png" else "TIFF"
         if channels is not None and channels.strip().upper() != "RGBA":
             raise SceneError("--channels", f"{channels!r}: a {kind} holds RGBA only; write .exr for Z, N or P")
-        return ("color", "alpha")
+        return CHANNEL_GROUPS["RGBA"]
     if channels is None:
         return None
     groups = [g.strip().upper() for g in channels.split(",")]
