@@ -242,3 +242,30 @@ def test_closing_line_says_which_device_and_why(tmp_path):
     assert p.returncode == 0 and f"({why})" in p.stdout, p.stdout
     p = cli("--width", "8", "--height", "6", "-o", "b.png", "--device", idx, cwd=tmp_path)
     assert p.returncode == 0 and "the default" not in p.stdout, p.stdout
+
+
+def test_guard_counts_are_pixel_by_pixel_counts():
+    """count_guards ORs every flag first and counts only the flags that fired: the counts must be
+    those of a plain pixel-by-pixel count, with no flag, one flag, and every flag set somewhere
+    (normal_fallback and jacobian_tiny on hits alone; eye_hit: a hit at depth 0)."""
+    from pyjulia4d.pipeline.codes import (GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS,
+                                          GUARD_ULP_STEP, STATUS_CAPPED, STATUS_HIT, STATUS_MISS)
+    from pyjulia4d.pipeline.result import count_guards
+    flags = (GUARD_ULP_STEP, GUARD_NORMAL_FALLBACK, GUARD_JACOBIAN_TINY, GUARD_SHELL_MISS)
+    rng = np.random.default_rng(7)
+    for case in range(12):
+        n = 3000
+        status = rng.choice([STATUS_MISS, STATUS_HIT, STATUS_CAPPED], n).astype(np.int32)
+        depth = np.where(status == STATUS_HIT, rng.uniform(0, 3, n), np.inf).astype(np.float32)
+        depth[rng.random(n) < (0.01 if case % 3 else 0)] = 0.0
+        guard = np.zeros(n, np.int32)
+        for f in flags[:case % 5]:
+            guard[rng.random(n) < 0.02] |= f
+        got = count_guards(status.reshape(50, 60), depth.reshape(50, 60), guard.reshape(50, 60))
+        hit = status == STATUS_HIT
+        want = {"ulp_step": int(np.sum(guard & GUARD_ULP_STEP != 0)),
+                "normal_fallback": int(np.sum((guard & GUARD_NORMAL_FALLBACK != 0) & hit)),
+                "jacobian_tiny": int(np.sum((guard & GUARD_JACOBIAN_TINY != 0) & hit)),
+                "shell_miss": int(np.sum(guard & GUARD_SHELL_MISS != 0)),
+                "eye_hit": int(np.sum(hit & (depth == 0)))}
+        assert got == want, case

@@ -154,7 +154,9 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
             counts[name] += int(np.count_nonzero(st == code))
         guard = got["flags"][own]
         if "normal" in got:  # guard flags (kernels/common/codes.cl): the march's buffer and the normals' w
-            guard = guard | got["normal"][own][..., 3].astype(np.int32)
+            nw = got["normal"][own][..., 3]
+            if nw.any():   # rarely: most tiles' normals raise no flag
+                guard = guard | nw.astype(np.int32)
         add_counts(guards, count_guards(st, got["depth"][own], guard))
         if "color" in keep:
             img["color"][dst] = got["rgba"][own][..., :3]

@@ -226,12 +226,17 @@ def add_counts(total: dict[str, int], more: dict[str, int]) -> dict[str, int]:
 def count_guards(status, depth, guard) -> dict[str, int]:
     """Pixels each numerical guard fired on (nothing clamped without being counted).
     ``guard`` holds the flags (kernels/common/codes.cl) of the march kernel's flags buffer ORed
-    with those the normals kernels write into the normal's w."""
+    with those the normals kernels write into the normal's w.  Guards are rare: one pass ORs
+    every pixel's flags, and only the flags that fired anywhere are counted pixel by pixel."""
     status, guard = (np.asarray(a).ravel() for a in (status, guard))
-    hit = status == STATUS_HIT
     guard = guard.astype(np.int32, copy=False)
+    fired_any = int(np.bitwise_or.reduce(guard)) if guard.size else 0
+    zero = np.asarray(depth).ravel() == 0
+    hit = status == STATUS_HIT if fired_any & (GUARD_NORMAL_FALLBACK | GUARD_JACOBIAN_TINY) or zero.any() else None
 
     def fired(flag, on=None):
+        if not fired_any & flag:
+            return 0
         m = (guard & flag) != 0
         return int(np.count_nonzero(m if on is None else m & on))
 
@@ -245,5 +250,5 @@ def count_guards(status, depth, guard) -> dict[str, int]:
         # de: within epsilon of the set by the estimate, yet no point inside: a miss (march/de.cl)
         "shell_miss": fired(GUARD_SHELL_MISS),
         # the hit is the eye itself, depth 0 (camera inside the set; shade.cl takes the view axis)
-        "eye_hit": int(np.count_nonzero(hit & (np.asarray(depth).ravel() == 0))),
+        "eye_hit": int(np.count_nonzero(hit & zero)) if hit is not None else 0,
     }
