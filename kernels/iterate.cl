@@ -75,19 +75,31 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
     return ratio * log(mq) / (real)4;
 }
 
+/* dm2 = mantissa * 2^e where big */
+#define DE_RESCALE(dm2, e, big) do { \
+        lint k_; \
+        lreal mant_ = frexp(dm2, &k_); \
+        dm2 = L_SEL(dm2, mant_, big); \
+        e = L_SEL(e, e + L_MASK(k_), big); \
+    } while (0)
+
 /* dm2 *= factor where live, rescaled as mantissa * 2^e long before float32 overflows */
 #define DE_GROW(dm2, e, factor, live) do { \
         dm2 = L_SEL(dm2, dm2 * (factor), live); \
         lmask big_ = (live) & (dm2 > (real)1e16); \
-        if (L_ANY(big_)) { \
-            lint k_; \
-            lreal mant_ = frexp(dm2, &k_); \
-            dm2 = L_SEL(dm2, mant_, big_); \
-            e = L_SEL(e, e + L_MASK(k_), big_); \
-        } \
+        if (L_ANY(big_)) \
+            DE_RESCALE(dm2, e, big_); \
     } while (0)
 
 #ifndef ALG_SPLIT
+/* one step of the estimate's orbit where live: q <- f(q) + c, |q'|^2 (dm2 * 2^e) grown */
+#define DE_ORBIT_STEP(q, m2, dm2, e, live, c, bailout2) do { \
+        DE_GROW(dm2, e, JULIA_DF2(m2), live); \
+        q = QSEL(q, julia_f(q, c), live); \
+        m2 = ALG_NORM2(q); \
+        live = m2 <= (bailout2); \
+    } while (0)
+
 inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat q = ALG_IN(p);
@@ -97,16 +109,48 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
     lmask e = 0;                    /* dm2 is really dm2 * 2^e */
     lmask live = m2 <= jp.bailout2;
     int n = 0;
-    for (; n < jp.max_iter && L_ANY(live); ++n) {
-        DE_GROW(dm2, e, JULIA_DF2(m2), live);
-        q = QSEL(q, julia_f(q, c), live);
-        m2 = ALG_NORM2(q);
-        live = m2 <= jp.bailout2;
-    }
+    for (; n < jp.max_iter && L_ANY(live); ++n)
+        DE_ORBIT_STEP(q, m2, dm2, e, live, c, jp.bailout2);
     COUNT_ITER(jp, n);
     *escaped = m2 > jp.bailout2;
     return de_value(m2, dm2, e);
 }
+
+#ifdef PACKET_PAIRS
+/* The estimates of two packets (march/de.cl march_ray_pair) in one loop, lane for lane the
+ * values julia_distance_formula gives.  Each orbit is a chain of dependent operations that
+ * leaves most of a CPU's vector units idle while it waits on the last result; two chains
+ * side by side fill them (kernels/march/march.cl, PACKET_PAIRS). */
+inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
+                                        lreal *da, lreal *db)
+{
+    quat qa = ALG_IN(pa), qb = ALG_IN(pb);
+    real4 c = ALG_C(jp.c);
+    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb);
+    lreal dm2a = (lreal)1, dm2b = (lreal)1;
+    lmask ea = 0, eb = 0;
+    lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2;
+    for (int n = 0; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
+        dm2a = L_SEL(dm2a, dm2a * JULIA_DF2(m2a), live_a);
+        dm2b = L_SEL(dm2b, dm2b * JULIA_DF2(m2b), live_b);
+        lmask big_a = live_a & (dm2a > (real)1e16), big_b = live_b & (dm2b > (real)1e16);
+        if (L_ANY(big_a | big_b)) {
+            DE_RESCALE(dm2a, ea, big_a);
+            DE_RESCALE(dm2b, eb, big_b);
+        }
+        qa = QSEL(qa, julia_f(qa, c), live_a);
+        qb = QSEL(qb, julia_f(qb, c), live_b);
+        m2a = ALG_NORM2(qa);
+        m2b = ALG_NORM2(qb);
+        live_a = m2a <= jp.bailout2;
+        live_b = m2b <= jp.bailout2;
+    }
+    *escaped_a = m2a > jp.bailout2;
+    *escaped_b = m2b > jp.bailout2;
+    *da = de_value(m2a, dm2a, ea);
+    *db = de_value(m2b, dm2b, eb);
+}
+#endif
 #else
 /* A split algebra (algebra/hypercomplex.cl): h = a e1 + b e2, and the Julia set of a
  * polynomial is the product K_a x K_b of the two complex filled Julia sets.  In C^2 the

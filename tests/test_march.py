@@ -13,11 +13,11 @@ from pyjulia4d.scene.model import Scene
 W, H = 48, 36
 
 
-def run_march(s: Scene, lanes: int = 1):
-    """Kernel and reference on the same (float32-representable) rays of a small image."""
-    R = Runner(kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
-               else kernel_config.scene_config(s, ray_buffers=True))
-    o, d = ref.generate_rays(camera_frame(s), W, H)
+def march_kernel(s: Scene, config, lanes: int, w: int = W, h: int = H):
+    """The march kernel of ``config`` on the (float32-representable) rays of a small image:
+    its outputs, the rays and the march's arguments."""
+    R = Runner(config)
+    o, d = ref.generate_rays(camera_frame(s), w, h)
     o, d = o.astype(R.real).astype(float), d.astype(R.real).astype(float)
     f, m = s.fractal, s.march
     n = len(o)
@@ -27,18 +27,30 @@ def run_march(s: Scene, lanes: int = 1):
     flags, bracket, unresolved = R.out(n, np.int32), R.out(n), R.out(n)
     args = (f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), near, far,
             m.z_resolution, m.post_steps, m.max_steps)
-    R("march", (n,), np.int32(W), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
+    R("march", (n,), np.int32(w), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
       R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(near), R.scalar(far),
       np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples, flags, bracket, unresolved, items=march_items(n, W, lanes))
-    k = (depth.get().astype(float), R.get4(point), status.get(), samples.get(),
-         bracket.get().astype(float))
+      depth, point, status, samples, flags, bracket, unresolved,
+      items=march_items(n, w, lanes, kernel_config.config_packets(config)))
+    out = {"depth": depth.get(), "point": R.get4(point), "status": status.get(), "samples": samples.get(),
+           "flags": flags.get(), "bracket": bracket.get(), "unresolved": unresolved.get()}
+    return out, o, d, args
+
+
+def run_march(s: Scene, lanes: int = 1):
+    """Kernel and reference on the same (float32-representable) rays of a small image."""
+    config = (kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
+              else kernel_config.scene_config(s, ray_buffers=True))
+    out, o, d, args = march_kernel(s, config, lanes)
+    k = (out["depth"].astype(float), out["point"], out["status"], out["samples"], out["bracket"].astype(float))
+    m = s.march
+    n = len(o)
     rflags = np.zeros(n, np.int32)
     rbracket = np.zeros(n)
     r = ref.march(o, d, *args, m.method, rflags, m.refine, rbracket) + (rbracket,)
     # the guard flags (kernels/common/codes.cl) agree wherever the statuses do
     same = k[2] == r[2]
-    assert np.array_equal(flags.get()[same], rflags[same])
+    assert np.array_equal(out["flags"][same], rflags[same])
     return k, r
 
 
@@ -159,3 +171,41 @@ def test_itp_needs_fewer_set_tests_than_bisection():
         assert np.all(n_itp <= steps + 1) and np.all(n_bis == steps)
         # measured: median 4 tests for 10 steps, 5 for 20 (c = -0.2+0.8i, max_iter 12)
         assert np.median(n_itp) <= steps / 2
+
+
+@pytest.mark.parametrize("over,size", [
+    ([], (48, 36)),
+    # 37 blocks to a row: the last work-item's second packet lies past the tile's edge
+    (["fractal.c=0.4,0.5,0,0"], (146, 9)),
+    # |q'|^2 rescaled (iterate.cl DE_RESCALE) in both packets' orbits; shell steps, refinement
+    (["fractal.max_iter=60", "fractal.bailout=50", "march.epsilon=1e-4"], (40, 20)),
+    (["fractal.function=cube", "fractal.c=0.3,0.5,0.1,0", "fractal.theta=30"], (44, 28)),
+])
+def test_packet_pairs_give_the_single_packets_pixels(over, size):
+    """Two packets per work-item (-D PACKET_PAIRS: march/de.cl march_ray_pair, their estimates side
+    by side) take the same steps lane for lane as one packet per work-item: every output equal,
+    bit for bit, whatever the tile's shape."""
+    lanes = max(packet_widths((8, 16)), default=None)
+    if lanes is None:
+        pytest.skip("no packet width on this device")
+    s = Scene.default().with_overrides(["march.method=de", *over])
+    pairs = kernel_config.march_config(s, lanes, ray_buffers=True)
+    assert kernel_config.config_packets(pairs) == 2
+    single = kernel_config.KernelConfig(pairs.pieces, tuple(x for x in pairs.defines if x != "PACKET_PAIRS"))
+    a, _, _, _ = march_kernel(s, pairs, lanes, *size)
+    b, _, _, _ = march_kernel(s, single, lanes, *size)
+    assert (a["status"] == 1).any() and (a["status"] != 1).any()
+    for key in a:
+        assert np.array_equal(a[key], b[key], equal_nan=True), key
+
+
+def test_packet_pairs_only_where_the_estimate_is_the_iterations():
+    """march_packets: pairs for the estimate's march of a Julia set in packets; one packet for one ray
+    per work-item, the other marches, the split algebras' and the other kinds' estimates."""
+    d = Scene.default()
+    assert kernel_config.march_packets(d, 16) == 2
+    assert kernel_config.march_packets(d, 1) == 1
+    for over in (["march.method=fixed"], ["march.method=proven"], ["fractal.algebra=hypercomplex"],
+                 ["fractal.kind=mandelbrot"]):
+        assert kernel_config.march_packets(d.with_overrides(over), 16) == 1, over
+    assert march_items(48 * 36, 48, 16, 2) == 6 * 9 and march_items(146 * 9, 146, 16, 2) == 19 * 3

@@ -183,5 +183,6 @@ def test_packet_kernels_say_so() -> None:
     kernels = _kernels()
     assert {"march", "light_terms", "normals_jacobian", "cone_starts", "shade"} <= set(kernels)
     for name, (qualifier, body) in kernels.items():
-        packet = "block_lanes(get_global_id(0)" in body or "get_global_id(0) * LANES" in body
+        packet = any(s in body for s in ("block_lanes(get_global_id(0)", "packet_lanes(get_global_id(0)",
+                                         "get_global_id(0) * LANES"))
         assert qualifier == ("PACKET_KERNEL" if packet else "__kernel"), name

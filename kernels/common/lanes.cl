@@ -145,16 +145,18 @@ inline quat QSEL(quat a, quat b, lmask m)
 #endif
 
 #if LANES > 1
-/* The pixels of work-item g's packet, the g-th BLOCK_W x BLOCK_H block of a tile tile_w wide
- * and n_items / tile_w high, in rows of blocks: lane_index[k] is lane k's pixel, n_items for
- * a lane past the tile's edge; 0 where the block lies below the tile (a padded launch).  Lane
- * 0's pixel is always in the tile. */
-inline int block_lanes(size_t g, int n_items, int tile_w, size_t *lane_index)
+/* The pixels of packet p of work-item g, which takes `packets` neighbouring BLOCK_W x BLOCK_H
+ * blocks of a tile tile_w wide and n_items / tile_w high (rows of blocks, each row's blocks
+ * grouped `packets` to a work-item): lane_index[k] is lane k's pixel, n_items for a lane
+ * past the tile's edge (all of them in a packet past its right edge); returns 0 where the
+ * work-item lies below the tile (a padded launch).  Packet 0's lane 0 is always in the tile. */
+inline int packet_lanes(size_t g, int p, int packets, int n_items, int tile_w, size_t *lane_index)
 {
     int tile_h = n_items / tile_w;
     int blocks_x = (tile_w + BLOCK_W - 1) / BLOCK_W;
-    int bx = (int)(g % (size_t)blocks_x) * BLOCK_W;
-    int by = (int)(g / (size_t)blocks_x) * BLOCK_H;
+    int groups_x = (blocks_x + packets - 1) / packets;
+    int bx = ((int)(g % (size_t)groups_x) * packets + p) * BLOCK_W;
+    int by = (int)(g / (size_t)groups_x) * BLOCK_H;
     if (by >= tile_h)
         return 0;
     for (int k = 0; k < LANES; ++k) {
@@ -162,5 +164,11 @@ inline int block_lanes(size_t g, int n_items, int tile_w, size_t *lane_index)
         lane_index[k] = x < tile_w && y < tile_h ? (size_t)y * tile_w + x : (size_t)n_items;
     }
     return 1;
+}
+
+/* one packet per work-item: the g-th block */
+inline int block_lanes(size_t g, int n_items, int tile_w, size_t *lane_index)
+{
+    return packet_lanes(g, 0, 1, n_items, tile_w, lane_index);
 }
 #endif

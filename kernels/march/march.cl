@@ -49,6 +49,15 @@
 #define CONE_ARGS
 #endif
 
+/* -D PACKET_PAIRS (packets, march/de.cl only): each work-item marches two neighbouring blocks,
+ * their estimates side by side (march_ray_pair), where one packet's chain of dependent
+ * operations would leave the vector units idle; pipeline/kernel_config.py march_packets. */
+#if defined(PACKET_PAIRS) && LANES > 1
+#define PACKETS 2
+#else
+#define PACKETS 1
+#endif
+
 PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,
@@ -57,116 +66,142 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
                     __global int *status, __global int *samples, __global int *flags,
                     __global real *bracket, __global real *unresolved COUNTER_ARG CLIP_ARGS CONE_ARGS)
 {
-    /* LANES neighbouring rays per work-item (common/lanes.cl): one ray, or a block of BLOCK_W x
-     * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high); launches are padded
-     * to whole work-groups (render.launch) and a block may reach past the tile's edges */
+    /* LANES neighbouring rays per packet (common/lanes.cl): one ray, or a block of BLOCK_W x
+     * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high), PACKETS packets per
+     * work-item; launches are padded to whole work-groups (render.launch) and a block may
+     * reach past the tile's edges */
 #if LANES == 1
     size_t i0 = get_global_id(0);
     if (i0 >= (size_t)n_items)
         return;
 #else
-    size_t lane_index[LANES];
-    if (!block_lanes(get_global_id(0), n_items, tile_w, lane_index))
-        return;
-    /* a lane past the tile's edge repeats the block's first pixel and is not written */
-    size_t i0 = lane_index[0];
+    size_t lane_index[PACKETS][LANES];
+    for (int p = 0; p < PACKETS; ++p)
+        if (!packet_lanes(get_global_id(0), p, PACKETS, n_items, tile_w, lane_index[p]))
+            return;
+    /* a lane past the tile's edge repeats the first packet's first pixel and is not written */
+    size_t i0 = lane_index[0][0];
 #endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter COUNTER_INIT(i0) };
-    quat o, d;
-    lmask valid;
-#if LANES == 1
-    RAY_AT(i0, o, d);
-    valid = 1;
-#else
-    for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
-        size_t i = lane_index[k] < (size_t)n_items ? lane_index[k] : i0;
-        real4 ok, dk;
-        RAY_AT(i, ok, dk);
-        ((real *)&o.x)[k] = ok.x; ((real *)&o.y)[k] = ok.y;
-        ((real *)&o.z)[k] = ok.z; ((real *)&o.w)[k] = ok.w;
-        ((real *)&d.x)[k] = dk.x; ((real *)&d.y)[k] = dk.y;
-        ((real *)&d.z)[k] = dk.z; ((real *)&d.w)[k] = dk.w;
-        ((mask_t *)&valid)[k] = lane_index[k] < (size_t)n_items ? -1 : 0;
-    }
-#endif
-
-    lreal near, far;
-    lmask live = valid & ball_span(o, d, radius, near_set, far_set, &near, &far);
+    quat o[PACKETS], d[PACKETS];
+    lreal near[PACKETS], far[PACKETS], start[PACKETS];
+    lmask live[PACKETS];
 #ifdef CLIP
-    lmask cut = 0;                  /* 1 + the plane that set near, 0: the ball did */
-    for (int k = 0; k < n_clip; ++k) {
-        real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
-        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
-        lreal dn = QDOT_UNIFORM(d, nk), on = QDOT_UNIFORM(o, nk) - off;
-        lreal tp = -on / dn;
-        far = L_SEL(far, fmin(far, tp), dn > (real)0);
-        lmask raise = (dn < (real)0) & (tp > near);
-        near = L_SEL(near, tp, raise);
-        cut = L_SEL(cut, (lmask)(k + 1), raise);
-        live &= !((dn == (real)0) & (on > (real)0));
-    }
+    lmask cut[PACKETS];             /* 1 + the plane that set near, 0: the ball did */
 #endif
-    live &= far >= near;
-    lreal start = near;
 #ifdef CONE_START
-    lreal t_lo, t_last;
+    lmask coned[PACKETS];
+#endif
+    for (int p = 0; p < PACKETS; ++p) {
+        lmask valid;
 #if LANES == 1
-    real2 cv = cone[CONE_AT(i0)];
-    t_lo = cv.x;
-    t_last = cv.y;
+        RAY_AT(i0, o[p], d[p]);
+        valid = 1;
 #else
-    for (int k = 0; k < LANES; ++k) {
-        real2 cv = cone[CONE_AT(lane_index[k] < (size_t)n_items ? lane_index[k] : i0)];
-        ((real *)&t_lo)[k] = cv.x;
-        ((real *)&t_last)[k] = cv.y;
-    }
+        for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
+            size_t i = lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0;
+            real4 ok, dk;
+            RAY_AT(i, ok, dk);
+            ((real *)&o[p].x)[k] = ok.x; ((real *)&o[p].y)[k] = ok.y;
+            ((real *)&o[p].z)[k] = ok.z; ((real *)&o[p].w)[k] = ok.w;
+            ((real *)&d[p].x)[k] = dk.x; ((real *)&d[p].y)[k] = dk.y;
+            ((real *)&d[p].z)[k] = dk.z; ((real *)&d[p].w)[k] = dk.w;
+            ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
+        }
 #endif
-    lmask coned = live & (t_last > near) & (near >= t_lo) & (t_last < far);
-    start = L_SEL(near, t_last, coned);
+        live[p] = valid & ball_span(o[p], d[p], radius, near_set, far_set, &near[p], &far[p]);
+#ifdef CLIP
+        cut[p] = 0;
+        for (int k = 0; k < n_clip; ++k) {
+            real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
+            real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
+            lreal dn = QDOT_UNIFORM(d[p], nk), on = QDOT_UNIFORM(o[p], nk) - off;
+            lreal tp = -on / dn;
+            far[p] = L_SEL(far[p], fmin(far[p], tp), dn > (real)0);
+            lmask raise = (dn < (real)0) & (tp > near[p]);
+            near[p] = L_SEL(near[p], tp, raise);
+            cut[p] = L_SEL(cut[p], (lmask)(k + 1), raise);
+            live[p] &= !((dn == (real)0) & (on > (real)0));
+        }
 #endif
-    lmask st = STATUS_MISS, n = 0, fl = 0;
-    lreal t = INFINITY, width = INFINITY, unres = 0;
-    if (L_ANY(live))
-        t = march_ray(o, d, start, far, live, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
-                      &width, &unres);
+        live[p] &= far[p] >= near[p];
+        start[p] = near[p];
 #ifdef CONE_START
-    /* a first point inside: the cone's estimate was wrong for this ray; march it from its entry */
-    lmask redo = coned & (st == STATUS_HIT) & (width == (real)0);
-    if (L_ANY(redo)) {
-        lreal t2 = march_ray(o, d, near, far, redo, jp, z_resolution, post_steps, max_steps, &st, &n, &fl,
-                             &width, &unres);
-        t = L_SEL(t, t2, redo);
+        lreal t_lo, t_last;
+#if LANES == 1
+        real2 cv = cone[CONE_AT(i0)];
+        t_lo = cv.x;
+        t_last = cv.y;
+#else
+        for (int k = 0; k < LANES; ++k) {
+            real2 cv = cone[CONE_AT(lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0)];
+            ((real *)&t_lo)[k] = cv.x;
+            ((real *)&t_last)[k] = cv.y;
+        }
+#endif
+        coned[p] = live[p] & (t_last > near[p]) & (near[p] >= t_lo) & (t_last < far[p]);
+        start[p] = L_SEL(near[p], t_last, coned[p]);
+#endif
     }
-    /* the estimate proves nothing: unresolved is measured from the entry, as without the cone */
-    unres = L_SEL(unres, unres + (start - near), coned & !redo);
+    lmask st[PACKETS], n[PACKETS], fl[PACKETS];
+    lreal t[PACKETS], width[PACKETS], unres[PACKETS];
+    for (int p = 0; p < PACKETS; ++p) {
+        st[p] = STATUS_MISS;
+        n[p] = fl[p] = 0;
+        t[p] = width[p] = INFINITY;
+        unres[p] = 0;
+    }
+#if PACKETS == 2
+    if (L_ANY(live[0] | live[1]))
+        march_ray_pair(o, d, start, far, live, jp, post_steps, max_steps, st, n, fl, width, unres, t);
+#else
+    if (L_ANY(live[0]))
+        t[0] = march_ray(o[0], d[0], start[0], far[0], live[0], jp, z_resolution, post_steps, max_steps,
+                         &st[0], &n[0], &fl[0], &width[0], &unres[0]);
+#endif
+    for (int p = 0; p < PACKETS; ++p) {
+#ifdef CONE_START
+        /* a first point inside: the cone's estimate was wrong for this ray; march it from its entry */
+        lmask redo = coned[p] & (st[p] == STATUS_HIT) & (width[p] == (real)0);
+        if (L_ANY(redo)) {
+            lreal t2 = march_ray(o[p], d[p], near[p], far[p], redo, jp, z_resolution, post_steps, max_steps,
+                                 &st[p], &n[p], &fl[p], &width[p], &unres[p]);
+            t[p] = L_SEL(t[p], t2, redo);
+        }
+        /* the estimate proves nothing: unresolved is measured from the entry, as without the cone */
+        unres[p] = L_SEL(unres[p], unres[p] + (start[p] - near[p]), coned[p] & !redo);
 #endif
 #ifdef CLIP
-    fl |= L_SEL((lmask)0, (lmask)FLAG_CUT_FACE | ((cut - 1) << 5), (st == STATUS_HIT) & (width == (real)0) & (cut > 0));
+        fl[p] |= L_SEL((lmask)0, (lmask)FLAG_CUT_FACE | ((cut[p] - 1) << 5),
+                       (st[p] == STATUS_HIT) & (width[p] == (real)0) & (cut[p] > 0));
 #endif
 #if LANES == 1
-    depth[i0] = t;
-    point[i0] = st == STATUS_HIT ? o + t * d : (real4)(NAN);
-    status[i0] = st;
-    samples[i0] = n;
-    flags[i0] = fl;
-    bracket[i0] = st == STATUS_HIT ? width : INFINITY;
-    unresolved[i0] = unres;
+        depth[i0] = t[p];
+        point[i0] = st[p] == STATUS_HIT ? o[p] + t[p] * d[p] : (real4)(NAN);
+        status[i0] = st[p];
+        samples[i0] = n[p];
+        flags[i0] = fl[p];
+        bracket[i0] = st[p] == STATUS_HIT ? width[p] : INFINITY;
+        unresolved[i0] = unres[p];
 #else
-    for (int k = 0; k < LANES; ++k) {   /* scatter */
-        size_t i = lane_index[k];
-        if (i >= (size_t)n_items)
-            continue;
-        real tk = ((real *)&t)[k];
-        int sk = ((mask_t *)&st)[k];
-        real4 ok = (real4)(((real *)&o.x)[k], ((real *)&o.y)[k], ((real *)&o.z)[k], ((real *)&o.w)[k]);
-        real4 dk = (real4)(((real *)&d.x)[k], ((real *)&d.y)[k], ((real *)&d.z)[k], ((real *)&d.w)[k]);
-        depth[i] = tk;
-        point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
-        status[i] = sk;
-        samples[i] = ((mask_t *)&n)[k];
-        flags[i] = ((mask_t *)&fl)[k];
-        bracket[i] = sk == STATUS_HIT ? ((real *)&width)[k] : INFINITY;
-        unresolved[i] = ((real *)&unres)[k];
-    }
+        for (int k = 0; k < LANES; ++k) {   /* scatter */
+            size_t i = lane_index[p][k];
+            if (i >= (size_t)n_items)
+                continue;
+            real tk = ((real *)&t[p])[k];
+            int sk = ((mask_t *)&st[p])[k];
+            real4 ok = (real4)(((real *)&o[p].x)[k], ((real *)&o[p].y)[k], ((real *)&o[p].z)[k],
+                               ((real *)&o[p].w)[k]);
+            real4 dk = (real4)(((real *)&d[p].x)[k], ((real *)&d[p].y)[k], ((real *)&d[p].z)[k],
+                               ((real *)&d[p].w)[k]);
+            depth[i] = tk;
+            point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
+            status[i] = sk;
+            samples[i] = ((mask_t *)&n[p])[k];
+            flags[i] = ((mask_t *)&fl[p])[k];
+            bracket[i] = sk == STATUS_HIT ? ((real *)&width[p])[k] : INFINITY;
+            unresolved[i] = ((real *)&unres[p])[k];
+        }
 #endif
+    }
 }

@@ -112,7 +112,7 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
             _run_tiles(probe, tiles, lambda t, got: None, events, silent())
             probe.close()
             big = max(plan.tiles, key=lambda t: t.n)
-            groups = -(-march_items(big.n, big.aw, plan.lanes) // local_size(probe.march_k, dev))
+            groups = -(-march_items(big.n, big.aw, plan.lanes, plan.march_packets) // local_size(probe.march_k, dev))
             return _seconds(events) / max(1, min(dev.max_compute_units, groups))
 
         prediction = predict(plan, run_probe)

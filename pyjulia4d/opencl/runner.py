@@ -74,13 +74,15 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
     return _local[key]
 
 
-def march_items(n: int, tile_w: int, lanes: int) -> int:
+def march_items(n: int, tile_w: int, lanes: int, packets: int = 1) -> int:
     """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
-    per block of pixels (kernels/march/march.cl)."""
+    per ``packets`` neighbouring blocks of pixels in a row (kernels/march/march.cl,
+    kernel_config.march_packets; the light terms and normals take one block each)."""
     if lanes == 1:
         return n
     bw, bh = kernel_config.packet_block(lanes)
-    return -(-tile_w // bw) * -(-(n // tile_w) // bh)
+    blocks_x = -(-tile_w // bw)
+    return -(-blocks_x // packets) * -(-(n // tile_w) // bh)
 
 
 def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
@@ -247,7 +249,7 @@ class TileRunner:
                               np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const,
                               bufs["depth"].data, bufs["point"].data, bufs["status"].data, bufs["samples"].data,
                               bufs["flags"].data, bufs["bracket"].data, bufs["unresolved"].data, *self.clip_args,
-                              *cone, items=march_items(n, tile.aw, plan.lanes)))
+                              *cone, items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
         if plan.normals:
             method = plan.scene.normals.method
             packet = plan.normals_in_march_config
@@ -289,7 +291,7 @@ class TileRunner:
                          *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
                          bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data,
                          bufs["unresolved2"].data, *self.clip_args,
-                         items=march_items(n, tile.aw, plan.lanes)))
+                         items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
         packet = plan.normals_in_march_config
         ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
                                  plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],

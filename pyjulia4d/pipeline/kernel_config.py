@@ -194,6 +194,23 @@ def packet_block(lanes: int) -> tuple[int, int]:
     return PACKET_BLOCKS.get(lanes, (lanes, 1))
 
 
+def march_packets(scene: Scene, lanes: int) -> int:
+    """Packets of ``lanes`` rays that a work-item of the march takes (kernels/march/march.cl): two
+    (-D PACKET_PAIRS), their estimates computed side by side, where the march steps by the
+    iteration's own estimate (the distance-estimate march of a Julia set of an algebra that is
+    not split: iterate.cl julia_distance_formula_pair); one otherwise, and with one ray per
+    work-item (GPUs run many work-items at once instead)."""
+    f = scene.fractal
+    pairs = (lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
+             and not ALGEBRAS_TABLE[f.algebra].split)
+    return 2 if pairs else 1
+
+
+def config_packets(config: KernelConfig) -> int:
+    """The march's packets per work-item in a program built from ``config`` (march_packets)."""
+    return 2 if "PACKET_PAIRS" in config.defines else 1
+
+
 def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
     """The march's program: the march, its cone, the Jacobian normals when the scene uses them and
     the light terms, with ``lanes`` rays per work-item (-D LANES, kernels/common/lanes.cl; 1:
@@ -212,7 +229,8 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
     if lanes == 1:
         return KernelConfig(pieces, defines)
     bw, bh = packet_block(lanes)
-    return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}"))
+    pairs = ("PACKET_PAIRS",) if march_packets(scene, lanes) == 2 else ()
+    return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}") + pairs)
 
 
 

@@ -239,6 +239,11 @@ class Plan:
         return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
 
     @property
+    def march_packets(self) -> int:
+        """Packets of rays a work-item of the march takes (kernel_config.march_packets)."""
+        return kernel_config.config_packets(self.march_config)
+
+    @property
     def normals_in_march_config(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
         return self.scene.normals.method == "jacobian"

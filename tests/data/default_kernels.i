@@ -190,12 +190,8 @@ lreal dm2 = (lreal)1;
 lmask e = 0;
 lmask live = m2 <= jp.bailout2;
 int n = 0;
-for (; n < jp.max_iter && (live); ++n) {
-do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) { lint k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + (k_)) : (e)); } } while (0);
-q = ((live) ? (julia_f(q, c)) : (q));
-m2 = dot((q), (q));
-live = m2 <= jp.bailout2;
-}
+for (; n < jp.max_iter && (live); ++n)
+do { do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) do { lint k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + (k_)) : (e)); } while (0); } while (0); q = ((live) ? (julia_f(q, c)) : (q)); m2 = dot((q), (q)); live = m2 <= (jp.bailout2); } while (0);
 ;
 *escaped = m2 > jp.bailout2;
 return de_value(m2, dm2, e);
@@ -244,50 +240,79 @@ live &= b - a > (real)2 * eps;
 *width = b - a;
 return a;
 }
+typedef struct {
+lreal t, t_prev, omega, step, r_prev;
+lmask active, shell, hit, miss, first;
+} de_march;
+inline de_march de_start(lreal near, lmask live)
+{
+de_march m;
+m.t = m.t_prev = near;
+m.omega = (lreal)((real)1.2);
+m.step = m.r_prev = (lreal)0;
+m.active = live;
+m.shell = m.hit = m.miss = m.first = (lmask)0;
+return m;
+}
+inline void de_leave(de_march *m, int i, lreal far, lmask *samples)
+{
+lmask out = m->active & (m->t > far);
+*samples = ((out) ? ((lmask)i) : (*samples));
+m->miss |= out;
+m->active &= !out;
+}
+inline void de_advance(de_march *m, int i, lreal dist, lmask escaped, real epsilon, lmask *samples,
+lmask *flags)
+{
+lreal r = ((escaped) ? (dist) : ((lreal)0));
+lmask gap = m->active & (m->omega > (real)1) & (r + m->r_prev < m->step);
+lmask got = m->active & !escaped & !gap;
+*samples = ((got) ? ((lmask)(i + 1)) : (*samples));
+m->hit |= got;
+if (i == 0)
+m->first = got;
+m->active &= !got;
+m->shell |= m->active & !gap & (dist < epsilon);
+m->step = ((gap) ? (m->step * ((real)1 - m->omega)) : (fmax(dist, epsilon) * m->omega));
+m->omega = ((gap) ? ((lreal)1) : (m->omega));
+m->r_prev = ((gap) ? (m->r_prev) : (r));
+lreal next = m->t + m->step;
+lmask stall = m->active & (next == m->t);
+if ((stall)) {
+next = ((stall) ? (nextafter(m->t, (lreal)INFINITY)) : (next));
+*flags |= ((stall) ? ((lmask)4) : ((lmask)0));
+}
+m->t_prev = ((m->active & !gap) ? (m->t) : (m->t_prev));
+m->t = ((m->active) ? (next) : (m->t));
+}
+inline lreal de_end(de_march *m, quat o, quat d, lreal near, lreal far, lmask live, int post_steps,
+int max_steps, julia_params jp, lmask *status, lmask *samples, lmask *flags,
+lreal *width, lreal *unresolved)
+{
+lmask hit = m->hit, first = m->first;
+*samples = ((m->active) ? ((lmask)max_steps) : (*samples));
+*flags |= ((m->miss & m->shell) ? ((lmask)8) : ((lmask)0));
+*status = ((live) ? (((hit) ? ((lmask)1) : (((m->miss) ? ((lmask)0) : ((lmask)2))))) : (*status));
+lreal w;
+lreal a = refine_bracket(o, d, m->t_prev, m->t, hit & !first, post_steps, jp, &w);
+*width = ((hit) ? (((hit & !first) ? (w) : ((lreal)0))) : (*width));
+lreal depth = ((hit) ? (((hit & !first) ? (a) : (m->t))) : ((lreal)INFINITY));
+*unresolved = ((live) ? (((hit) ? (depth - near) : (far - near))) : (*unresolved));
+return depth;
+}
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
 int z_resolution, int post_steps, int max_steps, lmask *status,
 lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
-lreal t = near, t_prev = near;
-lreal omega = ((real)1.2), step = 0, r_prev = 0;
-lmask active = live, shell = 0, hit = 0, miss = 0, first = 0;
-for (int i = 0; i < max_steps && (active); ++i) {
-lmask out = active & (t > far);
-*samples = ((out) ? ((lmask)i) : (*samples));
-miss |= out;
-active &= !out;
+de_march m = de_start(near, live);
+for (int i = 0; i < max_steps && (m.active); ++i) {
+de_leave(&m, i, far, samples);
 lmask escaped;
-lreal dist = julia_distance_formula(((o) + (t) * (d)), jp, &escaped);
-lreal r = ((escaped) ? (dist) : ((lreal)0));
-lmask gap = active & (omega > (real)1) & (r + r_prev < step);
-lmask got = active & !escaped & !gap;
-*samples = ((got) ? ((lmask)(i + 1)) : (*samples));
-hit |= got;
-if (i == 0)
-first = got;
-active &= !got;
-shell |= active & !gap & (dist < jp.epsilon);
-step = ((gap) ? (step * ((real)1 - omega)) : (fmax(dist, jp.epsilon) * omega));
-omega = ((gap) ? ((lreal)1) : (omega));
-r_prev = ((gap) ? (r_prev) : (r));
-lreal next = t + step;
-lmask stall = active & (next == t);
-if ((stall)) {
-next = ((stall) ? (nextafter(t, (lreal)INFINITY)) : (next));
-*flags |= ((stall) ? ((lmask)4) : ((lmask)0));
+lreal dist = julia_distance_formula(((o) + (m.t) * (d)), jp, &escaped);
+de_advance(&m, i, dist, escaped, jp.epsilon, samples, flags);
 }
-t_prev = ((active & !gap) ? (t) : (t_prev));
-t = ((active) ? (next) : (t));
-}
-*samples = ((active) ? ((lmask)max_steps) : (*samples));
-*flags |= ((miss & shell) ? ((lmask)8) : ((lmask)0));
-*status = ((live) ? (((hit) ? ((lmask)1) : (((miss) ? ((lmask)0) : ((lmask)2))))) : (*status));
-lreal w;
-lreal a = refine_bracket(o, d, t_prev, t, hit & !first, post_steps, jp, &w);
-*width = ((hit) ? (((hit & !first) ? (w) : ((lreal)0))) : (*width));
-lreal depth = ((hit) ? (((hit & !first) ? (a) : (t))) : ((lreal)INFINITY));
-*unresolved = ((live) ? (((hit) ? (depth - near) : (far - near))) : (*unresolved));
-return depth;
+return de_end(&m, o, d, near, far, live, post_steps, max_steps, jp, status, samples, flags, width,
+unresolved);
 }
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
