@@ -45,7 +45,7 @@ from pyjulia4d.opencl import build  # noqa: E402
 from pyjulia4d.pipeline import kernel_config  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
-from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
+from pyjulia4d.opencl.lanes import lanes_for, packet_pairs  # noqa: E402
 from pyjulia4d.opencl.runner import Precision, launch, march_items, queue_for  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
@@ -155,14 +155,15 @@ def march_throughput(scene: Scene, dev, repeats: int, lanes: int = 1, shuffle: b
             np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps), depth.data,
             point.data, status.data, samples.data, flags.data, bracket.data, unresolved.data)
     prg = build.program(ctx, cfg)
-    mprg = prg if lanes == 1 else build.program(ctx, kernel_config.march_config(scene, lanes, ray_buffers=True))
+    mcfg = kernel_config.march_config(scene, lanes, ray_buffers=True, pairs=packet_pairs(dev, lanes, scene.render.float == "double"))
+    mprg = prg if lanes == 1 else build.program(ctx, mcfg)
     launch(queue, cl.Kernel(prg, "generate_rays"), n, eye, fwd, right, up, pr.scalar(frame.tan_half_fov),
            np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), origins.data, dirs.data)
     if shuffle:
         perm = np.random.default_rng(0).permutation(n)
         dirs.set(dirs.get()[perm])
     march = cl.Kernel(mprg, "march")
-    items = march_items(n, w, lanes)
+    items = march_items(n, w, lanes, kernel_config.config_packets(mcfg))
     launch(queue, march, n, np.int32(w), *args, items=items)  # warm-up: PoCL specialises the work-group function
     queue.finish()
     ts = []

@@ -39,7 +39,7 @@ def march_kernel(s: Scene, config, lanes: int, w: int = W, h: int = H):
 
 def run_march(s: Scene, lanes: int = 1):
     """Kernel and reference on the same (float32-representable) rays of a small image."""
-    config = (kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
+    config = (kernel_config.march_config(s, lanes, ray_buffers=True, pairs=True) if lanes > 1
               else kernel_config.scene_config(s, ray_buffers=True))
     out, o, d, args = march_kernel(s, config, lanes)
     k = (out["depth"].astype(float), out["point"], out["status"], out["samples"], out["bracket"].astype(float))
@@ -189,7 +189,7 @@ def test_packet_pairs_give_the_single_packets_pixels(over, size):
     if lanes is None:
         pytest.skip("no packet width on this device")
     s = Scene.default().with_overrides(["march.method=de", *over])
-    pairs = kernel_config.march_config(s, lanes, ray_buffers=True)
+    pairs = kernel_config.march_config(s, lanes, ray_buffers=True, pairs=True)
     assert kernel_config.config_packets(pairs) == 2
     single = kernel_config.KernelConfig(pairs.pieces, tuple(x for x in pairs.defines if x != "PACKET_PAIRS"))
     a, _, _, _ = march_kernel(s, pairs, lanes, *size)
@@ -209,3 +209,17 @@ def test_packet_pairs_only_where_the_estimate_is_the_iterations():
                  ["fractal.kind=mandelbrot"]):
         assert kernel_config.march_packets(d.with_overrides(over), 16) == 1, over
     assert march_items(48 * 36, 48, 16, 2) == 6 * 9 and march_items(146 * 9, 146, 16, 2) == 19 * 3
+
+
+def test_pairs_where_a_packet_fills_one_vector_register():
+    """lanes.packet_pairs: two packets per work-item where one fills no more than the device's
+    native vector (AVX-512: 16 floats, 8 doubles), not where it spans two (AVX2's 8 floats)."""
+    from types import SimpleNamespace
+
+    from pyjulia4d.opencl.lanes import packet_pairs
+
+    avx512 = SimpleNamespace(native_vector_width_float=16, native_vector_width_double=8)
+    avx2 = SimpleNamespace(native_vector_width_float=8, native_vector_width_double=4)
+    assert packet_pairs(avx512, 16, False) and packet_pairs(avx512, 8, True)
+    assert not packet_pairs(avx2, 16, False) and not packet_pairs(avx2, 8, True)
+    assert not packet_pairs(avx512, 1, False) and not packet_pairs(SimpleNamespace(), 16, False)

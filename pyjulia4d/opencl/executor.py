@@ -18,7 +18,7 @@ import pyopencl as cl
 from pyjulia4d.pipeline import antialias
 from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.opencl.devices import check_device, device_of, has_fp64
-from pyjulia4d.opencl.lanes import lanes_for, march_lanes
+from pyjulia4d.opencl.lanes import lanes_for, march_lanes, packet_pairs
 from pyjulia4d.opencl.runner import TileRunner, local_size, march_items
 from pyjulia4d.pipeline.calibrate import Prediction, judge, predict, tile_side, wanted
 from pyjulia4d.pipeline.framing import fit_camera
@@ -92,16 +92,17 @@ def plan_render(scene: Scene, dev: cl.Device, lanes: int | None = None, outputs=
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     if lanes is None:
         lanes = march_lanes(lanes_for(dev, scene.render.variant, double), march_method(scene))
+    pairs = packet_pairs(dev, lanes, double)
     if scene.camera.fit:   # framing.py: a quick first pass places the camera
         with warnings.catch_warnings():   # refuse before any pass runs; warn after it
             warnings.simplefilter("ignore")
-            make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
+            make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region, pairs=pairs)
 
             def first_pass(s: Scene, outs) -> RenderResult:
-                return run_plan(make_plan(s, dev, lanes, outputs=outs, force=True), dev)
+                return run_plan(make_plan(s, dev, lanes, outputs=outs, force=True, pairs=pairs), dev)
 
             scene, _ = fit_camera(scene, first_pass)
-    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region)
+    plan = make_plan(scene, dev, lanes, outputs=outputs, force=force, tile=tile, region=region, pairs=pairs)
     prediction = None
     if calibrate and wanted(plan.estimate.seconds):
         def run_probe(tiles) -> float:

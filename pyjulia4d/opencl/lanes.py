@@ -99,3 +99,20 @@ def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     if double:
         return int(remembered("lanes_double", device, int, lambda d: probe(d, double=True)))
     return int(remembered("lanes", device, int, probe))
+
+
+def packet_pairs(device: cl.Device, lanes: int, double: bool) -> bool:
+    """Whether a work-item of the march takes two packets of ``lanes`` rays (kernel_config.
+    march_packets): where one packet fills no more than one of the device's vector registers
+    (its native vector width in floats or doubles; 16 floats in AVX-512).  There one packet's
+    march is a single chain of dependent operations that leaves the vector units waiting, and two
+    side by side took 0.87-0.93x the march's time on the default scene; with AVX2's 8-float
+    registers a packet of 16 is already two chains, and pairs took 1.02x
+    (benchmarks/commit_ratio.py, docs/performance.md)."""
+    if lanes <= 1:
+        return False
+    try:
+        width = device.native_vector_width_double if double else device.native_vector_width_float
+    except (cl.Error, AttributeError):
+        return False
+    return 0 < width and lanes <= width

@@ -194,16 +194,17 @@ def packet_block(lanes: int) -> tuple[int, int]:
     return PACKET_BLOCKS.get(lanes, (lanes, 1))
 
 
-def march_packets(scene: Scene, lanes: int) -> int:
+def march_packets(scene: Scene, lanes: int, pairs: bool = True) -> int:
     """Packets of ``lanes`` rays that a work-item of the march takes (kernels/march/march.cl): two
-    (-D PACKET_PAIRS), their estimates computed side by side, where the march steps by the
-    iteration's own estimate (the distance-estimate march of a Julia set of an algebra that is
-    not split: iterate.cl julia_distance_formula_pair); one otherwise, and with one ray per
-    work-item (GPUs run many work-items at once instead)."""
+    (-D PACKET_PAIRS), their estimates computed side by side, where ``pairs`` asks for them
+    (opencl/lanes.py packet_pairs: where a packet fills one vector register) and the march
+    steps by the iteration's own estimate (the distance-estimate march of a Julia set of an
+    algebra that is not split: iterate.cl julia_distance_formula_pair); one otherwise, and
+    with one ray per work-item."""
     f = scene.fractal
-    pairs = (lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
-             and not ALGEBRAS_TABLE[f.algebra].split)
-    return 2 if pairs else 1
+    both = (pairs and lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
+            and not ALGEBRAS_TABLE[f.algebra].split)
+    return 2 if both else 1
 
 
 def config_packets(config: KernelConfig) -> int:
@@ -211,11 +212,12 @@ def config_packets(config: KernelConfig) -> int:
     return 2 if "PACKET_PAIRS" in config.defines else 1
 
 
-def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelConfig:
+def march_config(scene: Scene, lanes: int, ray_buffers: bool = False, pairs: bool = False) -> KernelConfig:
     """The march's program: the march, its cone, the Jacobian normals when the scene uses them and
     the light terms, with ``lanes`` rays per work-item (-D LANES, kernels/common/lanes.cl; 1:
-    one ray); the same pieces as scene_config up to march/march.cl.  The other normals and
-    shading are shade_config's, one pixel per work-item."""
+    one ray) and, with ``pairs``, two packets per work-item of the march where they apply
+    (march_packets); the same pieces as scene_config up to march/march.cl.  The other normals
+    and shading are shade_config's, one pixel per work-item."""
     cfg = scene_config(scene, ray_buffers)
     pieces = cfg.pieces[: cfg.pieces.index("march/march") + 1]
     if scene.normals.method == "jacobian":
@@ -229,8 +231,8 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False) -> KernelC
     if lanes == 1:
         return KernelConfig(pieces, defines)
     bw, bh = packet_block(lanes)
-    pairs = ("PACKET_PAIRS",) if march_packets(scene, lanes) == 2 else ()
-    return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}") + pairs)
+    two = ("PACKET_PAIRS",) if march_packets(scene, lanes, pairs) == 2 else ()
+    return KernelConfig(pieces, defines + (f"LANES={lanes}", f"BLOCK_W={bw}", f"BLOCK_H={bh}") + two)
 
 
 

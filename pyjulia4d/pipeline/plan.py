@@ -198,6 +198,7 @@ class Plan:
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
+    pairs: bool = False           # two packets per work-item of the march, where they apply (kernel_config.march_packets)
 
     @property
     def radius(self) -> float:
@@ -236,7 +237,7 @@ class Plan:
     @property
     def reflect_config(self) -> kernel_config.KernelConfig:
         """The march of the reflected rays: this plan's march reading given rays."""
-        return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True)
+        return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True, pairs=self.pairs)
 
     @property
     def march_packets(self) -> int:
@@ -293,16 +294,18 @@ def check_flag(name: str, value) -> bool:
 
 
 def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
-              tile: int = TILE, region=None) -> Plan:
+              tile: int = TILE, region=None, pairs: bool = False) -> Plan:
     """Check and resolve ``scene`` for ``device`` (a pyopencl Device, "CPU" or "GPU") with
-    ``lanes`` rays per work-item of the march, keeping ``outputs`` (None: all), over the
-    image or its ``region`` (x0, y0, w, h) alone; each argument is checked, with the one-line
-    SceneError naming it."""
+    ``lanes`` rays per work-item of the march (``pairs``: two packets of them where they apply,
+    kernel_config.march_packets), keeping ``outputs`` (None: all), over the image or its
+    ``region`` (x0, y0, w, h) alone; each argument is checked, with the one-line SceneError
+    naming it."""
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     check_lanes(lanes)
     check_tile(tile)
     check_flag("force", force)
+    check_flag("pairs", pairs)
     region = check_region(scene, region)
     kept = resolve_outputs(outputs)
     est = workload.check(scene, device, force=force, outputs=kept)
@@ -315,9 +318,9 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
         normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
         double=scene.render.float == "double", lanes=lanes, outputs=kept,
         config=kernel_config.shade_config(scene),
-        march_config=kernel_config.march_config(scene, lanes),
+        march_config=kernel_config.march_config(scene, lanes, pairs=pairs),
         tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
-        region=region or (0, 0, scene.image.width, scene.image.height),
+        region=region or (0, 0, scene.image.width, scene.image.height), pairs=pairs,
         estimate=est)
 
 
