@@ -263,3 +263,28 @@ def test_lights_and_reflection_compile_only_where_used():
     assert {"REFLECTION", "EXTRA_LIGHTS=2", "EXTRA_SHADOWS"} <= set(cfg.defines)
     # no shadows: the extra lights shine, but no shadow rays are compiled for them
     assert "EXTRA_SHADOWS" not in kernel_config.scene_config(lit.with_overrides(["shading.shadow=none"])).defines
+
+
+@pytest.mark.parametrize("name", ["soft+ao", "hard+trap", "three-lights-soft", "w"])
+def test_packet_pairs_light_the_same_pixels(name):
+    """Two packets per work-item (-D PACKET_PAIRS: the march's and the light terms' shadow rays
+    and occlusion, their estimates side by side) give every output of one packet per work-item,
+    bit for bit, on a tile whose last pair of blocks is cut by the edge."""
+    import dataclasses
+
+    from harness import device, packet_widths
+    from pyjulia4d.opencl.executor import run_plan
+    from pyjulia4d.pipeline.plan import make_plan
+
+    lanes = max(packet_widths((8, 16)), default=None)
+    if lanes is None:
+        pytest.skip("no packet width on this device")
+    s = Scene.default().with_overrides(LIGHT_SCENES[name] + ["image.width=44", "image.height=30"])
+    dev = device()
+    pair, one = make_plan(s, dev, lanes, pairs=True), make_plan(s, dev, lanes, pairs=False)
+    assert pair.march_packets == 2 and one.march_packets == 1 and pair.light_terms
+    a, b = run_plan(pair, dev), run_plan(one, dev)
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray):
+            assert np.array_equal(x, y, equal_nan=True), f.name

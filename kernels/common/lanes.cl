@@ -144,6 +144,15 @@ inline quat QSEL(quat a, quat b, lmask m)
 #define PACKET_KERNEL __kernel
 #endif
 
+/* -D PACKET_PAIRS: a work-item of the march and of the light terms takes two packets, their
+ * estimates side by side, where one packet's chain of dependent operations would leave the
+ * vector units idle (march/march.cl, shade/light.cl; pipeline/kernel_config.py march_packets) */
+#if defined(PACKET_PAIRS) && LANES > 1
+#define PACKETS 2
+#else
+#define PACKETS 1
+#endif
+
 #if LANES > 1
 /* The pixels of packet p of work-item g, which takes `packets` neighbouring BLOCK_W x BLOCK_H
  * blocks of a tile tile_w wide and n_items / tile_w high (rows of blocks, each row's blocks

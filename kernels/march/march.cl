@@ -49,15 +49,8 @@
 #define CONE_ARGS
 #endif
 
-/* -D PACKET_PAIRS (packets, march/de.cl only): each work-item marches two neighbouring blocks,
- * their estimates side by side (march_ray_pair), where one packet's chain of dependent
- * operations would leave the vector units idle; pipeline/kernel_config.py march_packets. */
-#if defined(PACKET_PAIRS) && LANES > 1
-#define PACKETS 2
-#else
-#define PACKETS 1
-#endif
-
+/* -D PACKET_PAIRS (common/lanes.cl PACKETS; march/de.cl only): each work-item marches two
+ * neighbouring blocks, their estimates side by side (march_ray_pair). */
 PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
                     const real4 c, const int max_iter, const real bailout, const real epsilon,
                     const real radius, const real near_set, const real far_set,

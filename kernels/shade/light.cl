@@ -13,36 +13,79 @@
  * going there keeps what it has (lit).  Lanes outside ``lit`` trace nothing and get 0: no hit, or
  * a hit facing away from the light (LIGHT_FACES below), its own shadow. */
 #if defined(SHADOW_HARD) || defined(SHADOW_SOFT)
-inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, real radius, real step,
-                        real softness, int max_steps)
+/* A packet's shadow rays between steps. */
+typedef struct {
+    lreal t, t1, vis;
+    lmask active;
+} shadow_march;
+
+inline shadow_march shadow_start(quat o, quat l, lreal tmax, lmask lit, real radius, real step)
 {
+    shadow_march m;
     lreal b = QDOT(o, l);
     quat perp = QRAY(o, l, -b);
     lreal disc = radius * radius - QNORM2(perp);
     lreal s = sqrt(fmax(disc, (real)0));
-    lreal t = fmax(-b - s, (lreal)step);
-    lreal t1 = fmin(-b + s, tmax);
-    lmask active = lit & (disc > (real)0) & (t1 > t);
-    lreal vis = L_SEL((lreal)0, (lreal)1, lit);
-    for (int i = 0; i < max_steps && L_ANY(active); ++i) {
-        quat x = QRAY(o, l, t);
+    m.t = fmax(-b - s, (lreal)step);
+    m.t1 = fmin(-b + s, tmax);
+    m.active = lit & (disc > (real)0) & (m.t1 > m.t);
+    m.vis = L_SEL((lreal)0, (lreal)1, lit);
+    return m;
+}
+
+#ifdef ALG_HAS_DE
+/* a step by the estimate d at t (escaped: the point's orbit escaped; else the ray is in the set) */
+inline void shadow_advance(shadow_march *m, lreal d, lmask escaped, real step, real softness)
+{
+    lmask in = m->active & !escaped;
+#ifdef SHADOW_SOFT
+    m->vis = L_SEL(m->vis, fmin(m->vis, softness * (real)2 * d / m->t), m->active & escaped);
+#endif
+    m->t = m->t + fmax(d, (lreal)step);
+    m->vis = L_SEL(m->vis, (lreal)0, in);
+    m->active &= !in & (m->t < m->t1);
+}
+#endif
+
+inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, real radius, real step,
+                        real softness, int max_steps)
+{
+    shadow_march m = shadow_start(o, l, tmax, lit, radius, step);
+    for (int i = 0; i < max_steps && L_ANY(m.active); ++i) {
+        quat x = QRAY(o, l, m.t);
 #ifdef ALG_HAS_DE
         lmask escaped;
         lreal d = julia_distance_formula(x, jp, &escaped);
-        lmask in = active & !escaped;
-#ifdef SHADOW_SOFT
-        vis = L_SEL(vis, fmin(vis, softness * (real)2 * d / t), active & escaped);
-#endif
-        t = t + fmax(d, (lreal)step);
+        shadow_advance(&m, d, escaped, step, softness);
 #else
-        lmask in = active & julia_inside(x, jp);
-        t = t + step;
+        lmask in = m.active & julia_inside(x, jp);
+        m.t = m.t + step;
+        m.vis = L_SEL(m.vis, (lreal)0, in);
+        m.active &= !in & (m.t < m.t1);
 #endif
-        vis = L_SEL(vis, (lreal)0, in);
-        active &= !in & (t < t1);
     }
-    return clamp(vis, (real)0, (real)1);
+    return clamp(m.vis, (real)0, (real)1);
 }
+
+#ifdef PACKET_PAIRS
+/* shadow_ray of two packets, [0] and [1], their estimates side by side (march/march.cl
+ * PACKET_PAIRS): lane for lane the same steps and visibilities. */
+inline void shadow_ray_pair(const quat *o, const quat *l, const lreal *tmax, const lmask *lit, julia_params jp,
+                            real radius, real step, real softness, int max_steps, lreal *vis)
+{
+    shadow_march a = shadow_start(o[0], l[0], tmax[0], lit[0], radius, step);
+    shadow_march b = shadow_start(o[1], l[1], tmax[1], lit[1], radius, step);
+    for (int i = 0; i < max_steps && L_ANY(a.active | b.active); ++i) {
+        lmask ea, eb;
+        lreal da, db;
+        julia_distance_formula_pair(QRAY(o[0], l[0], a.t), QRAY(o[1], l[1], b.t), jp, &ea, &eb, &da, &db);
+        shadow_advance(&a, da, ea, step, softness);
+        shadow_advance(&b, db, eb, step, softness);
+    }
+    vis[0] = clamp(a.vis, (real)0, (real)1);
+    vis[1] = clamp(b.vis, (real)0, (real)1);
+}
+#endif
 #endif
 
 /* A hit whose normal points away from a light (n . l <= 0, l towards the light from the hit)
@@ -74,6 +117,28 @@ inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real 
     }
     return clamp((real)1 - strength * occ / wsum, (real)0, (real)1);
 }
+
+#ifdef PACKET_PAIRS
+/* ambient_occlusion of two packets, their estimates side by side: the same values */
+inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp, real dist, real strength,
+                                   lreal *amb)
+{
+    lreal occ_a = (lreal)0, occ_b = (lreal)0;
+    real wsum = 0, w = 1;
+    for (int i = 1; i <= 5; ++i) {
+        real h = dist * (real)i / (real)5;
+        lmask ea, eb;
+        lreal da, db;
+        julia_distance_formula_pair(QRAY(p[0], n[0], (lreal)h), QRAY(p[1], n[1], (lreal)h), jp, &ea, &eb, &da, &db);
+        occ_a += w * fmax((real)h - (real)2 * L_SEL((lreal)0, da, ea), (real)0) / h;
+        occ_b += w * fmax((real)h - (real)2 * L_SEL((lreal)0, db, eb), (real)0) / h;
+        wsum += w;
+        w *= (real)0.5;
+    }
+    amb[0] = clamp((real)1 - strength * occ_a / wsum, (real)0, (real)1);
+    amb[1] = clamp((real)1 - strength * occ_b / wsum, (real)0, (real)1);
+}
+#endif
 #endif
 
 /* The colour value of a hit.  Iteration: the smooth escape count nu = n + 1 -
@@ -144,60 +209,86 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
                           __global const float4 *lights_rgb, __global float4 *terms,
                           __global float4 *vis_extra)
 {
+    /* PACKETS blocks per work-item, as the march's (march/march.cl, PACKET_PAIRS) */
 #if LANES == 1
     size_t i0 = get_global_id(0);
     if (i0 >= (size_t)n_items)
         return;
 #else
-    size_t lane_index[LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
-    if (!block_lanes(get_global_id(0), n_items, tile_w, lane_index))
-        return;
+    size_t lane_index[PACKETS][LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
+    for (int k = 0; k < PACKETS; ++k)
+        if (!packet_lanes(get_global_id(0), k, PACKETS, n_items, tile_w, lane_index[k]))
+            return;
 #endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
-    quat p, nw, pin;
-    lmask hit;
+    quat p[PACKETS], nw[PACKETS], pin[PACKETS];
+    lmask hit[PACKETS];
 #if LANES == 1
-    hit = status[i0] == STATUS_HIT;
-    if (!hit) {
+    hit[0] = status[i0] == STATUS_HIT;
+    if (!hit[0]) {
         terms[i0] = (float4)(1, 1, 0, 0);
         return;
     }
-    p = point[i0];
+    p[0] = point[i0];
     real4 nc = normal[i0];
-    nw = nc.x * right + nc.y * up - nc.z * forward;
-    pin = p + bracket[i0] * normalize(p - eye);
+    nw[0] = nc.x * right + nc.y * up - nc.z * forward;
+    pin[0] = p[0] + bracket[i0] * normalize(p[0] - eye);
 #else
     /* a miss or a lane past the edge takes a point whose orbit leaves the bailout ball at once,
      * as do its occlusion points: at the origin (inside many sets) its estimates ran to max_iter
      * and held its packet's loops that long */
     real4 away = (real4)((real)4 * (bailout + radius + ao_distance), 0, 0, 0);
-    for (int k = 0; k < LANES; ++k) {   /* gather */
-        size_t i = lane_index[k];
-        int h = i < (size_t)n_items && status[i] == STATUS_HIT;
-        real4 pk = h ? point[i] : away;
-        real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
-        real4 nk = nc.x * right + nc.y * up - nc.z * forward;
-        real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
-        ((real *)&pin.x)[k] = ik.x; ((real *)&pin.y)[k] = ik.y; ((real *)&pin.z)[k] = ik.z; ((real *)&pin.w)[k] = ik.w;
-        ((real *)&p.x)[k] = pk.x; ((real *)&p.y)[k] = pk.y; ((real *)&p.z)[k] = pk.z; ((real *)&p.w)[k] = pk.w;
-        ((real *)&nw.x)[k] = nk.x; ((real *)&nw.y)[k] = nk.y; ((real *)&nw.z)[k] = nk.z; ((real *)&nw.w)[k] = nk.w;
-        ((mask_t *)&hit)[k] = h ? -1 : 0;
+    for (int b = 0; b < PACKETS; ++b) {
+        for (int k = 0; k < LANES; ++k) {   /* gather */
+            size_t i = lane_index[b][k];
+            int h = i < (size_t)n_items && status[i] == STATUS_HIT;
+            real4 pk = h ? point[i] : away;
+            real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
+            real4 nk = nc.x * right + nc.y * up - nc.z * forward;
+            real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
+            ((real *)&pin[b].x)[k] = ik.x; ((real *)&pin[b].y)[k] = ik.y;
+            ((real *)&pin[b].z)[k] = ik.z; ((real *)&pin[b].w)[k] = ik.w;
+            ((real *)&p[b].x)[k] = pk.x; ((real *)&p[b].y)[k] = pk.y; ((real *)&p[b].z)[k] = pk.z; ((real *)&p[b].w)[k] = pk.w;
+            ((real *)&nw[b].x)[k] = nk.x; ((real *)&nw[b].y)[k] = nk.y;
+            ((real *)&nw[b].z)[k] = nk.z; ((real *)&nw[b].w)[k] = nk.w;
+            ((mask_t *)&hit[b])[k] = h ? -1 : 0;
+        }
     }
 #endif
-    lreal vis = (lreal)1, amb = (lreal)1, val = (lreal)0;
+    lreal vis[PACKETS], amb[PACKETS], val[PACKETS];
 #ifdef EXTRA_SHADOWS
-    lreal ve[3] = {(lreal)1, (lreal)1, (lreal)1};
+    lreal ve[3][PACKETS];
 #endif
-    if (L_ANY(hit)) {   /* a block of misses (the background) has nothing to light */
-        quat o = QRAY(p, nw, (lreal)bias);   /* off the surface, outside: where shadow rays and occlusion start */
+    lmask any_hit = 0;
+    for (int b = 0; b < PACKETS; ++b) {
+        vis[b] = amb[b] = (lreal)1;
+        val[b] = (lreal)0;
+#ifdef EXTRA_SHADOWS
+        ve[0][b] = ve[1][b] = ve[2][b] = (lreal)1;
+#endif
+        any_hit |= hit[b];
+    }
+    if (L_ANY(any_hit)) {   /* a block of misses (the background) has nothing to light */
+        quat o[PACKETS];     /* off the surface, outside: where shadow rays and occlusion start */
+        for (int b = 0; b < PACKETS; ++b)
+            o[b] = QRAY(p[b], nw[b], (lreal)bias);
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
         {
             quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
-            quat lv = QADD(lp, QSCALE((lreal)-1, o));
-            lreal dist = QLEN(lv);
-            quat l = QSCALE((real)1 / fmax(dist, REAL_MIN), lv);
-            lmask facing = hit & LIGHT_FACES(nw, QADD(lp, QSCALE((lreal)-1, p)));
-            vis = shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps);
+            quat l[PACKETS];
+            lreal dist[PACKETS];
+            lmask facing[PACKETS];
+            for (int b = 0; b < PACKETS; ++b) {
+                quat lv = QADD(lp, QSCALE((lreal)-1, o[b]));
+                dist[b] = QLEN(lv);
+                l[b] = QSCALE((real)1 / fmax(dist[b], REAL_MIN), lv);
+                facing[b] = hit[b] & LIGHT_FACES(nw[b], QADD(lp, QSCALE((lreal)-1, p[b])));
+            }
+#if PACKETS == 2
+            shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, vis);
+#else
+            vis[0] = shadow_ray(o[0], l[0], dist[0], facing[0], jp, radius, step, softness, max_steps);
+#endif
         }
 #endif
 #ifdef EXTRA_SHADOWS
@@ -207,55 +298,73 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
             for (int j = 0; j < EXTRA_LIGHTS; ++j) {
                 real4 g = lights_geo[j];
                 quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
-                quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
-                lreal dist;
-                if (lights_rgb[j].w != 0.0f) {
-                    lv = to = gq;
-                    dist = (lreal)INFINITY;
-                } else {
-                    lv = QADD(gq, QSCALE((lreal)-1, o));
-                    to = QADD(gq, QSCALE((lreal)-1, p));
-                    dist = QLEN(lv);
+                quat l[PACKETS];
+                lreal dist[PACKETS];
+                lmask facing[PACKETS];
+                for (int b = 0; b < PACKETS; ++b) {
+                    quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
+                    if (lights_rgb[j].w != 0.0f) {
+                        lv = to = gq;
+                        dist[b] = (lreal)INFINITY;
+                    } else {
+                        lv = QADD(gq, QSCALE((lreal)-1, o[b]));
+                        to = QADD(gq, QSCALE((lreal)-1, p[b]));
+                        dist[b] = QLEN(lv);
+                    }
+                    l[b] = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
+                    /* a light with no direction in the rays' 3D space: shade.cl lights along the
+                     * view instead, which every hit faces */
+                    lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
+                                 (QDOT_UNIFORM(to, forward) == (real)0);
+                    facing[b] = hit[b] & (LIGHT_FACES(nw[b], to) | flat);
                 }
-                quat l = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
-                /* a light with no direction in the rays' 3D space: shade.cl lights along the
-                 * view instead, which every hit faces */
-                lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
-                             (QDOT_UNIFORM(to, forward) == (real)0);
-                lmask facing = hit & (LIGHT_FACES(nw, to) | flat);
-                ve[j] = shadow_ray(o, l, dist, facing, jp, radius, step, softness, max_steps);
+#if PACKETS == 2
+                shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, ve[j]);
+#else
+                ve[j][0] = shadow_ray(o[0], l[0], dist[0], facing[0], jp, radius, step, softness, max_steps);
+#endif
             }
         }
 #endif
 #ifdef AO
-        amb = ambient_occlusion(o, nw, jp, ao_distance, ao_strength);
+#if PACKETS == 2
+        ambient_occlusion_pair(o, nw, jp, ao_distance, ao_strength, amb);
+#else
+        amb[0] = ambient_occlusion(o[0], nw[0], jp, ao_distance, ao_strength);
 #endif
+#endif
+        for (int b = 0; b < PACKETS; ++b) {
 #if defined(COLOR_ITERATION)
-        val = orbit_value(pin, jp);
+            val[b] = orbit_value(pin[b], jp);
 #elif defined(COLOR_TRAP)
-        val = orbit_value(p, jp, trap);
+            val[b] = orbit_value(p[b], jp, trap);
 #elif defined(COLOR_W)
-        val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
+            val[b] = clamp((real)0.5 + p[b].w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
 #endif
+        }
     }
 #if LANES == 1
-    terms[i0] = (float4)((float)vis, (float)amb, (float)val, 0.0f);
+    terms[i0] = (float4)((float)vis[0], (float)amb[0], (float)val[0], 0.0f);
 #ifdef EXTRA_SHADOWS
-    vis_extra[i0] = (float4)((float)ve[0], (float)ve[1], (float)ve[2], 0.0f);
+    vis_extra[i0] = (float4)((float)ve[0][0], (float)ve[1][0], (float)ve[2][0], 0.0f);
 #endif
 #else
-    for (int k = 0; k < LANES; ++k) {   /* scatter */
-        size_t i = lane_index[k];
-        if (i >= (size_t)n_items)
-            continue;
-        terms[i] = status[i] == STATUS_HIT
-                       ? (float4)((float)((real *)&vis)[k], (float)((real *)&amb)[k], (float)((real *)&val)[k], 0.0f)
-                       : (float4)(1, 1, 0, 0);
+    for (int b = 0; b < PACKETS; ++b) {
+        for (int k = 0; k < LANES; ++k) {   /* scatter */
+            size_t i = lane_index[b][k];
+            if (i >= (size_t)n_items)
+                continue;
+            terms[i] = status[i] == STATUS_HIT
+                           ? (float4)((float)((real *)&vis[b])[k], (float)((real *)&amb[b])[k],
+                                      (float)((real *)&val[b])[k], 0.0f)
+                           : (float4)(1, 1, 0, 0);
 #ifdef EXTRA_SHADOWS
-        vis_extra[i] = status[i] == STATUS_HIT
-                       ? (float4)((float)((real *)&ve[0])[k], (float)((real *)&ve[1])[k], (float)((real *)&ve[2])[k], 0.0f)
-                       : (float4)(1, 1, 1, 0);
+            vis_extra[i] = status[i] == STATUS_HIT
+                           ? (float4)((float)((real *)&ve[0][b])[k], (float)((real *)&ve[1][b])[k],
+                                      (float)((real *)&ve[2][b])[k], 0.0f)
+                           : (float4)(1, 1, 1, 0);
 #endif
+        }
     }
 #endif
 }

@@ -266,7 +266,8 @@ class TileRunner:
             kernels.append(launch(q, self.light_k, n, np.int32(tile.aw), bufs["point"].data, bufs["normal"].data,
                                   bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
                                   self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
-                                  bufs["vis_extra"].data, items=march_items(n, tile.aw, plan.lanes)))
+                                  bufs["vis_extra"].data,
+                                  items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
