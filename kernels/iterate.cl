@@ -20,6 +20,28 @@ inline lmask julia_inside(quat p, julia_params jp)
     return live;
 }
 
+/* one step of the level function's orbit where live, counting the steps done */
+#define LEVEL_ORBIT_STEP(q, m2, steps, live, c, bailout2) do { \
+        q = QSEL(q, julia_f(q, c), live); \
+        m2 = ALG_NORM2(q); \
+        steps = L_SEL(steps, steps + 1, live); \
+        live = m2 <= (bailout2); \
+    } while (0)
+
+/* F and the inside flag from the orbit's last |q|^2 and the steps it took (julia_level) */
+inline lreal level_value(lreal m2, lmask steps, julia_params jp, lmask *inside)
+{
+    *inside = m2 <= jp.bailout2;
+    lmask k = jp.max_iter - steps;
+#if JULIA_GROWTH == 2
+    lreal e = ldexp(log(m2 / jp.bailout2), L_INT(min(k, 60)));
+#else
+    lreal e = log(m2 / jp.bailout2) * pow((lreal)JULIA_GROWTH, convert_lreal(min(k, 60)));
+#endif
+    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
+    return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
+}
+
 /* The level function of the truncated set (march/refine.cl): F = |q_N|^2 / bailout^2 - 1 at
  * N = max_iter, <= 0 exactly when the point is inside (*inside, the same test as
  * julia_inside).  With bailout >= the escape radius every |q_n| > bailout stays so, so
@@ -36,23 +58,30 @@ inline lreal julia_level(quat p, julia_params jp, lmask *inside)
     lmask live = m2 <= jp.bailout2;
     lmask steps = 0;                /* iterations done, per lane */
     int n = 0;
-    for (; n < jp.max_iter && L_ANY(live); ++n) {
-        q = QSEL(q, julia_f(q, c), live);
-        m2 = ALG_NORM2(q);
-        steps = L_SEL(steps, steps + 1, live);
-        live = m2 <= jp.bailout2;
-    }
+    for (; n < jp.max_iter && L_ANY(live); ++n)
+        LEVEL_ORBIT_STEP(q, m2, steps, live, c, jp.bailout2);
     COUNT_ITER(jp, n);
-    *inside = m2 <= jp.bailout2;
-    lmask k = jp.max_iter - steps;
-#if JULIA_GROWTH == 2
-    lreal e = ldexp(log(m2 / jp.bailout2), L_INT(min(k, 60)));
-#else
-    lreal e = log(m2 / jp.bailout2) * pow((lreal)JULIA_GROWTH, convert_lreal(min(k, 60)));
-#endif
-    lreal out = L_SEL(expm1(fmin(e, (real)69)), (lreal)1e30, (k > 60) | (e > (real)69));
-    return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
+    return level_value(m2, steps, jp, inside);
 }
+
+#ifdef PACKET_PAIRS
+/* julia_level at two packets' points in one loop (march/refine.cl refine_bracket_pair) */
+inline void julia_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b,
+                             lreal *fa, lreal *fb)
+{
+    quat qa = ALG_IN(pa), qb = ALG_IN(pb);
+    real4 c = ALG_C(jp.c);
+    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb);
+    lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2;
+    lmask steps_a = 0, steps_b = 0;
+    for (int n = 0; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
+        LEVEL_ORBIT_STEP(qa, m2a, steps_a, live_a, c, jp.bailout2);
+        LEVEL_ORBIT_STEP(qb, m2b, steps_b, live_b, c, jp.bailout2);
+    }
+    *fa = level_value(m2a, steps_a, jp, inside_a);
+    *fb = level_value(m2b, steps_b, jp, inside_b);
+}
+#endif
 
 #ifdef ALG_HAS_DE
 /* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (seed 001 §3.1, eq. 8)

@@ -82,20 +82,24 @@ inline void de_advance(de_march *m, int i, lreal dist, lmask escaped, real epsil
     m->t = L_SEL(m->t, next, m->active);
 }
 
-/* after the last step: the status, the refined bracket and the depth */
-inline lreal de_end(de_march *m, quat o, quat d, lreal near, lreal far, lmask live, int post_steps,
-                    int max_steps, julia_params jp, lmask *status, lmask *samples, lmask *flags,
-                    lreal *width, lreal *unresolved)
+/* after the last step: the status, the samples' and flags' last words; returns the lanes
+ * whose bracket the refinement narrows (march/refine.cl) */
+inline lmask de_close(const de_march *m, lmask live, int max_steps, lmask *status, lmask *samples, lmask *flags)
 {
-    lmask hit = m->hit, first = m->first;
     *samples = L_SEL(*samples, (lmask)max_steps, m->active);
     *flags |= L_SEL((lmask)0, (lmask)GUARD_SHELL_MISS, m->miss & m->shell);
     *status = L_SEL(*status, L_SEL(L_SEL((lmask)STATUS_CAPPED, (lmask)STATUS_MISS, m->miss),
-                                   (lmask)STATUS_HIT, hit), live);
-    lreal w;
-    lreal a = refine_bracket(o, d, m->t_prev, m->t, hit & !first, post_steps, jp, &w);
-    *width = L_SEL(*width, L_SEL((lreal)0, w, hit & !first), hit);
-    lreal depth = L_SEL((lreal)INFINITY, L_SEL(m->t, a, hit & !first), hit);
+                                   (lmask)STATUS_HIT, m->hit), live);
+    return m->hit & !m->first;
+}
+
+/* the depth, given the refined bracket's outer end a and its width w */
+inline lreal de_depth(const de_march *m, lreal a, lreal w, lreal near, lreal far, lmask live, lreal *width,
+                      lreal *unresolved)
+{
+    lmask hit = m->hit, refined = m->hit & !m->first;
+    *width = L_SEL(*width, L_SEL((lreal)0, w, refined), hit);
+    lreal depth = L_SEL((lreal)INFINITY, L_SEL(m->t, a, refined), hit);
     /* the estimate is no proof for the truncated set (above): nothing in front is proven */
     *unresolved = L_SEL(*unresolved, L_SEL(far - near, depth - near, hit), live);
     return depth;
@@ -112,30 +116,44 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lreal dist = julia_distance_formula(QRAY(o, d, m.t), jp, &escaped);
         de_advance(&m, i, dist, escaped, jp.epsilon, samples, flags);
     }
-    return de_end(&m, o, d, near, far, live, post_steps, max_steps, jp, status, samples, flags, width,
-                  unresolved);
+    lmask todo = de_close(&m, live, max_steps, status, samples, flags);
+    lreal w;
+    lreal a = refine_bracket(o, d, m.t_prev, m.t, todo, post_steps, jp, &w);
+    return de_depth(&m, a, w, near, far, live, width, unresolved);
 }
 
 #ifdef PACKET_PAIRS
-/* march_ray of two packets, [0] and [1], their estimates side by side
- * (iterate.cl julia_distance_formula_pair): lane for lane the same steps and results. */
+/* march_ray of two packets, [0] and [1], their estimates and set tests side by side
+ * (iterate.cl julia_distance_formula_pair, march/refine.cl refine_bracket_pair): lane for
+ * lane the same steps and results. */
 inline void march_ray_pair(const quat *o, const quat *d, const lreal *near, const lreal *far, const lmask *live,
                            julia_params jp, int post_steps, int max_steps, lmask *status, lmask *samples,
                            lmask *flags, lreal *width, lreal *unresolved, lreal *depth)
 {
-    de_march a = de_start(near[0], live[0]), b = de_start(near[1], live[1]);
-    for (int i = 0; i < max_steps && L_ANY(a.active | b.active); ++i) {
-        de_leave(&a, i, far[0], &samples[0]);
-        de_leave(&b, i, far[1], &samples[1]);
-        lmask ea, eb;
-        lreal da, db;
-        julia_distance_formula_pair(QRAY(o[0], d[0], a.t), QRAY(o[1], d[1], b.t), jp, &ea, &eb, &da, &db);
-        de_advance(&a, i, da, ea, jp.epsilon, &samples[0], &flags[0]);
-        de_advance(&b, i, db, eb, jp.epsilon, &samples[1], &flags[1]);
+    de_march m[2] = {de_start(near[0], live[0]), de_start(near[1], live[1])};
+    for (int i = 0; i < max_steps && L_ANY(m[0].active | m[1].active); ++i) {
+        de_leave(&m[0], i, far[0], &samples[0]);
+        de_leave(&m[1], i, far[1], &samples[1]);
+        lmask e0, e1;
+        lreal d0, d1;
+        julia_distance_formula_pair(QRAY(o[0], d[0], m[0].t), QRAY(o[1], d[1], m[1].t), jp, &e0, &e1, &d0, &d1);
+        de_advance(&m[0], i, d0, e0, jp.epsilon, &samples[0], &flags[0]);
+        de_advance(&m[1], i, d1, e1, jp.epsilon, &samples[1], &flags[1]);
     }
-    depth[0] = de_end(&a, o[0], d[0], near[0], far[0], live[0], post_steps, max_steps, jp, &status[0],
-                      &samples[0], &flags[0], &width[0], &unresolved[0]);
-    depth[1] = de_end(&b, o[1], d[1], near[1], far[1], live[1], post_steps, max_steps, jp, &status[1],
-                      &samples[1], &flags[1], &width[1], &unresolved[1]);
+    lmask todo[2];
+    lreal t_prev[2], t[2], a[2], w[2];
+    for (int k = 0; k < 2; ++k) {
+        todo[k] = de_close(&m[k], live[k], max_steps, &status[k], &samples[k], &flags[k]);
+        t_prev[k] = m[k].t_prev;
+        t[k] = m[k].t;
+    }
+#ifdef REFINE_ITP
+    refine_bracket_pair(o, d, t_prev, t, todo, post_steps, jp, a, w);
+#else
+    for (int k = 0; k < 2; ++k)
+        a[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], todo[k], post_steps, jp, &w[k]);
+#endif
+    for (int k = 0; k < 2; ++k)
+        depth[k] = de_depth(&m[k], a[k], w[k], near[k], far[k], live[k], &width[k], &unresolved[k]);
 }
 #endif

@@ -19,6 +19,56 @@
  * (and two level evaluations at the ends), usually far fewer; the loop stops there.
  * Both stop early once the bracket cannot be split in the number format. */
 
+#ifdef REFINE_ITP
+/* A packet's ITP refinement between set tests: the bracket [a, b], g = -F at its ends. */
+typedef struct {
+    lreal a, b, ya, yb, eps, k1;
+    lmask live;
+} itp_state;
+
+inline itp_state itp_start(lreal a, lreal b, lreal fa, lreal fb, lmask todo, int steps)
+{
+    itp_state s;
+    s.a = a;
+    s.b = b;
+    /* g = -F: g(a) < 0 outside, g(b) >= 0 inside, the orientation ITP is stated in */
+    s.ya = -fmax(fa, REAL_MIN);
+    s.yb = -fmin(fb, (real)0);
+    lreal w0 = b - a;
+    s.eps = ldexp(w0, -(steps + 1));       /* target: b - a <= 2 eps = w0 / 2^steps */
+    s.k1 = (real)0.2 / w0;
+    s.live = todo & (b - a > (real)2 * s.eps);
+    return s;
+}
+
+/* the point of step j; lanes whose bracket cannot be split any more leave */
+inline lreal itp_point(itp_state *s, int j, int steps)
+{
+    lreal a = s->a, b = s->b;
+    lreal xh = (real)0.5 * (a + b);
+    s->live &= (xh > a) & (xh < b);           /* adjacent numbers: nothing left to split */
+    lreal r = ldexp(s->eps, steps + 1 - j) - (real)0.5 * (b - a);
+    lreal delta = s->k1 * (b - a) * (b - a);
+    lreal xf = L_SEL(xh, (s->yb * a - s->ya * b) / (s->yb - s->ya), s->yb != s->ya);
+    lreal sigma = L_SEL((lreal)-1, (lreal)1, xh >= xf);
+    lreal xt = L_SEL(xh, xf + sigma * delta, delta <= fabs(xh - xf));
+    lreal x = L_SEL(xh - sigma * r, xt, fabs(xt - xh) <= r);
+    return L_SEL(xh, x, (x > a) & (x < b));
+}
+
+/* the set test at x: F(x) = f, inside or not */
+inline void itp_take(itp_state *s, lreal x, lreal f, lmask inside)
+{
+    lreal y = -f;
+    lmask got_in = s->live & inside, got_out = s->live & !inside;
+    s->b = L_SEL(s->b, x, got_in);
+    s->yb = L_SEL(s->yb, fmax(y, (real)0), got_in);
+    s->a = L_SEL(s->a, x, got_out);
+    s->ya = L_SEL(s->ya, fmin(y, -REAL_MIN), got_out);
+    s->live &= s->b - s->a > (real)2 * s->eps;
+}
+#endif
+
 inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int steps,
                             julia_params jp, lreal *width)
 {
@@ -30,32 +80,16 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
     lmask inside;
     lreal fa = julia_level(QRAY(o, d, a), jp, &inside);
     lreal fb = julia_level(QRAY(o, d, b), jp, &inside);
-    /* g = -F: g(a) < 0 outside, g(b) >= 0 inside, the orientation ITP is stated in */
-    lreal ya = -fmax(fa, REAL_MIN), yb = -fmin(fb, (real)0);
-    lreal w0 = b - a;
-    lreal eps = ldexp(w0, -(steps + 1));       /* target: b - a <= 2 eps = w0 / 2^steps */
-    lreal k1 = (real)0.2 / w0;
-    lmask live = todo & (b - a > (real)2 * eps);
-    for (int j = 0; j <= steps && L_ANY(live); ++j) {
-        lreal xh = (real)0.5 * (a + b);
-        live &= (xh > a) & (xh < b);           /* adjacent numbers: nothing left to split */
-        if (!L_ANY(live))
+    itp_state s = itp_start(a, b, fa, fb, todo, steps);
+    for (int j = 0; j <= steps && L_ANY(s.live); ++j) {
+        lreal x = itp_point(&s, j, steps);
+        if (!L_ANY(s.live))
             break;
-        lreal r = ldexp(eps, steps + 1 - j) - (real)0.5 * (b - a);
-        lreal delta = k1 * (b - a) * (b - a);
-        lreal xf = L_SEL(xh, (yb * a - ya * b) / (yb - ya), yb != ya);
-        lreal sigma = L_SEL((lreal)-1, (lreal)1, xh >= xf);
-        lreal xt = L_SEL(xh, xf + sigma * delta, delta <= fabs(xh - xf));
-        lreal x = L_SEL(xh - sigma * r, xt, fabs(xt - xh) <= r);
-        x = L_SEL(xh, x, (x > a) & (x < b));
-        lreal y = -julia_level(QRAY(o, d, x), jp, &inside);
-        lmask got_in = live & inside, got_out = live & !inside;
-        b = L_SEL(b, x, got_in);
-        yb = L_SEL(yb, fmax(y, (real)0), got_in);
-        a = L_SEL(a, x, got_out);
-        ya = L_SEL(ya, fmin(y, -REAL_MIN), got_out);
-        live &= b - a > (real)2 * eps;
+        lreal f = julia_level(QRAY(o, d, x), jp, &inside);
+        itp_take(&s, x, f, inside);
     }
+    a = s.a;
+    b = s.b;
 #else
     lmask live = todo;
     for (int j = 0; j < steps && L_ANY(live); ++j) {
@@ -71,3 +105,38 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
     *width = b - a;
     return a;
 }
+
+#if defined(PACKET_PAIRS) && defined(REFINE_ITP)
+/* refine_bracket of two packets, [0] and [1], their set tests side by side
+ * (iterate.cl julia_level_pair): lane for lane the same brackets. */
+inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, const lreal *b, const lmask *todo,
+                                int steps, julia_params jp, lreal *out, lreal *width)
+{
+    if (!L_ANY(todo[0] | todo[1])) {   /* nothing bracketed: no set tests at all */
+        out[0] = a[0];
+        out[1] = a[1];
+        width[0] = b[0] - a[0];
+        width[1] = b[1] - a[1];
+        return;
+    }
+    lmask ia, ib;
+    lreal fa0, fa1, fb0, fb1;
+    julia_level_pair(QRAY(o[0], d[0], a[0]), QRAY(o[1], d[1], a[1]), jp, &ia, &ib, &fa0, &fa1);
+    julia_level_pair(QRAY(o[0], d[0], b[0]), QRAY(o[1], d[1], b[1]), jp, &ia, &ib, &fb0, &fb1);
+    itp_state s0 = itp_start(a[0], b[0], fa0, fb0, todo[0], steps);
+    itp_state s1 = itp_start(a[1], b[1], fa1, fb1, todo[1], steps);
+    for (int j = 0; j <= steps && L_ANY(s0.live | s1.live); ++j) {
+        lreal x0 = itp_point(&s0, j, steps), x1 = itp_point(&s1, j, steps);
+        if (!L_ANY(s0.live | s1.live))
+            break;
+        lreal f0, f1;
+        julia_level_pair(QRAY(o[0], d[0], x0), QRAY(o[1], d[1], x1), jp, &ia, &ib, &f0, &f1);
+        itp_take(&s0, x0, f0, ia);
+        itp_take(&s1, x1, f1, ib);
+    }
+    out[0] = s0.a;
+    out[1] = s1.a;
+    width[0] = s0.b - s0.a;
+    width[1] = s1.b - s1.a;
+}
+#endif

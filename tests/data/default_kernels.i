@@ -150,6 +150,14 @@ live = dot((q), (q)) <= jp.bailout2;
 ;
 return live;
 }
+inline lreal level_value(lreal m2, lmask steps, julia_params jp, lmask *inside)
+{
+*inside = m2 <= jp.bailout2;
+lmask k = jp.max_iter - steps;
+lreal e = ldexp(log(m2 / jp.bailout2), (min(k, 60)));
+lreal out = (((k > 60) | (e > (real)69)) ? ((lreal)1e30) : (expm1(fmin(e, (real)69))));
+return ((*inside) ? (m2 / jp.bailout2 - (real)1) : (out));
+}
 inline lreal julia_level(quat p, julia_params jp, lmask *inside)
 {
 quat q = (p);
@@ -158,18 +166,10 @@ lreal m2 = dot((q), (q));
 lmask live = m2 <= jp.bailout2;
 lmask steps = 0;
 int n = 0;
-for (; n < jp.max_iter && (live); ++n) {
-q = ((live) ? (julia_f(q, c)) : (q));
-m2 = dot((q), (q));
-steps = ((live) ? (steps + 1) : (steps));
-live = m2 <= jp.bailout2;
-}
+for (; n < jp.max_iter && (live); ++n)
+do { q = ((live) ? (julia_f(q, c)) : (q)); m2 = dot((q), (q)); steps = ((live) ? (steps + 1) : (steps)); live = m2 <= (jp.bailout2); } while (0);
 ;
-*inside = m2 <= jp.bailout2;
-lmask k = jp.max_iter - steps;
-lreal e = ldexp(log(m2 / jp.bailout2), (min(k, 60)));
-lreal out = (((k > 60) | (e > (real)69)) ? ((lreal)1e30) : (expm1(fmin(e, (real)69))));
-return ((*inside) ? (m2 / jp.bailout2 - (real)1) : (out));
+return level_value(m2, steps, jp, inside);
 }
 inline lreal de_value(lreal m2, lreal dm2, lmask e)
 {
@@ -202,6 +202,46 @@ lmask escaped;
 lreal d = julia_distance_formula(p, jp, &escaped);
 return ((escaped) ? (d) : ((lreal)0));
 }
+typedef struct {
+lreal a, b, ya, yb, eps, k1;
+lmask live;
+} itp_state;
+inline itp_state itp_start(lreal a, lreal b, lreal fa, lreal fb, lmask todo, int steps)
+{
+itp_state s;
+s.a = a;
+s.b = b;
+s.ya = -fmax(fa, FLT_MIN);
+s.yb = -fmin(fb, (real)0);
+lreal w0 = b - a;
+s.eps = ldexp(w0, -(steps + 1));
+s.k1 = (real)0.2 / w0;
+s.live = todo & (b - a > (real)2 * s.eps);
+return s;
+}
+inline lreal itp_point(itp_state *s, int j, int steps)
+{
+lreal a = s->a, b = s->b;
+lreal xh = (real)0.5 * (a + b);
+s->live &= (xh > a) & (xh < b);
+lreal r = ldexp(s->eps, steps + 1 - j) - (real)0.5 * (b - a);
+lreal delta = s->k1 * (b - a) * (b - a);
+lreal xf = ((s->yb != s->ya) ? ((s->yb * a - s->ya * b) / (s->yb - s->ya)) : (xh));
+lreal sigma = ((xh >= xf) ? ((lreal)1) : ((lreal)-1));
+lreal xt = ((delta <= fabs(xh - xf)) ? (xf + sigma * delta) : (xh));
+lreal x = ((fabs(xt - xh) <= r) ? (xt) : (xh - sigma * r));
+return (((x > a) & (x < b)) ? (x) : (xh));
+}
+inline void itp_take(itp_state *s, lreal x, lreal f, lmask inside)
+{
+lreal y = -f;
+lmask got_in = s->live & inside, got_out = s->live & !inside;
+s->b = ((got_in) ? (x) : (s->b));
+s->yb = ((got_in) ? (fmax(y, (real)0)) : (s->yb));
+s->a = ((got_out) ? (x) : (s->a));
+s->ya = ((got_out) ? (fmin(y, -FLT_MIN)) : (s->ya));
+s->live &= s->b - s->a > (real)2 * s->eps;
+}
 inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int steps,
 julia_params jp, lreal *width)
 {
@@ -212,31 +252,16 @@ return a;
 lmask inside;
 lreal fa = julia_level(((o) + (a) * (d)), jp, &inside);
 lreal fb = julia_level(((o) + (b) * (d)), jp, &inside);
-lreal ya = -fmax(fa, FLT_MIN), yb = -fmin(fb, (real)0);
-lreal w0 = b - a;
-lreal eps = ldexp(w0, -(steps + 1));
-lreal k1 = (real)0.2 / w0;
-lmask live = todo & (b - a > (real)2 * eps);
-for (int j = 0; j <= steps && (live); ++j) {
-lreal xh = (real)0.5 * (a + b);
-live &= (xh > a) & (xh < b);
-if (!(live))
+itp_state s = itp_start(a, b, fa, fb, todo, steps);
+for (int j = 0; j <= steps && (s.live); ++j) {
+lreal x = itp_point(&s, j, steps);
+if (!(s.live))
 break;
-lreal r = ldexp(eps, steps + 1 - j) - (real)0.5 * (b - a);
-lreal delta = k1 * (b - a) * (b - a);
-lreal xf = ((yb != ya) ? ((yb * a - ya * b) / (yb - ya)) : (xh));
-lreal sigma = ((xh >= xf) ? ((lreal)1) : ((lreal)-1));
-lreal xt = ((delta <= fabs(xh - xf)) ? (xf + sigma * delta) : (xh));
-lreal x = ((fabs(xt - xh) <= r) ? (xt) : (xh - sigma * r));
-x = (((x > a) & (x < b)) ? (x) : (xh));
-lreal y = -julia_level(((o) + (x) * (d)), jp, &inside);
-lmask got_in = live & inside, got_out = live & !inside;
-b = ((got_in) ? (x) : (b));
-yb = ((got_in) ? (fmax(y, (real)0)) : (yb));
-a = ((got_out) ? (x) : (a));
-ya = ((got_out) ? (fmin(y, -FLT_MIN)) : (ya));
-live &= b - a > (real)2 * eps;
+lreal f = julia_level(((o) + (x) * (d)), jp, &inside);
+itp_take(&s, x, f, inside);
 }
+a = s.a;
+b = s.b;
 *width = b - a;
 return a;
 }
@@ -285,18 +310,19 @@ next = ((stall) ? (nextafter(m->t, (lreal)INFINITY)) : (next));
 m->t_prev = ((m->active & !gap) ? (m->t) : (m->t_prev));
 m->t = ((m->active) ? (next) : (m->t));
 }
-inline lreal de_end(de_march *m, quat o, quat d, lreal near, lreal far, lmask live, int post_steps,
-int max_steps, julia_params jp, lmask *status, lmask *samples, lmask *flags,
-lreal *width, lreal *unresolved)
+inline lmask de_close(const de_march *m, lmask live, int max_steps, lmask *status, lmask *samples, lmask *flags)
 {
-lmask hit = m->hit, first = m->first;
 *samples = ((m->active) ? ((lmask)max_steps) : (*samples));
 *flags |= ((m->miss & m->shell) ? ((lmask)8) : ((lmask)0));
-*status = ((live) ? (((hit) ? ((lmask)1) : (((m->miss) ? ((lmask)0) : ((lmask)2))))) : (*status));
-lreal w;
-lreal a = refine_bracket(o, d, m->t_prev, m->t, hit & !first, post_steps, jp, &w);
-*width = ((hit) ? (((hit & !first) ? (w) : ((lreal)0))) : (*width));
-lreal depth = ((hit) ? (((hit & !first) ? (a) : (m->t))) : ((lreal)INFINITY));
+*status = ((live) ? (((m->hit) ? ((lmask)1) : (((m->miss) ? ((lmask)0) : ((lmask)2))))) : (*status));
+return m->hit & !m->first;
+}
+inline lreal de_depth(const de_march *m, lreal a, lreal w, lreal near, lreal far, lmask live, lreal *width,
+lreal *unresolved)
+{
+lmask hit = m->hit, refined = m->hit & !m->first;
+*width = ((hit) ? (((refined) ? (w) : ((lreal)0))) : (*width));
+lreal depth = ((hit) ? (((refined) ? (a) : (m->t))) : ((lreal)INFINITY));
 *unresolved = ((live) ? (((hit) ? (depth - near) : (far - near))) : (*unresolved));
 return depth;
 }
@@ -311,8 +337,10 @@ lmask escaped;
 lreal dist = julia_distance_formula(((o) + (m.t) * (d)), jp, &escaped);
 de_advance(&m, i, dist, escaped, jp.epsilon, samples, flags);
 }
-return de_end(&m, o, d, near, far, live, post_steps, max_steps, jp, status, samples, flags, width,
-unresolved);
+lmask todo = de_close(&m, live, max_steps, status, samples, flags);
+lreal w;
+lreal a = refine_bracket(o, d, m.t_prev, m.t, todo, post_steps, jp, &w);
+return de_depth(&m, a, w, near, far, live, width, unresolved);
 }
 inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 {
