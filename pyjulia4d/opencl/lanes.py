@@ -106,8 +106,8 @@ def packet_pairs(device: cl.Device, lanes: int, double: bool) -> bool:
     march_packets): where one packet fills no more than one of the device's vector registers
     (its native vector width in floats or doubles; 16 floats in AVX-512).  There one packet's
     march is a single chain of dependent operations that leaves the vector units waiting, and two
-    side by side took 0.87-0.93x the march's time on the default scene; with AVX2's 8-float
-    registers a packet of 16 is already two chains, and pairs took 1.02x
+    side by side took 0.83x the march's time and 0.78x the light terms' on the default scene;
+    with AVX2's 8-float registers a packet of 16 is already two chains, and pairs took 1.02x
     (benchmarks/commit_ratio.py, docs/performance.md)."""
     if lanes <= 1:
         return False
