@@ -190,6 +190,16 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
  * |a'_{n+1}| = D |a_n|^(D-1) |a'_n|) where the component has provably escaped, |a_n| > 1 +
  * |c_a| (then |a^D + c_a| > |a|), and 0 where it has not (an under-estimate: safe steps).
  * The loop is the set test's (|h_n| <= bailout); *escaped is that test's. */
+/* the estimate from the orbit's end q and the components' squared derivatives da * 2^ea, db * 2^eb */
+inline lreal split_value(quat q, real4 c, lreal da, lmask ea, lreal db, lmask eb)
+{
+    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
+    real ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
+    lreal d_a = L_SEL((lreal)0, de_value(ma, da, ea), ma > ra * ra);
+    lreal d_b = L_SEL((lreal)0, de_value(mb, db, eb), mb > rb * rb);
+    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+}
+
 inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat q = ALG_IN(p);
@@ -208,12 +218,47 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
     }
     COUNT_ITER(jp, n);
     *escaped = m2 > jp.bailout2;
-    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
-    real ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
-    lreal d_a = L_SEL((lreal)0, de_value(ma, da, ea), ma > ra * ra);
-    lreal d_b = L_SEL((lreal)0, de_value(mb, db, eb), mb > rb * rb);
-    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+    return split_value(q, c, da, ea, db, eb);
 }
+
+#ifdef PACKET_PAIRS
+/* The estimates of two packets (march/de.cl march_ray_pair) in one loop, lane for lane the
+ * values julia_distance_formula gives; one test for the four derivatives' rescaling. */
+inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
+                                        lreal *dpa, lreal *dpb)
+{
+    quat q0 = ALG_IN(pa), q1 = ALG_IN(pb);
+    real4 c = ALG_C(jp.c);
+    lreal m0 = ALG_NORM2(q0), m1 = ALG_NORM2(q1);
+    lreal a0 = (lreal)1, b0 = (lreal)1, a1 = (lreal)1, b1 = (lreal)1;
+    lmask ea0 = 0, eb0 = 0, ea1 = 0, eb1 = 0;
+    lmask live0 = m0 <= jp.bailout2, live1 = m1 <= jp.bailout2;
+    for (int n = 0; n < jp.max_iter && L_ANY(live0 | live1); ++n) {
+        a0 = L_SEL(a0, a0 * JULIA_DF2(q0.x * q0.x + q0.y * q0.y), live0);
+        b0 = L_SEL(b0, b0 * JULIA_DF2(q0.z * q0.z + q0.w * q0.w), live0);
+        a1 = L_SEL(a1, a1 * JULIA_DF2(q1.x * q1.x + q1.y * q1.y), live1);
+        b1 = L_SEL(b1, b1 * JULIA_DF2(q1.z * q1.z + q1.w * q1.w), live1);
+        lmask ga0 = live0 & (a0 > (real)1e16), gb0 = live0 & (b0 > (real)1e16);
+        lmask ga1 = live1 & (a1 > (real)1e16), gb1 = live1 & (b1 > (real)1e16);
+        if (L_ANY(ga0 | gb0 | ga1 | gb1)) {
+            DE_RESCALE(a0, ea0, ga0);
+            DE_RESCALE(b0, eb0, gb0);
+            DE_RESCALE(a1, ea1, ga1);
+            DE_RESCALE(b1, eb1, gb1);
+        }
+        q0 = QSEL(q0, julia_f(q0, c), live0);
+        q1 = QSEL(q1, julia_f(q1, c), live1);
+        m0 = ALG_NORM2(q0);
+        m1 = ALG_NORM2(q1);
+        live0 = m0 <= jp.bailout2;
+        live1 = m1 <= jp.bailout2;
+    }
+    *escaped_a = m0 > jp.bailout2;
+    *escaped_b = m1 > jp.bailout2;
+    *dpa = split_value(q0, c, a0, ea0, b0, eb0);
+    *dpb = split_value(q1, c, a1, ea1, b1, eb1);
+}
+#endif
 #endif
 
 /* The distance estimate the march steps by: 0 inside (the point never escaped). */

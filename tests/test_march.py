@@ -180,6 +180,9 @@ def test_itp_needs_fewer_set_tests_than_bisection():
     # |q'|^2 rescaled (iterate.cl DE_RESCALE) in both packets' orbits; shell steps, refinement
     (["fractal.max_iter=60", "fractal.bailout=50", "march.epsilon=1e-4"], (40, 20)),
     (["fractal.function=cube", "fractal.c=0.3,0.5,0.1,0", "fractal.theta=30"], (44, 28)),
+    # a split algebra's estimate (iterate.cl, ALG_SPLIT), its four derivatives rescaled
+    (["fractal.algebra=hypercomplex", "fractal.c=-0.123,0.745,0,0", "fractal.max_iter=40",
+      "fractal.bailout=20"], (40, 24)),
 ])
 def test_packet_pairs_give_the_single_packets_pixels(over, size):
     """Two packets per work-item (-D PACKET_PAIRS: march/de.cl march_ray_pair, their estimates side
@@ -201,12 +204,13 @@ def test_packet_pairs_give_the_single_packets_pixels(over, size):
 
 def test_packet_pairs_only_where_the_estimate_is_the_iterations():
     """march_packets: pairs for the estimate's march of a Julia set in packets; one packet for one ray
-    per work-item, the other marches, the split algebras' and the other kinds' estimates."""
+    per work-item, the other marches and the other kinds' estimates."""
     d = Scene.default()
     assert kernel_config.march_packets(d, 16) == 2
-    assert kernel_config.march_packets(d, 1) == 1
-    for over in (["march.method=fixed"], ["march.method=proven"], ["fractal.algebra=hypercomplex"],
-                 ["fractal.kind=mandelbrot"]):
+    assert kernel_config.march_packets(d.with_overrides(["fractal.algebra=hypercomplex"]), 8) == 2
+    assert kernel_config.march_packets(d, 1) == 1 and kernel_config.march_packets(d, 16, pairs=False) == 1
+    for over in (["march.method=fixed"], ["march.method=proven"], ["fractal.kind=mandelbrot"],
+                 ["fractal.algebra=hypercomplex", "fractal.function=sin"]):
         assert kernel_config.march_packets(d.with_overrides(over), 16) == 1, over
     assert march_items(48 * 36, 48, 16, 2) == 6 * 9 and march_items(146 * 9, 146, 16, 2) == 19 * 3
 

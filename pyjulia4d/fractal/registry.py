@@ -72,12 +72,6 @@ class Algebra(_Entry):
         or a disc per complex component of a split algebra) and their twin."""
         return f"enclose/{self.enclosure}"
 
-    @property
-    def split(self) -> bool:
-        """A product of two complex planes (h = a e1 + b e2): its distance estimate is that of a
-        product of two sets (kernels/iterate.cl, ALG_SPLIT), its enclosures a disc per plane."""
-        return self.enclosure == "split"
-
 
 @dataclass(frozen=True)
 class Kind:

@@ -198,12 +198,10 @@ def march_packets(scene: Scene, lanes: int, pairs: bool = True) -> int:
     """Packets of ``lanes`` rays that a work-item of the march takes (kernels/march/march.cl): two
     (-D PACKET_PAIRS), their estimates computed side by side, where ``pairs`` asks for them
     (opencl/lanes.py packet_pairs: where a packet fills one vector register) and the march
-    steps by the iteration's own estimate (the distance-estimate march of a Julia set of an
-    algebra that is not split: iterate.cl julia_distance_formula_pair); one otherwise, and
-    with one ray per work-item."""
+    steps by the iteration's own estimate (the distance-estimate march of a Julia set:
+    iterate.cl julia_distance_formula_pair); one otherwise, and with one ray per work-item."""
     f = scene.fractal
-    both = (pairs and lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
-            and not ALGEBRAS_TABLE[f.algebra].split)
+    both = pairs and lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
     return 2 if both else 1
 
 
