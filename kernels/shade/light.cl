@@ -67,7 +67,11 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, 
     return clamp(m.vis, (real)0, (real)1);
 }
 
-#ifdef PACKET_PAIRS
+#if PACKETS == 2 && defined(ALG_HAS_DE)
+#define LIGHT_PAIRS   /* two packets' estimates side by side (iterate.cl julia_distance_formula_pair) */
+#endif
+
+#ifdef LIGHT_PAIRS
 /* shadow_ray of two packets, [0] and [1], their estimates side by side (march/march.cl
  * PACKET_PAIRS): lane for lane the same steps and visibilities. */
 inline void shadow_ray_pair(const quat *o, const quat *l, const lreal *tmax, const lmask *lit, julia_params jp,
@@ -118,7 +122,7 @@ inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real 
     return clamp((real)1 - strength * occ / wsum, (real)0, (real)1);
 }
 
-#ifdef PACKET_PAIRS
+#ifdef LIGHT_PAIRS
 /* ambient_occlusion of two packets, their estimates side by side: the same values */
 inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp, real dist, real strength,
                                    lreal *amb)
@@ -284,10 +288,11 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
                 l[b] = QSCALE((real)1 / fmax(dist[b], REAL_MIN), lv);
                 facing[b] = hit[b] & LIGHT_FACES(nw[b], QADD(lp, QSCALE((lreal)-1, p[b])));
             }
-#if PACKETS == 2
+#ifdef LIGHT_PAIRS
             shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, vis);
 #else
-            vis[0] = shadow_ray(o[0], l[0], dist[0], facing[0], jp, radius, step, softness, max_steps);
+            for (int b = 0; b < PACKETS; ++b)
+                vis[b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
 #endif
         }
 #endif
@@ -318,19 +323,21 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
                                  (QDOT_UNIFORM(to, forward) == (real)0);
                     facing[b] = hit[b] & (LIGHT_FACES(nw[b], to) | flat);
                 }
-#if PACKETS == 2
+#ifdef LIGHT_PAIRS
                 shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, ve[j]);
 #else
-                ve[j][0] = shadow_ray(o[0], l[0], dist[0], facing[0], jp, radius, step, softness, max_steps);
+                for (int b = 0; b < PACKETS; ++b)
+                    ve[j][b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
 #endif
             }
         }
 #endif
 #ifdef AO
-#if PACKETS == 2
+#ifdef LIGHT_PAIRS
         ambient_occlusion_pair(o, nw, jp, ao_distance, ao_strength, amb);
 #else
-        amb[0] = ambient_occlusion(o[0], nw[0], jp, ao_distance, ao_strength);
+        for (int b = 0; b < PACKETS; ++b)
+            amb[b] = ambient_occlusion(o[b], nw[b], jp, ao_distance, ao_strength);
 #endif
 #endif
         for (int b = 0; b < PACKETS; ++b) {
