@@ -120,6 +120,23 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
             DE_RESCALE(dm2, e, big_); \
     } while (0)
 
+/* two packets' orbits from the points pa, pb (the pair estimates below): declares their
+ * iterates, |q|^2 and live lanes */
+#define PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, bailout2) \
+    quat qa = ALG_IN(pa), qb = ALG_IN(pb); \
+    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
+    lmask live_a = m2a <= (bailout2), live_b = m2b <= (bailout2)
+
+/* two packets' orbits one step on where live (the pair estimates below) */
+#define PAIR_ORBIT_STEP(qa, qb, m2a, m2b, live_a, live_b, c, bailout2) do { \
+        qa = QSEL(qa, julia_f(qa, c), live_a); \
+        qb = QSEL(qb, julia_f(qb, c), live_b); \
+        m2a = ALG_NORM2(qa); \
+        m2b = ALG_NORM2(qb); \
+        live_a = m2a <= (bailout2); \
+        live_b = m2b <= (bailout2); \
+    } while (0)
+
 #ifndef ALG_SPLIT
 /* one step of the estimate's orbit where live: q <- f(q) + c, |q'|^2 (dm2 * 2^e) grown */
 #define DE_ORBIT_STEP(q, m2, dm2, e, live, c, bailout2) do { \
@@ -153,12 +170,10 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
                                         lreal *da, lreal *db)
 {
-    quat qa = ALG_IN(pa), qb = ALG_IN(pb);
     real4 c = ALG_C(jp.c);
-    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb);
+    PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, jp.bailout2);
     lreal dm2a = (lreal)1, dm2b = (lreal)1;
     lmask ea = 0, eb = 0;
-    lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2;
     for (int n = 0; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
         dm2a = L_SEL(dm2a, dm2a * JULIA_DF2(m2a), live_a);
         dm2b = L_SEL(dm2b, dm2b * JULIA_DF2(m2b), live_b);
@@ -167,12 +182,7 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
             DE_RESCALE(dm2a, ea, big_a);
             DE_RESCALE(dm2b, eb, big_b);
         }
-        qa = QSEL(qa, julia_f(qa, c), live_a);
-        qb = QSEL(qb, julia_f(qb, c), live_b);
-        m2a = ALG_NORM2(qa);
-        m2b = ALG_NORM2(qb);
-        live_a = m2a <= jp.bailout2;
-        live_b = m2b <= jp.bailout2;
+        PAIR_ORBIT_STEP(qa, qb, m2a, m2b, live_a, live_b, c, jp.bailout2);
     }
     *escaped_a = m2a > jp.bailout2;
     *escaped_b = m2b > jp.bailout2;
@@ -227,12 +237,10 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
                                         lreal *dpa, lreal *dpb)
 {
-    quat q0 = ALG_IN(pa), q1 = ALG_IN(pb);
     real4 c = ALG_C(jp.c);
-    lreal m0 = ALG_NORM2(q0), m1 = ALG_NORM2(q1);
+    PAIR_ORBIT_START(pa, pb, q0, q1, m0, m1, live0, live1, jp.bailout2);
     lreal a0 = (lreal)1, b0 = (lreal)1, a1 = (lreal)1, b1 = (lreal)1;
     lmask ea0 = 0, eb0 = 0, ea1 = 0, eb1 = 0;
-    lmask live0 = m0 <= jp.bailout2, live1 = m1 <= jp.bailout2;
     for (int n = 0; n < jp.max_iter && L_ANY(live0 | live1); ++n) {
         a0 = L_SEL(a0, a0 * JULIA_DF2(q0.x * q0.x + q0.y * q0.y), live0);
         b0 = L_SEL(b0, b0 * JULIA_DF2(q0.z * q0.z + q0.w * q0.w), live0);
@@ -246,12 +254,7 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
             DE_RESCALE(a1, ea1, ga1);
             DE_RESCALE(b1, eb1, gb1);
         }
-        q0 = QSEL(q0, julia_f(q0, c), live0);
-        q1 = QSEL(q1, julia_f(q1, c), live1);
-        m0 = ALG_NORM2(q0);
-        m1 = ALG_NORM2(q1);
-        live0 = m0 <= jp.bailout2;
-        live1 = m1 <= jp.bailout2;
+        PAIR_ORBIT_STEP(q0, q1, m0, m1, live0, live1, c, jp.bailout2);
     }
     *escaped_a = m0 > jp.bailout2;
     *escaped_b = m1 > jp.bailout2;
