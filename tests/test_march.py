@@ -183,6 +183,11 @@ def test_itp_needs_fewer_set_tests_than_bisection():
     # a split algebra's estimate (iterate.cl, ALG_SPLIT), its four derivatives rescaled
     (["fractal.algebra=hypercomplex", "fractal.c=-0.123,0.745,0,0", "fractal.max_iter=40",
       "fractal.bailout=20"], (40, 24)),
+    # the Mandelbrot sets' own estimate and level (kind/mandelbrot.cl), quaternion and split
+    (["fractal.kind=mandelbrot", "fractal.max_iter=30", "camera.position=0.4,2.2,-3.2,0",
+      "camera.target=-0.5,0,0,0"], (36, 20)),
+    (["fractal.kind=mandelbrot", "fractal.algebra=hypercomplex", "fractal.max_iter=30",
+      "camera.position=0.4,2.2,-3.2,0", "camera.target=-0.5,0,0,0"], (36, 20)),
 ])
 def test_packet_pairs_give_the_single_packets_pixels(over, size):
     """Two packets per work-item (-D PACKET_PAIRS: march/de.cl march_ray_pair, their estimates side
@@ -203,13 +208,14 @@ def test_packet_pairs_give_the_single_packets_pixels(over, size):
 
 
 def test_packet_pairs_only_where_the_estimate_is_the_iterations():
-    """march_packets: pairs for the estimate's march of a Julia set in packets; one packet for one ray
-    per work-item, the other marches and the other kinds' estimates."""
+    """march_packets: pairs for the estimate's march of a Julia or Mandelbrot set in packets; one
+    packet for one ray per work-item, the other marches and the other kinds' estimates."""
     d = Scene.default()
     assert kernel_config.march_packets(d, 16) == 2
     assert kernel_config.march_packets(d.with_overrides(["fractal.algebra=hypercomplex"]), 8) == 2
+    assert kernel_config.march_packets(d.with_overrides(["fractal.kind=mandelbrot"]), 16) == 2
     assert kernel_config.march_packets(d, 1) == 1 and kernel_config.march_packets(d, 16, pairs=False) == 1
-    for over in (["march.method=fixed"], ["march.method=proven"], ["fractal.kind=mandelbrot"],
+    for over in (["march.method=fixed"], ["march.method=proven"], ["fractal.kind=julia_stack"],
                  ["fractal.algebra=hypercomplex", "fractal.function=sin"]):
         assert kernel_config.march_packets(d.with_overrides(over), 16) == 1, over
     assert march_items(48 * 36, 48, 16, 2) == 6 * 9 and march_items(146 * 9, 146, 16, 2) == 19 * 3

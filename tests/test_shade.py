@@ -265,7 +265,7 @@ def test_lights_and_reflection_compile_only_where_used():
     assert "EXTRA_SHADOWS" not in kernel_config.scene_config(lit.with_overrides(["shading.shadow=none"])).defines
 
 
-@pytest.mark.parametrize("name", ["soft+ao", "hard+trap", "three-lights-soft", "w"])
+@pytest.mark.parametrize("name", ["soft+ao", "hard+trap", "three-lights-soft", "w", "mandelbrot-trap"])
 def test_packet_pairs_light_the_same_pixels(name):
     """Two packets per work-item (-D PACKET_PAIRS: the march's and the light terms' shadow rays
     and occlusion, their estimates side by side) give every output of one packet per work-item,

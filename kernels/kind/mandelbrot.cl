@@ -58,6 +58,43 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
     return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
 }
 
+#ifdef PACKET_PAIRS
+/* two packets' orbits of q -> f(q) + c from their points (the pairs below, as iterate.cl's) */
+#define MANDEL_PAIR_START(pa, pb) \
+    quat ca = ALG_IN(pa), cb = ALG_IN(pb); \
+    quat qa = MANDEL_START(ca), qb = MANDEL_START(cb); \
+    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
+    lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2
+#define MANDEL_PAIR_STEP() do { \
+        qa = QSEL(qa, mandel_f(qa, ca), live_a); \
+        qb = QSEL(qb, mandel_f(qb, cb), live_b); \
+        m2a = ALG_NORM2(qa); \
+        m2b = ALG_NORM2(qb); \
+        live_a = m2a <= jp.bailout2; \
+        live_b = m2b <= jp.bailout2; \
+    } while (0)
+
+/* mandel_level at two packets' points in one loop (march/refine.cl refine_bracket_pair) */
+inline void mandel_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b,
+                              lreal *fa, lreal *fb)
+{
+    MANDEL_PAIR_START(pa, pb);
+    lmask steps_a = 1, steps_b = 1;   /* q_1 = c: one iteration done */
+    for (int n = 1; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
+        steps_a = L_SEL(steps_a, steps_a + 1, live_a);
+        steps_b = L_SEL(steps_b, steps_b + 1, live_b);
+        MANDEL_PAIR_STEP();
+    }
+    *inside_a = m2a <= jp.bailout2;
+    *inside_b = m2b <= jp.bailout2;
+    *fa = L_SEL(kind_level(m2a, jp.bailout2, jp.max_iter - steps_a, JULIA_GROWTH), m2a / jp.bailout2 - (real)1,
+                *inside_a);
+    *fb = L_SEL(kind_level(m2b, jp.bailout2, jp.max_iter - steps_b, JULIA_GROWTH), m2b / jp.bailout2 - (real)1,
+                *inside_b);
+}
+#define julia_level_pair mandel_level_pair
+#endif
+
 #ifdef ALG_HAS_DE
 /* The distance estimate of seed 001 §3.1 eq. 8, d = |q_n| ln|q_n| / (2 |q_n'|), with the
  * derivative taken with respect to c:  q'_1 = 1,  q'_{n+1} = f'(q_n) q'_n + 1.  Its norm is
@@ -89,11 +126,41 @@ inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
     *escaped = m2 > jp.bailout2;
     return de_value(m2, dr * dr, e + e);
 }
+
+#ifdef PACKET_PAIRS
+/* mandel_distance_formula at two packets' points in one loop (march/de.cl march_ray_pair) */
+inline void mandel_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
+                                         lreal *da, lreal *db)
+{
+    MANDEL_PAIR_START(pa, pb);
+    lreal dra = (lreal)1, drb = (lreal)1;
+    lmask ea = 0, eb = 0;
+    for (int n = 1; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
+        MANDEL_GROW(dra, ea, sqrt(JULIA_DF2(m2a)), live_a);
+        MANDEL_GROW(drb, eb, sqrt(JULIA_DF2(m2b)), live_b);
+        MANDEL_PAIR_STEP();
+    }
+    *escaped_a = m2a > jp.bailout2;
+    *escaped_b = m2b > jp.bailout2;
+    *da = de_value(m2a, dra * dra, ea + ea);
+    *db = de_value(m2b, drb * drb, eb + eb);
+}
+#endif
 #else
 /* The split algebra (algebra/hypercomplex.cl): c = c_a e1 + c_b e2 and the set is the product
  * M_a x M_b of two complex Mandelbrot sets, so, as for its Julia sets (iterate.cl),
  * d = sqrt(d_a^2 + d_b^2) / sqrt(2), each d_a the complex estimate above where the component
  * has provably escaped (|a_n| > 1 + |c_a|), else 0. */
+/* the estimate from the orbit's end q, c and the components' derivative bounds da * 2^ea, db * 2^eb */
+inline lreal mandel_split_value(quat q, quat c, lreal da, lmask ea, lreal db, lmask eb)
+{
+    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
+    lreal ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
+    lreal d_a = L_SEL((lreal)0, de_value(ma, da * da, ea + ea), ma > ra * ra);
+    lreal d_b = L_SEL((lreal)0, de_value(mb, db * db, eb + eb), mb > rb * rb);
+    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+}
+
 inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
     quat c = ALG_IN(p);
@@ -112,12 +179,30 @@ inline lreal mandel_distance_formula(quat p, julia_params jp, lmask *escaped)
     }
     COUNT_ITER(jp, n - 1);
     *escaped = m2 > jp.bailout2;
-    lreal ma = q.x * q.x + q.y * q.y, mb = q.z * q.z + q.w * q.w;
-    lreal ra = (real)1 + hypot(c.x, c.y), rb = (real)1 + hypot(c.z, c.w);
-    lreal d_a = L_SEL((lreal)0, de_value(ma, da * da, ea + ea), ma > ra * ra);
-    lreal d_b = L_SEL((lreal)0, de_value(mb, db * db, eb + eb), mb > rb * rb);
-    return sqrt(d_a * d_a + d_b * d_b) * (real)0.70710678118654752;
+    return mandel_split_value(q, c, da, ea, db, eb);
 }
+
+#ifdef PACKET_PAIRS
+/* mandel_distance_formula at two packets' points in one loop (march/de.cl march_ray_pair) */
+inline void mandel_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask *escaped_a, lmask *escaped_b,
+                                         lreal *dpa, lreal *dpb)
+{
+    MANDEL_PAIR_START(pa, pb);
+    lreal a0 = (lreal)1, b0 = (lreal)1, a1 = (lreal)1, b1 = (lreal)1;
+    lmask ea0 = 0, eb0 = 0, ea1 = 0, eb1 = 0;
+    for (int n = 1; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
+        MANDEL_GROW(a0, ea0, sqrt(JULIA_DF2(qa.x * qa.x + qa.y * qa.y)), live_a);
+        MANDEL_GROW(b0, eb0, sqrt(JULIA_DF2(qa.z * qa.z + qa.w * qa.w)), live_a);
+        MANDEL_GROW(a1, ea1, sqrt(JULIA_DF2(qb.x * qb.x + qb.y * qb.y)), live_b);
+        MANDEL_GROW(b1, eb1, sqrt(JULIA_DF2(qb.z * qb.z + qb.w * qb.w)), live_b);
+        MANDEL_PAIR_STEP();
+    }
+    *escaped_a = m2a > jp.bailout2;
+    *escaped_b = m2b > jp.bailout2;
+    *dpa = mandel_split_value(qa, ca, a0, ea0, b0, eb0);
+    *dpb = mandel_split_value(qb, cb, a1, ea1, b1, eb1);
+}
+#endif
 #endif
 
 inline lreal mandel_distance(quat p, julia_params jp)
@@ -128,6 +213,9 @@ inline lreal mandel_distance(quat p, julia_params jp)
 }
 #define julia_distance_formula mandel_distance_formula
 #define julia_distance mandel_distance
+#ifdef PACKET_PAIRS
+#define julia_distance_formula_pair mandel_distance_formula_pair
+#endif
 #endif  /* ALG_HAS_DE */
 
 #define julia_inside mandel_inside

@@ -198,10 +198,11 @@ def march_packets(scene: Scene, lanes: int, pairs: bool = True) -> int:
     """Packets of ``lanes`` rays that a work-item of the march takes (kernels/march/march.cl): two
     (-D PACKET_PAIRS), their estimates computed side by side, where ``pairs`` asks for them
     (opencl/lanes.py packet_pairs: where a packet fills one vector register) and the march
-    steps by the iteration's own estimate (the distance-estimate march of a Julia set:
-    iterate.cl julia_distance_formula_pair); one otherwise, and with one ray per work-item."""
+    steps by the estimate of a Julia or Mandelbrot set (julia_distance_formula_pair,
+    julia_level_pair: iterate.cl, kind/mandelbrot.cl); one otherwise, and with one ray per
+    work-item."""
     f = scene.fractal
-    both = pairs and lanes > 1 and march_method(scene) == "de" and f.kind == "julia"
+    both = pairs and lanes > 1 and march_method(scene) == "de" and f.kind in ("julia", "mandelbrot")
     return 2 if both else 1
 
 
