@@ -20,6 +20,13 @@ inline lmask julia_inside(quat p, julia_params jp)
     return live;
 }
 
+/* two packets' orbits from the points pa, pb (the pair level and estimates below): declares their
+ * iterates, |q|^2 and live lanes */
+#define PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, bailout2) \
+    quat qa = ALG_IN(pa), qb = ALG_IN(pb); \
+    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
+    lmask live_a = m2a <= (bailout2), live_b = m2b <= (bailout2)
+
 /* one step of the level function's orbit where live, counting the steps done */
 #define LEVEL_ORBIT_STEP(q, m2, steps, live, c, bailout2) do { \
         q = QSEL(q, julia_f(q, c), live); \
@@ -69,10 +76,8 @@ inline lreal julia_level(quat p, julia_params jp, lmask *inside)
 inline void julia_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b,
                              lreal *fa, lreal *fb)
 {
-    quat qa = ALG_IN(pa), qb = ALG_IN(pb);
     real4 c = ALG_C(jp.c);
-    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb);
-    lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2;
+    PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, jp.bailout2);
     lmask steps_a = 0, steps_b = 0;
     for (int n = 0; n < jp.max_iter && L_ANY(live_a | live_b); ++n) {
         LEVEL_ORBIT_STEP(qa, m2a, steps_a, live_a, c, jp.bailout2);
@@ -119,13 +124,6 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
         if (L_ANY(big_)) \
             DE_RESCALE(dm2, e, big_); \
     } while (0)
-
-/* two packets' orbits from the points pa, pb (the pair estimates below): declares their
- * iterates, |q|^2 and live lanes */
-#define PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, bailout2) \
-    quat qa = ALG_IN(pa), qb = ALG_IN(pb); \
-    lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
-    lmask live_a = m2a <= (bailout2), live_b = m2b <= (bailout2)
 
 /* two packets' orbits one step on where live (the pair estimates below) */
 #define PAIR_ORBIT_STEP(qa, qb, m2a, m2b, live_a, live_b, c, bailout2) do { \

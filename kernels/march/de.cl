@@ -147,12 +147,7 @@ inline void march_ray_pair(const quat *o, const quat *d, const lreal *near, cons
         t_prev[k] = m[k].t_prev;
         t[k] = m[k].t;
     }
-#ifdef REFINE_ITP
     refine_bracket_pair(o, d, t_prev, t, todo, post_steps, jp, a, w);
-#else
-    for (int k = 0; k < 2; ++k)
-        a[k] = refine_bracket(o[k], d[k], t_prev[k], t[k], todo[k], post_steps, jp, &w[k]);
-#endif
     for (int k = 0; k < 2; ++k)
         depth[k] = de_depth(&m[k], a[k], w[k], near[k], far[k], live[k], &width[k], &unresolved[k]);
 }

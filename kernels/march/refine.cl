@@ -106,12 +106,16 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
     return a;
 }
 
-#if defined(PACKET_PAIRS) && defined(REFINE_ITP)
-/* refine_bracket of two packets, [0] and [1], their set tests side by side
- * (iterate.cl julia_level_pair): lane for lane the same brackets. */
+#ifdef PACKET_PAIRS
+/* refine_bracket of two packets, [0] and [1]: ITP's set tests side by side (iterate.cl
+ * julia_level_pair), lane for lane the same brackets; bisection one packet after the other. */
 inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, const lreal *b, const lmask *todo,
                                 int steps, julia_params jp, lreal *out, lreal *width)
 {
+#ifndef REFINE_ITP
+    for (int k = 0; k < 2; ++k)
+        out[k] = refine_bracket(o[k], d[k], a[k], b[k], todo[k], steps, jp, &width[k]);
+#else
     if (!L_ANY(todo[0] | todo[1])) {   /* nothing bracketed: no set tests at all */
         out[0] = a[0];
         out[1] = a[1];
@@ -138,5 +142,6 @@ inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, co
     out[1] = s1.a;
     width[0] = s0.b - s0.a;
     width[1] = s1.b - s1.a;
+#endif
 }
 #endif

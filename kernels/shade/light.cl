@@ -33,17 +33,22 @@ inline shadow_march shadow_start(quat o, quat l, lreal tmax, lmask lit, real rad
     return m;
 }
 
+/* the ray moves on by dt; lanes whose point was in the set (in) are in shadow and stop */
+inline void shadow_move(shadow_march *m, lmask in, lreal dt)
+{
+    m->t = m->t + dt;
+    m->vis = L_SEL(m->vis, (lreal)0, in);
+    m->active &= !in & (m->t < m->t1);
+}
+
 #ifdef ALG_HAS_DE
 /* a step by the estimate d at t (escaped: the point's orbit escaped; else the ray is in the set) */
 inline void shadow_advance(shadow_march *m, lreal d, lmask escaped, real step, real softness)
 {
-    lmask in = m->active & !escaped;
 #ifdef SHADOW_SOFT
     m->vis = L_SEL(m->vis, fmin(m->vis, softness * (real)2 * d / m->t), m->active & escaped);
 #endif
-    m->t = m->t + fmax(d, (lreal)step);
-    m->vis = L_SEL(m->vis, (lreal)0, in);
-    m->active &= !in & (m->t < m->t1);
+    shadow_move(m, m->active & !escaped, fmax(d, (lreal)step));
 }
 #endif
 
@@ -58,10 +63,7 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, 
         lreal d = julia_distance_formula(x, jp, &escaped);
         shadow_advance(&m, d, escaped, step, softness);
 #else
-        lmask in = m.active & julia_inside(x, jp);
-        m.t = m.t + step;
-        m.vis = L_SEL(m.vis, (lreal)0, in);
-        m.active &= !in & (m.t < m.t1);
+        shadow_move(&m, m.active & julia_inside(x, jp), (lreal)step);
 #endif
     }
     return clamp(m.vis, (real)0, (real)1);
