@@ -124,6 +124,69 @@ def test_peers_report_runs(tmp_path, monkeypatch):
     assert "| pyjulia4d default |" in md and "pixels per CPU-second" in md
 
 
+def test_peer_error_counts_wrong_pixels():
+    """benchmarks/peer_error.py's error of a row, on hand-made depths: a silhouette
+    disagreement is wrong at any tolerance, a depth error is wrong past its share of a pixel."""
+    import numpy as np
+
+    pe = load("peer_error")
+    inf = np.inf
+    truth = np.array([1.0, 2.0, 3.0, inf, 4.0])
+    pixel = np.full(5, 1e-2)                     # one pixel's worth of depth everywhere
+    depth = np.array([[1.0, 2.0005, 3.05, 1.0, inf]])   # exact, 0.05 px, 5 px, false hit, missed
+    e = pe.errors(depth, np.arange(5), truth, pixel)
+    assert e["sil"] == 0.4
+    assert e["wrong01"] == 0.6 and e["wrong1"] == 0.6   # the 5 px error and both silhouette errors
+    depth[0, 1] = 2.002                                  # 0.2 px: wrong at 0.1 px, not at 1 px
+    e = pe.errors(depth, np.arange(5), truth, pixel)
+    assert e["wrong01"] == 0.8 and e["wrong1"] == 0.6
+    assert abs(e["p50"] - 0.002) < 1e-12 and e["p99"] > e["p90"] > e["p50"]
+    assert pe.as_good(e, e) and not pe.as_good(e, dict(e, wrong1=0.5))
+
+
+def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
+    """POV-Ray's depth as benchmarks/peer_error.py reads it (a distance pigment in two 16-bit
+    channels) against the float64 brute force of the same set: at precision 1000 POV-Ray
+    steps over nothing at this size, so every pixel both hit agrees to 1e-6 (its bisection
+    polishes to about 1e-7) - which checks the encoding, the decoding and the view mapping."""
+    import shutil
+
+    import numpy as np
+
+    if shutil.which("povray") is None:
+        pytest.skip("povray not installed (Debian: apt-get install povray)")
+    pe = load("peer_error")
+    from pyjulia4d import reference as ref
+    from pyjulia4d.geometry.camera import camera_frame
+    from pyjulia4d.interop.povray import import_pov
+    from pyjulia4d.measure.truth import brute_force_depth
+
+    w, h = 32, 24
+    text = pe.pov_matched(w, h, 1000)
+    (tmp_path / "s.pov").write_text(text)
+    scene = import_pov(tmp_path / "s.pov", w, h).scene
+    o, d = ref.generate_rays(camera_frame(scene), w, h)
+    idx = np.arange(0, w * h, 5)
+    truth = brute_force_depth(scene, o[idx], d[idx])
+    hit = np.isfinite(truth)
+    assert 0.2 < hit.mean() < 0.8
+    depth = pe.pov_depth(text, w, h, tmp_path, float(truth[hit].min()) - 0.5, float(truth[hit].max()) + 0.5)
+    got = depth.ravel()[idx]
+    assert np.array_equal(np.isfinite(got), hit)
+    assert np.max(np.abs(got[hit] - truth[hit])) < 1e-6
+
+
+@pytest.mark.slow   # a child process per setting
+def test_peer_error_report_runs(tmp_path, monkeypatch):
+    pe = load("peer_error")
+    monkeypatch.setattr(pe, "PRECISIONS", (20,))
+    monkeypatch.setattr(pe, "SETTINGS", {k: pe.SETTINGS[k] for k in list(pe.SETTINGS)[:2]})
+    assert pe.main(["--size", "32x24", "--repeats", "1", "--renders", "1", "--samples", "100",
+                    "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "peer_error.md").read_text()
+    assert "| default (de, epsilon 1e-3, 4 ITP steps) |" in md and "wrong by > 0.1 px" in md
+
+
 @pytest.mark.slow   # Mandelbulber2's OpenCL warm-ups
 def test_peers_report_runs_with_mandelbulber(tmp_path):
     import shutil
@@ -252,6 +315,8 @@ def test_commit_ratio_report_runs(tmp_path):
     ("scaling.py", ["--repeats", "3"]),
     ("throughput.py", ["--size", "axb"]),
     ("pov_compare.py", ["--repeats", "many"]),
+    ("peer_error.py", ["--samples", "0"]),
+    ("peer_error.py", ["--scenes", "nothing"]),
 ])
 def test_bad_flags_are_one_line_and_exit_2(script, args, tmp_path):
     # benchmarks/bench_args.py: a bad flag is one line naming it, exit status 2, no traceback

@@ -1,0 +1,313 @@
+"""POV-Ray and pyjulia4d at equal depth error: each one's error against a float64 brute
+force, beside its pixels per CPU-second.
+
+The speed targets ask for pyjulia4d's rate as a multiple of POV-Ray's "at equal or better
+depth error".  ``peers.py`` times both at their defaults, which are not equally accurate:
+POV-Ray's julia_fractal steps at 1/precision along the ray and so steps over thin parts of
+the set, where pyjulia4d's distance-estimate march stops within epsilon 1e-3 of it.  Here
+each renderer runs at several settings, and each setting's error is measured:
+
+* The scenes: ``matched`` is ``peers.py``'s POV-Ray scene (pyjulia4d's default scene at 640x480,
+  a shadowless light at the eye), ``max_iter 20`` the same at ``max_iteration 20``, and
+  ``hypercomplex sqr`` is ``pov_compare.py``'s.  pyjulia4d renders what ``import-pov`` makes of
+  each, so both render the same truncated set (POV-Ray's escape radius and iteration count).
+* The truth: ``measure.truth.brute_force_depth`` (float64, a chord scan at 2e-4 through the
+  bounding ball, a scan at 2e-6 over the chord before the first inside sample, bisection) on
+  ``--samples`` pixels drawn at random, the same pixels for every row.
+* POV-Ray's depth: the same scene with the fractal's pigment replaced by a function of the
+  distance to the camera, ``finish { ambient 1 diffuse 0 }``, no light, written as a linear
+  16-bit PNG: red holds v = (distance - lo) / (hi - lo) over the truth's depth range, green
+  frac(256 v), which together give the depth to about 1e-8 (OpenImageIO reads the file; Pillow
+  would cut it to 8 bits).  Its hit mask is the alpha.  Its CPU seconds are its own report of
+  the trace of the scene with its own look ("Trace Time ... CPU-seconds total"), at each
+  ``precision``.
+* pyjulia4d's depth: the ``depth`` output of a render at each setting (the same march as the
+  timed render, which keeps colour and alpha as ``peers.py``'s does); CPU seconds of a warm
+  render in a child process (``peers.py``'s measure), median of ``--renders`` renders, and the
+  median of ``--repeats`` runs alternating with POV-Ray's.
+* The error of a row: the share of the sampled pixels whose hit or miss differs from the
+  truth's (silhouette); over the pixels both hit, |depth - truth| at the median, 90th and
+  99th percentiles (scene units); and the share of pixels that are wrong: in the silhouette,
+  or in depth by more than 0.1 (and 1) pixel's worth, t 2 tan(fov/2) / height at the truth's
+  depth t.  POV-Ray polishes each hit by bisection to about 1e-7, below float32's spacing at
+  these depths (2.4e-7 at t = 3) and far below what a picture shows, so its median is not
+  what separates the renderers; its misses of thin parts (precision is its step, 1/precision)
+  are.  A row is at least as good as another where it has no more wrong pixels at either
+  tolerance.
+
+For each POV-Ray row the table names the fastest pyjulia4d row at least as good, and the ratio
+of the two rates.  Writes benchmarks/results/peer_error.md (a section per run).  POV-Ray is
+skipped with a message where it is not installed.
+
+    python benchmarks/peer_error.py [--scenes matched,max_iter,hypercomplex] [--samples 2000] [--repeats 3]
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "benchmarks") not in sys.path:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import peers  # noqa: E402
+import pov_compare  # noqa: E402
+from bench_args import Parser, size_of  # noqa: E402
+from run_log import append_run, git_commit, utc_now  # noqa: E402
+
+PRECISIONS = (10, 20, 40, 100)   # POV-Ray's default is 20
+
+# pyjulia4d's settings: name -> overrides of the imported scene
+SETTINGS = {
+    "default (de, epsilon 1e-3, 4 ITP steps)": [],
+    "de, epsilon 3e-3": ["march.quality=custom", "march.method=de", "march.epsilon=0.003"],
+    "de, epsilon 1e-2": ["march.quality=custom", "march.method=de", "march.epsilon=0.01"],
+    "de, epsilon 1e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.01",
+                                      "march.post_steps=8"],
+    "de, epsilon 3e-2": ["march.quality=custom", "march.method=de", "march.epsilon=0.03"],
+    "de, epsilon 3e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.03",
+                                      "march.post_steps=8"],
+    "fixed, z 50, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=50",
+                                 "march.post_steps=8"],
+    "fixed, z 100, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=100",
+                                  "march.post_steps=8"],
+    "draft (proven)": ["march.quality=draft"],
+}
+
+
+def pov_matched(w: int, h: int, precision: float) -> str:
+    return re.sub(r"precision [0-9.]+", f"precision {precision:g}", peers.pov_scene(w, h))
+
+
+def pov_max_iter(w: int, h: int, precision: float) -> str:
+    return re.sub(r"max_iteration \d+", "max_iteration 20", pov_matched(w, h, precision))
+
+
+def pov_hypercomplex(w: int, h: int, precision: float) -> str:
+    return pov_compare.pov_text("hypercomplex sqr", precision=precision)
+
+
+SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex}
+
+CHILD = r"""
+import json, resource, statistics, sys, warnings
+warnings.simplefilter("ignore")
+import numpy as np
+from pyjulia4d import Scene, render
+from pyjulia4d.app.cli import CHANNEL_GROUPS
+from pyjulia4d.pipeline.codes import STATUS_HIT
+a = json.loads(sys.argv[1])
+s = Scene.from_toml(a["toml"], a["over"])
+PNG = CHANNEL_GROUPS["RGBA"]   # what `render -o picture.png` keeps
+render(s, outputs=PNG)
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+times = []
+for _ in range(a["renders"]):
+    c0 = cpu()
+    render(s, outputs=PNG)
+    times.append(cpu() - c0)
+r = render(s, outputs={"depth", "status"})
+np.save(a["depth"], np.where(r.status == STATUS_HIT, r.depth, np.inf).astype(np.float64))
+print(json.dumps({"cpu": statistics.median(times), "device": r.device_name}))
+"""
+
+
+def run_pyjulia4d(toml: Path, over: list[str], depth_path: Path, renders: int) -> dict:
+    arg = json.dumps({"toml": str(toml), "over": over, "depth": str(depth_path), "renders": renders})
+    p = subprocess.run([sys.executable, "-c", CHILD, arg], capture_output=True, text=True, cwd=ROOT, timeout=3600)
+    if p.returncode != 0:
+        raise RuntimeError((p.stderr.strip().splitlines() or ["?"])[-1])
+    r = json.loads(p.stdout)
+    r["depth"] = np.load(depth_path)
+    return r
+
+
+def _pov(text: str, w: int, h: int, tmp: Path, name: str, extra: list[str]) -> tuple[float, Path]:
+    src, out = tmp / f"{name}.pov", tmp / f"{name}.png"
+    src.write_text(text)
+    out.unlink(missing_ok=True)
+    p = subprocess.run(["povray", f"+I{src}", f"+O{out}", f"+W{w}", f"+H{h}", "-D", "-A", "+UA", *extra],
+                       capture_output=True, text=True, cwd=tmp, timeout=3600)
+    m = re.search(r"Trace Time:.*?with ([0-9.]+) CPU-seconds total", p.stdout + p.stderr, re.S)
+    if p.returncode != 0 or not m or not out.exists():
+        raise RuntimeError(f"povray failed: {(p.stderr.strip().splitlines() or ['?'])[-1]}")
+    return float(m.group(1)), out
+
+
+def pov_time(text: str, w: int, h: int, tmp: Path) -> float:
+    """POV-Ray's CPU seconds for the trace of ``text`` with its own look."""
+    return _pov(text, w, h, tmp, "look", [])[0]
+
+
+def depth_text(text: str, lo: float, hi: float) -> str:
+    """``text`` with the fractal coloured by its distance to the camera, unlit (ambient 1, no
+    light): v = (distance - lo) / (hi - lo) in red, frac(256 v) in green (POV-Ray's functions
+    are double precision; two 16-bit channels hold v to about 2e-7 of [lo, hi])."""
+    m = re.search(r"camera \{[^}]*?location <([^>]*)>", text)
+    ex, ey, ez = (float(v) for v in m.group(1).split(","))
+    lo, hi = float(lo), float(hi)
+    v = (f"(sqrt((x-({ex}))*(x-({ex}))+(y-({ey}))*(y-({ey}))+(z-({ez}))*(z-({ez}))) - ({lo!r})) / {hi - lo!r}")
+    # the average of two pigments halves each: their colours are doubled
+    look = ("pigment { average pigment_map { "
+            f"[1 function {{ {v} }} color_map {{ [0 rgb <0, 0, 0>] [1 rgb <2, 0, 0>] }}] "
+            f"[1 function {{ mod(256 * {v}, 1) }} color_map {{ [0 rgb <0, 0, 0>] [1 rgb <0, 2, 0>] }}] }} }} "
+            "finish { ambient 1 diffuse 0 specular 0 }")
+    text = re.sub(r"pigment \{[^{}]*\}\s*finish \{[^{}]*\}", look, text)
+    return re.sub(r"light_source \{[^{}]*\}", "", text)
+
+
+def pov_depth(text: str, w: int, h: int, tmp: Path, lo: float, hi: float) -> np.ndarray:
+    """POV-Ray's depth per pixel (+inf on a miss), from a linear 16-bit PNG of depth_text: red
+    gives 256 v to within 0.002, which picks the whole part that green's fraction completes."""
+    import OpenImageIO as oiio
+
+    _, out = _pov(depth_text(text, lo, hi), w, h, tmp, "depth",
+                  ["+FN", "Bits_Per_Color=16", "File_Gamma=1.0", "Dither=off"])
+    f = oiio.ImageInput.open(str(out))
+    try:
+        a = f.read_image("uint16")
+    finally:
+        f.close()
+    coarse, frac = (a[..., k].astype(np.float64) / 65535 for k in (0, 1))
+    v = (np.round(256 * coarse - frac) + frac) / 256
+    return np.where(a[..., 3] > 0, lo + v * (hi - lo), np.inf)
+
+
+def errors(depth: np.ndarray, idx: np.ndarray, truth: np.ndarray, pixel: np.ndarray) -> dict:
+    """The error of ``depth`` (H, W; inf on a miss) at the flat pixel indices ``idx`` against
+    ``truth`` (inf on a miss): the silhouette error (share of pixels whose hit or miss differs),
+    |depth - truth| over the pixels both hit at p50, p90 and p99 (scene units), and the share
+    of pixels wrong by more than 0.1 and 1 pixel's worth of depth (``pixel``: the footprint of
+    a pixel at the truth's depth) or in the silhouette."""
+    t = depth.ravel()[idx]
+    hit, thit = np.isfinite(t), np.isfinite(truth)
+    both = hit & thit
+    e = np.abs(t[both] - truth[both])
+    p50, p90, p99 = (np.percentile(e, [50, 90, 99]) if e.size else (math.nan,) * 3)
+    out = {"sil": float(np.mean(hit != thit)), "p50": float(p50), "p90": float(p90), "p99": float(p99)}
+    for key, px in WRONG.items():
+        wrong = hit != thit
+        wrong[both] |= e > px * pixel[both]
+        out[key] = float(np.mean(wrong))
+    return out
+
+
+WRONG = {"wrong01": 0.1, "wrong1": 1.0}   # tolerances, in pixels' worth of depth
+
+
+def as_good(a: dict, b: dict) -> bool:
+    """a has no more wrong pixels than b at either tolerance."""
+    return all(a[k] <= b[k] for k in WRONG)
+
+
+def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: int, have_pov: bool,
+              tmp: Path) -> tuple[list[str], str]:
+    from pyjulia4d import reference as ref
+    from pyjulia4d.geometry.camera import camera_frame
+    from pyjulia4d.interop.povray import import_pov
+    from pyjulia4d.measure.truth import brute_force_depth
+
+    make = SCENES[name]
+    src = tmp / "scene.pov"
+    src.write_text(make(w, h, 20))
+    imported = import_pov(src, w, h)
+    toml = tmp / "scene.toml"
+    toml.write_text(imported.toml)
+    scene = imported.scene
+    o, d = ref.generate_rays(camera_frame(scene), w, h)
+    idx = np.random.default_rng(1).choice(w * h, min(samples, w * h), replace=False)
+    truth = brute_force_depth(scene, o[idx], d[idx])
+    # a pixel's footprint at depth t: t 2 tan(fov / 2) / height (fov: the vertical angle)
+    pixel = np.where(np.isfinite(truth), truth, 0.0) * 2 * math.tan(math.radians(scene.camera.fov) / 2) / h
+    fin = truth[np.isfinite(truth)]
+    lo, hi = (float(fin.min()) - 0.5, float(fin.max()) + 0.5) if fin.size else (0.0, 10.0)
+    rows: dict[str, dict] = {}
+    if have_pov:
+        for p in PRECISIONS:
+            rows[f"POV-Ray, precision {p}"] = errors(pov_depth(make(w, h, p), w, h, tmp, lo, hi), idx, truth, pixel)
+    times: dict[str, list[float]] = {k: [] for k in list(rows) + list(SETTINGS)}
+    device = "?"
+    for _ in range(repeats):   # alternate, so the shared machine's load falls on all alike
+        for p in PRECISIONS if have_pov else ():
+            times[f"POV-Ray, precision {p}"].append(pov_time(make(w, h, p), w, h, tmp))
+        for k, over in SETTINGS.items():
+            r = run_pyjulia4d(toml, over, tmp / "depth.npy", renders)
+            device = r["device"]
+            times[k].append(r["cpu"])
+            if k not in rows:
+                rows[k] = errors(r["depth"], idx, truth, pixel)
+    px = w * h
+    for k, r in rows.items():
+        r["cpu"] = statistics.median(times[k])
+        r["rate"] = px / r["cpu"] if r["cpu"] > 0 else math.inf
+    lines = [f"\n### {name} ({w}x{h}, {len(idx)} pixels against the truth, {int(np.isfinite(truth).sum())} of them "
+             f"hit)\n", "| renderer, setting | CPU s | pixels per CPU-second | silhouette error | depth error p50 "
+             "| p90 | p99 | wrong by > 0.1 px | > 1 px |", "|---|---|---|---|---|---|---|---|---|"]
+    for k, r in rows.items():
+        lines.append(f"| {k} | {r['cpu']:.3f} | {r['rate']:.3g} | {100 * r['sil']:.2f} % | {r['p50']:.1e} "
+                     f"| {r['p90']:.1e} | {r['p99']:.1e} | {100 * r['wrong01']:.2f} % | {100 * r['wrong1']:.2f} % |")
+        print(lines[-1], flush=True)
+    pov_rows = [k for k in rows if k.startswith("POV-Ray")]
+    if pov_rows:
+        lines += ["", "| POV-Ray row | fastest pyjulia4d setting at least as good | rate / POV-Ray's |",
+                  "|---|---|---|"]
+        for k in pov_rows:
+            good = [s for s in SETTINGS if as_good(rows[s], rows[k])]
+            best = max(good, key=lambda s: rows[s]["rate"]) if good else None
+            ratio = f"{rows[best]['rate'] / rows[k]['rate']:.2f}" if best else "-"
+            lines.append(f"| {k} | {best or 'none'} | {ratio} |")
+            print(lines[-1], flush=True)
+    return lines, device
+
+
+def main(argv=None) -> int:
+    ap = Parser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="640x480")
+    ap.add_argument("--scenes", default="matched", help="comma-separated: " + ", ".join(SCENES)
+                    + " (substrings), or all")
+    ap.add_argument("--samples", type=int, default=2000, help="pixels compared with the truth (1 to 100000)")
+    ap.add_argument("--repeats", type=int, default=3, help="alternating timed runs of each row (1 to 50)")
+    ap.add_argument("--renders", type=int, default=3, help="timed renders per pyjulia4d run, median (1 to 50)")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    a = ap.parse_args(argv)
+    w, h = size_of(a.size, "--size")
+    for flag, v, top in (("--samples", a.samples, 100_000), ("--repeats", a.repeats, 50), ("--renders", a.renders, 50)):
+        if not 1 <= v <= top:
+            ap.error(f"{flag}: expected 1 to {top}, got {v}")
+    want = [s.strip() for s in a.scenes.split(",")]
+    names = [n for n in SCENES if "all" in want or any(s and s in n for s in want)]
+    if not names:
+        ap.error(f"--scenes: expected some of {', '.join(SCENES)} or all, got {a.scenes!r}")
+    warnings.simplefilter("ignore")
+    have_pov = shutil.which("povray") is not None
+    if not have_pov:
+        print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
+    lines, device = [], "?"
+    with tempfile.TemporaryDirectory() as td:
+        for n in names:
+            more, device = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
+            lines += more
+    head = (f"\n## {utc_now()}, pyjulia4d on {device}, commit {git_commit()}, median of {a.repeats} alternating "
+            f"runs ({a.renders} renders each for pyjulia4d)\n")
+    md = a.out / "peer_error.md"
+    append_run(md, "# POV-Ray and pyjulia4d at equal depth error\n\nWritten by `python benchmarks/peer_error.py` "
+               "(see its docstring: the truth, how each depth is read, what is timed).\n",
+               head + "\n".join(lines) + "\n")
+    print(f"wrote {md}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
