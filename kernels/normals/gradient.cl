@@ -31,7 +31,7 @@ __kernel void normals_gradient(const int n_items, __global const real4 *point, _
     }
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 n = normal_gradient(point[i], jp, h, right, up, forward);
-    real l = length(n);
+    real l = sqrt(DOT4(n, n));   /* not length(): common/lanes.cl DOT3 */
     /* a flat or non-finite difference: the view axis, flagged (common/codes.cl), never 0 on a hit */
     normal[i] = l > (real)0 && isfinite(l) ? n / l
                                            : (real4)(0, 0, 1, (real)GUARD_NORMAL_FALLBACK);

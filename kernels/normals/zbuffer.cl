@@ -10,7 +10,7 @@ inline real3 cam_point(__global const real4 *point, size_t i, real4 eye,
                        real4 right, real4 up, real4 forward)
 {
     real4 v = point[i] - eye;
-    return (real3)(dot(v, right), dot(v, up), -dot(v, forward));
+    return (real3)(DOT4(v, right), DOT4(v, up), -DOT4(v, forward));   /* common/lanes.cl DOT3 */
 }
 
 /* Tangent along one image axis from neighbours a (step -1) and b (step +1),
@@ -59,17 +59,17 @@ __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __
                           (real3)(1, 0, 0), eye, right, up, forward);
     real3 ty = zb_tangent(point, depth, status, i, i + width, i - width, y < height - 1, y > 0, p,
                           (real3)(0, 1, 0), eye, right, up, forward);
-    real3 n = cross(tx, ty);
+    real3 n = (real3)(tx.y * ty.z - tx.z * ty.y, tx.z * ty.x - tx.x * ty.z, tx.x * ty.y - tx.y * ty.x);   /* tx x ty */
     real3 view = -p;                          /* towards the eye */
-    if (dot(n, view) < (real)0)
+    if (DOT3(n, view) < (real)0)
         n = -n;
-    real l = length(n);
+    real l = sqrt(DOT3(n, n));
     int guard = 0;
     if (!(l > (real)0) || !isfinite(l)) {
         /* degenerate plane: face the eye; if the hit is the eye itself (camera inside the
          * set, depth 0) the view axis.  Flagged either way (common/codes.cl). */
         guard = GUARD_NORMAL_FALLBACK;
-        n = view, l = length(view);
+        n = view, l = sqrt(DOT3(view, view));
         if (!(l > (real)0) || !isfinite(l))
             n = (real3)(0, 0, 1), l = 1;
     }

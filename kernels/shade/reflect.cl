@@ -27,10 +27,10 @@ __kernel void reflect_rays(const int n_items, __global const real4 *point, __glo
     real4 nc = normal[i];
     real4 n = nc.x * right + nc.y * up - nc.z * forward;
     real4 d = p - eye;
-    real dd = dot(d, d);
+    real dd = DOT4(d, d);   /* not dot(): common/lanes.cl DOT3 */
     d = dd > 0 ? d / sqrt(dd) : forward;        /* the eye inside the set: the view axis */
-    real4 r = d - 2 * dot(d, n) * n;
-    real rr = dot(r, r);
+    real4 r = d - 2 * DOT4(d, n) * n;
+    real rr = DOT4(r, r);
     dirs[i] = rr > 0 ? r / sqrt(rr) : -d;
     origins[i] = p + bias * n;
 }
@@ -53,12 +53,12 @@ __kernel void reflect_color(const int n_items, __global const int *status, __glo
     real4 n = nc.x * right + nc.y * up - nc.z * forward;
 #ifdef LIGHT_POINT
     real4 l = light_pos - point[i];
-    real ll = dot(l, l);
+    real ll = DOT4(l, l);
     l = ll > 0 ? l / sqrt(ll) : -dirs[i];
 #else
     real4 l = -dirs[i];
 #endif
-    float lambert = fmax((float)dot(n, l), 0.0f);
+    float lambert = fmax((float)DOT4(n, l), 0.0f);
     float3 rgb = color.xyz * (ambient * sky.xyz + diffuse * lambert * light_color.xyz);
     refl[i] = (float4)(rgb, 1.0f);
 }

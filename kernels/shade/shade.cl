@@ -34,19 +34,19 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
         return;
     }
     real4 pv = point[i] - eye;
-    float3 p = (float3)(dot(pv, right), dot(pv, up), -dot(pv, forward));
+    float3 p = (float3)(DOT4(pv, right), DOT4(pv, up), -DOT4(pv, forward));
     /* the hit is the eye itself (camera inside the set, depth 0): no eye-to-point
      * direction, take the view axis (counted on the host as guards["eye_hit"]) */
-    p = dot(p, p) > 0.0f ? normalize(p) : (float3)(0.0f, 0.0f, -1.0f);
+    p = UNIT3(p, (float3)(0.0f, 0.0f, -1.0f));
     float3 n = (float3)(normal[i].x, normal[i].y, normal[i].z);
     float3 v = -p;                                   /* towards the eye */
 #ifdef LIGHT_POINT
     real4 lv = light_pos - point[i];
-    float3 l = normalize((float3)(dot(lv, right), dot(lv, up), -dot(lv, forward)));
+    float3 l = UNIT3((float3)(DOT4(lv, right), DOT4(lv, up), -DOT4(lv, forward)), v);
 #else
     float3 l = v;
 #endif
-    float lambert = fmax(dot(n, l), 0.0f);
+    float lambert = fmax(DOT3(n, l), 0.0f);
 #ifdef LIGHT_TERMS
     float4 tm = terms[i];
     float vis = tm.x, ao = tm.y;
@@ -63,8 +63,8 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
     float3 lit = base * (diffuse * vis * lambert);
 #ifdef SPECULAR
     if (lambert > 0.0f) {
-        float3 hv = normalize(l + v);
-        lit += vis * specular * pow(fmax(dot(n, hv), 0.0f), shininess);
+        float3 hv = UNIT3(l + v, (float3)(0.0f));   /* none: the light straight behind, no highlight */
+        lit += vis * specular * pow(fmax(DOT3(n, hv), 0.0f), shininess);
     }
 #endif
     float3 rgb = base * (ambient * ao) * sky.xyz + lit * light_color.xyz;
@@ -77,14 +77,13 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
     for (int j = 0; j < EXTRA_LIGHTS; ++j) {
         float4 lc = lights_rgb[j];
         real4 g = lc.w != 0.0f ? lights_geo[j] : lights_geo[j] - point[i];
-        float3 lj = (float3)(dot(g, right), dot(g, up), -dot(g, forward));
-        lj = dot(lj, lj) > 0.0f ? normalize(lj) : v;
+        float3 lj = UNIT3((float3)(DOT4(g, right), DOT4(g, up), -DOT4(g, forward)), v);
         float vj = j == 0 ? ve.x : (j == 1 ? ve.y : ve.z);
-        float lam = fmax(dot(n, lj), 0.0f);
+        float lam = fmax(DOT3(n, lj), 0.0f);
         float3 add = base * (diffuse * vj * lam);
 #ifdef SPECULAR
         if (lam > 0.0f)
-            add += vj * specular * pow(fmax(dot(n, normalize(lj + v)), 0.0f), shininess);
+            add += vj * specular * pow(fmax(DOT3(n, UNIT3(lj + v, (float3)(0.0f))), 0.0f), shininess);
 #endif
         rgb += add * lc.xyz;
     }
@@ -95,7 +94,7 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
 #ifdef FOG
     /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the
      * distance from the eye, fog_start where the bounding ball begins */
-    float fade = exp(-fog * fmax((float)length(pv) - fog_start, 0.0f));
+    float fade = exp(-fog * fmax((float)sqrt(DOT4(pv, pv)) - fog_start, 0.0f));
     rgb = mix(background.xyz, rgb, fade);
 #endif
     rgba[i] = (float4)(rgb, 1.0f);

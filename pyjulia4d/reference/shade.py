@@ -207,6 +207,14 @@ def light_terms_of_plan(plan, point, normal, status, bracket, F: Formula):
                        la.ao_strength, la.trap, shadow, sh.ao > 0, sh.coloring, F, plan.scene.fractal.kind == "mandelbrot")
 
 
+def unit_or(a, fallback):
+    """a / |a| per row, ``fallback`` where a has no direction (|a|^2 is 0 or not finite):
+    shade.cl's UNIT3 (common/lanes.cl)."""
+    aa = np.sum(a * a, axis=-1, keepdims=True)
+    ok = (aa > 0) & np.isfinite(aa)
+    return np.where(ok, a / np.sqrt(np.where(ok, aa, 1.0)), fallback)
+
+
 def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
           ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0,
           sky=(1.0, 1.0, 1.0), lights_geo=None, lights_rgb=None, vis_extra=None, refl=None,
@@ -221,16 +229,11 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
     rgba[:, :3] = background
     if not hit.any():
         return rgba
-    p = to_camera(point[hit] - frame.position, frame)
-    lp = np.linalg.norm(p, axis=-1, keepdims=True)
     # the hit is the eye itself (depth 0, camera inside the set): the view axis (shade.cl)
-    p = np.where(lp > 0, p / np.where(lp > 0, lp, 1), np.array([0.0, 0.0, -1.0]))
+    p = unit_or(to_camera(point[hit] - frame.position, frame), np.array([0.0, 0.0, -1.0]))
     v = -p
-    if light_pos is None:
-        l = v
-    else:
-        l = to_camera(np.asarray(light_pos) - point[hit], frame)
-        l /= np.linalg.norm(l, axis=-1, keepdims=True)
+    # the light at the hit itself: from the eye
+    l = v if light_pos is None else unit_or(to_camera(np.asarray(light_pos) - point[hit], frame), v)
     n = normal[hit]
     lam = np.maximum(dot4(n, l), 0.0)
     vis = terms[hit, 0] if terms is not None else np.ones(len(lam))
@@ -243,8 +246,7 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
         lam = np.maximum(dot4(n, l), 0.0)
         out = base * (diffuse * vis * lam)[:, None]
         if specular > 0:
-            hv = l + v
-            hv /= np.linalg.norm(hv, axis=-1, keepdims=True)
+            hv = unit_or(l + v, 0.0)   # none (the light straight behind): no highlight
             spec = np.where(lam > 0, np.maximum(dot4(n, hv), 0.0) ** shininess, 0.0)
             out = out + (vis * specular * spec)[:, None]
         return out
@@ -255,8 +257,7 @@ def shade(status, normal, point, frame: Frame, light_pos, color, background, lig
             lj = np.broadcast_to(to_camera(np.asarray(lights_geo[j])[None, :], frame), p.shape)
         else:
             lj = to_camera(np.asarray(lights_geo[j]) - point[hit], frame)
-        ln = np.linalg.norm(lj, axis=-1, keepdims=True)
-        lj = np.where(ln > 0, lj / np.where(ln > 0, ln, 1), v)
+        lj = unit_or(lj, v)
         vj = vis_extra[hit, j] if vis_extra is not None else np.ones(len(lam))
         rgb = rgb + lit(lj, vj) * np.asarray(lights_rgb[j, :3])[None, :]
     if refl is not None:   # the mirror bounce (shade/reflect.cl), before depth cueing

@@ -9,6 +9,11 @@ real bailout2;
 real epsilon;
 int max_iter;
 } julia_params;
+inline float3 unit3_or(float3 a, float3 fallback)
+{
+float aa = ((a).x * (a).x + (a).y * (a).y + (a).z * (a).z);
+return aa > 0.0f && aa <= FLT_MAX ? a * rsqrt(aa) : fallback;
+}
 typedef real lreal;
 typedef int lmask;
 typedef int mask_t;
@@ -141,11 +146,11 @@ inline lmask julia_inside(quat p, julia_params jp)
 {
 quat q = (p);
 real4 c = (jp.c);
-lmask live = dot((q), (q)) <= jp.bailout2;
+lmask live = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w) <= jp.bailout2;
 int n = 0;
 for (; n < jp.max_iter && (live); ++n) {
 q = ((live) ? (julia_f(q, c)) : (q));
-live = dot((q), (q)) <= jp.bailout2;
+live = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w) <= jp.bailout2;
 }
 ;
 return live;
@@ -162,12 +167,12 @@ inline lreal julia_level(quat p, julia_params jp, lmask *inside)
 {
 quat q = (p);
 real4 c = (jp.c);
-lreal m2 = dot((q), (q));
+lreal m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w);
 lmask live = m2 <= jp.bailout2;
 lmask steps = 0;
 int n = 0;
 for (; n < jp.max_iter && (live); ++n)
-do { q = ((live) ? (julia_f(q, c)) : (q)); m2 = dot((q), (q)); steps = ((live) ? (steps + 1) : (steps)); live = m2 <= (jp.bailout2); } while (0);
+do { q = ((live) ? (julia_f(q, c)) : (q)); m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w); steps = ((live) ? (steps + 1) : (steps)); live = m2 <= (jp.bailout2); } while (0);
 ;
 return level_value(m2, steps, jp, inside);
 }
@@ -185,13 +190,13 @@ inline lreal julia_distance_formula(quat p, julia_params jp, lmask *escaped)
 {
 quat q = (p);
 real4 c = (jp.c);
-lreal m2 = dot((q), (q));
+lreal m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w);
 lreal dm2 = (lreal)1;
 lmask e = 0;
 lmask live = m2 <= jp.bailout2;
 int n = 0;
 for (; n < jp.max_iter && (live); ++n)
-do { do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) do { lint k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + (k_)) : (e)); } while (0); } while (0); q = ((live) ? (julia_f(q, c)) : (q)); m2 = dot((q), (q)); live = m2 <= (jp.bailout2); } while (0);
+do { do { dm2 = ((live) ? (dm2 * (((real)4 * (m2)))) : (dm2)); lmask big_ = (live) & (dm2 > (real)1e16); if ((big_)) do { lint k_; lreal mant_ = frexp(dm2, &k_); dm2 = ((big_) ? (mant_) : (dm2)); e = ((big_) ? (e + (k_)) : (e)); } while (0); } while (0); q = ((live) ? (julia_f(q, c)) : (q)); m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w); live = m2 <= (jp.bailout2); } while (0);
 ;
 *escaped = m2 > jp.bailout2;
 return de_value(m2, dm2, e);
@@ -352,7 +357,7 @@ quat j2 = (((real4)(((lreal)0), ((lreal)0), ((lreal)1), ((lreal)0))));
 quat j3 = (((real4)(((lreal)0), ((lreal)0), ((lreal)0), ((lreal)1))));
 lmask live = 1;
 for (int n = 0; n < jp.max_iter && (live); ++n) {
-lreal m2 = dot((q), (q));
+lreal m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w);
 live &= m2 <= jp.bailout2;
 lmask tiny = live & (m2 < sqrt(FLT_MIN));
 *guard |= ((tiny) ? ((lmask)2) : ((lmask)0));
@@ -364,7 +369,7 @@ j1 = ((live) ? (julia_f_jvp(q, j1)) : (j1));
 j2 = ((live) ? (julia_f_jvp(q, j2)) : (j2));
 j3 = ((live) ? (julia_f_jvp(q, j3)) : (j3));
 q = ((live) ? (julia_f(q, c)) : (q));
-lreal s = fmax(fmax(length(j0), length(j1)), fmax(length(j2), length(j3)));
+lreal s = fmax(fmax(sqrt((((j0)).x * ((j0)).x + ((j0)).y * ((j0)).y + ((j0)).z * ((j0)).z + ((j0)).w * ((j0)).w)), sqrt((((j1)).x * ((j1)).x + ((j1)).y * ((j1)).y + ((j1)).z * ((j1)).z + ((j1)).w * ((j1)).w))), fmax(sqrt((((j2)).x * ((j2)).x + ((j2)).y * ((j2)).y + ((j2)).z * ((j2)).z + ((j2)).w * ((j2)).w)), sqrt((((j3)).x * ((j3)).x + ((j3)).y * ((j3)).y + ((j3)).z * ((j3)).z + ((j3)).w * ((j3)).w))));
 lmask rescale = live & ((s > (real)1e12) | ((s < (real)1e-12) & (s > (real)0)));
 if ((rescale)) {
 lreal inv = (real)1 / s;
@@ -374,7 +379,7 @@ j2 = ((rescale) ? (((inv) * (j2))) : (j2));
 j3 = ((rescale) ? (((inv) * (j3))) : (j3));
 }
 }
-return ((real4)((dot((q), (j0))), (dot((q), (j1))), (dot((q), (j2))), (dot((q), (j3)))));
+return ((real4)(((((q)).x * ((j0)).x + ((q)).y * ((j0)).y + ((q)).z * ((j0)).z + ((q)).w * ((j0)).w)), ((((q)).x * ((j1)).x + ((q)).y * ((j1)).y + ((q)).z * ((j1)).z + ((q)).w * ((j1)).w)), ((((q)).x * ((j2)).x + ((q)).y * ((j2)).y + ((q)).z * ((j2)).z + ((q)).w * ((j2)).w)), ((((q)).x * ((j3)).x + ((q)).y * ((j3)).y + ((q)).z * ((j3)).z + ((q)).w * ((j3)).w))));
 }
 inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *guard,
 lreal *nx, lreal *ny, lreal *nz)
