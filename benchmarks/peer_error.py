@@ -39,7 +39,7 @@ For each POV-Ray row the table names the fastest pyjulia4d row at least as good,
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run).  POV-Ray is
 skipped with a message where it is not installed.
 
-    python benchmarks/peer_error.py [--scenes matched,max_iter,hypercomplex] [--samples 2000] [--repeats 3]
+    python benchmarks/peer_error.py [--scenes all] [--samples 4000] [--repeats 3] [--look default]
 """
 from __future__ import annotations
 
@@ -98,6 +98,8 @@ def pov_hypercomplex(w: int, h: int, precision: float) -> str:
 
 
 SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex}
+LIT = ("matched", "max_iter 20")   # the scenes --look default lights (peers.py's point light)
+LOOK: list[str] = []               # --look default: pyjulia4d's soft shadows and occlusion
 
 CHILD = r"""
 import json, resource, statistics, sys, warnings
@@ -243,7 +245,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
         for p in PRECISIONS if have_pov else ():
             times[f"POV-Ray, precision {p}"].append(pov_time(make(w, h, p), w, h, tmp))
         for k, over in SETTINGS.items():
-            r = run_pyjulia4d(toml, over, tmp / "depth.npy", renders)
+            r = run_pyjulia4d(toml, LOOK + over, tmp / "depth.npy", renders)
             device = r["device"]
             times[k].append(r["cpu"])
             if k not in rows:
@@ -281,9 +283,13 @@ def main(argv=None) -> int:
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--scenes", default="matched", help="comma-separated: " + ", ".join(SCENES)
                     + " (substrings), or all")
-    ap.add_argument("--samples", type=int, default=2000, help="pixels compared with the truth (1 to 100000)")
+    ap.add_argument("--samples", type=int, default=4000, help="pixels compared with the truth (1 to 100000)")
     ap.add_argument("--repeats", type=int, default=3, help="alternating timed runs of each row (1 to 50)")
     ap.add_argument("--renders", type=int, default=3, help="timed renders per pyjulia4d run, median (1 to 50)")
+    ap.add_argument("--look", choices=("matched", "default"), default="matched",
+                    help="matched: a shadowless light at the eye; default: pyjulia4d's own look (soft shadows, "
+                         "occlusion) against POV-Ray's shadows from the same point light, on the quaternion scenes "
+                         "(the depths, and so the errors, are the same)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")
@@ -294,16 +300,35 @@ def main(argv=None) -> int:
     names = [n for n in SCENES if "all" in want or any(s and s in n for s in want)]
     if not names:
         ap.error(f"--scenes: expected some of {', '.join(SCENES)} or all, got {a.scenes!r}")
+    if a.look == "default":
+        from pyjulia4d.scene.model import Scene
+
+        sh = Scene.default().shading
+        peers.LOOK[:] = []   # peers.pov_scene: the point light, POV-Ray's shadows on
+        LOOK[:] = [f"shading.shadow={sh.shadow}", f"shading.ao={sh.ao}"]
+        kept = [n for n in names if n in LIT]
+        if not kept:
+            ap.error(f"--look default: lights {' and '.join(LIT)} alone, got --scenes {a.scenes!r}")
+        if kept != names:
+            print(f"--look default: {', '.join(n for n in names if n not in LIT)} left out (lit at the eye)",
+                  file=sys.stderr)
+        names = kept
     warnings.simplefilter("ignore")
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
     lines, device = [], "?"
-    with tempfile.TemporaryDirectory() as td:
-        for n in names:
-            more, device = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
-            lines += more
-    head = (f"\n## {utc_now()}, pyjulia4d on {device}, commit {git_commit()}, median of {a.repeats} alternating "
+    try:
+        with tempfile.TemporaryDirectory() as td:
+            for n in names:
+                more, device = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
+                lines += more
+    finally:   # peers.py's look, and this module's, as they were for the next caller in this process
+        peers.LOOK[:] = peers.MATCHED
+        LOOK[:] = []
+    look = (", pyjulia4d's default look (soft shadows, occlusion) against POV-Ray's shadows from the same point "
+            "light" if a.look == "default" else "")
+    head = (f"\n## {utc_now()}{look}, pyjulia4d on {device}, commit {git_commit()}, median of {a.repeats} alternating "
             f"runs ({a.renders} renders each for pyjulia4d)\n")
     md = a.out / "peer_error.md"
     append_run(md, "# POV-Ray and pyjulia4d at equal depth error\n\nWritten by `python benchmarks/peer_error.py` "

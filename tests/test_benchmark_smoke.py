@@ -185,6 +185,10 @@ def test_peer_error_report_runs(tmp_path, monkeypatch):
                     "--out", str(tmp_path)]) == 0
     md = (tmp_path / "peer_error.md").read_text()
     assert "| default (de, epsilon 1e-3, 4 ITP steps) |" in md and "wrong by > 0.1 px" in md
+    assert pe.main(["--size", "32x24", "--repeats", "1", "--renders", "1", "--samples", "100", "--look", "default",
+                    "--scenes", "matched", "--out", str(tmp_path)]) == 0
+    assert "pyjulia4d's default look" in (tmp_path / "peer_error.md").read_text()
+    assert pe.peers.LOOK == pe.peers.MATCHED and pe.LOOK == []
 
 
 @pytest.mark.slow   # Mandelbulber2's OpenCL warm-ups
@@ -317,6 +321,7 @@ def test_commit_ratio_report_runs(tmp_path):
     ("pov_compare.py", ["--repeats", "many"]),
     ("peer_error.py", ["--samples", "0"]),
     ("peer_error.py", ["--scenes", "nothing"]),
+    ("peer_error.py", ["--look", "default", "--scenes", "hypercomplex"]),
 ])
 def test_bad_flags_are_one_line_and_exit_2(script, args, tmp_path):
     # benchmarks/bench_args.py: a bad flag is one line naming it, exit status 2, no traceback
