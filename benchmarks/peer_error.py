@@ -33,7 +33,7 @@ each renderer runs at several settings, and each setting's error is measured:
   these depths (2.4e-7 at t = 3) and far below what a picture shows, so its median is not
   what separates the renderers; its misses of thin parts (precision is its step, 1/precision)
   are.  A row is at least as good as another where it has no more wrong pixels at either
-  tolerance.
+  tolerance.  The shares carry their standard error over the draw of pixels.
 
 For each POV-Ray row the table names the fastest pyjulia4d row at least as good, and the ratio
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run).  POV-Ray is
@@ -209,6 +209,12 @@ def errors(depth: np.ndarray, idx: np.ndarray, truth: np.ndarray, pixel: np.ndar
 WRONG = {"wrong01": 0.1, "wrong1": 1.0}   # tolerances, in pixels' worth of depth
 
 
+def share(p: float, n: int) -> str:
+    """A share of n sampled pixels with its standard error, sqrt(p (1 - p) / n), in percent:
+    how far another draw of the pixels could move it."""
+    return f"{100 * p:.2f} ± {100 * math.sqrt(p * (1 - p) / n):.2f} %"
+
+
 def as_good(a: dict, b: dict) -> bool:
     """a has no more wrong pixels than b at either tolerance."""
     return all(a[k] <= b[k] for k in WRONG)
@@ -250,7 +256,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
             times[k].append(r["cpu"])
             if k not in rows:
                 rows[k] = errors(r["depth"], idx, truth, pixel)
-    px = w * h
+    px, n = w * h, len(idx)
     for k, r in rows.items():
         r["cpu"] = statistics.median(times[k])
         r["rate"] = px / r["cpu"] if r["cpu"] > 0 else math.inf
@@ -258,8 +264,8 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
              f"hit)\n", "| renderer, setting | CPU s | pixels per CPU-second | silhouette error | depth error p50 "
              "| p90 | p99 | wrong by > 0.1 px | > 1 px |", "|---|---|---|---|---|---|---|---|---|"]
     for k, r in rows.items():
-        lines.append(f"| {k} | {r['cpu']:.3f} | {r['rate']:.3g} | {100 * r['sil']:.2f} % | {r['p50']:.1e} "
-                     f"| {r['p90']:.1e} | {r['p99']:.1e} | {100 * r['wrong01']:.2f} % | {100 * r['wrong1']:.2f} % |")
+        lines.append(f"| {k} | {r['cpu']:.3f} | {r['rate']:.3g} | {share(r['sil'], n)} | {r['p50']:.1e} "
+                     f"| {r['p90']:.1e} | {r['p99']:.1e} | {share(r['wrong01'], n)} | {share(r['wrong1'], n)} |")
         print(lines[-1], flush=True)
     pov_rows = [k for k in rows if k.startswith("POV-Ray")]
     if pov_rows:
