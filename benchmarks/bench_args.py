@@ -28,3 +28,12 @@ def size_of(text: str, flag: str = "--size") -> tuple[int, int]:
               file=sys.stderr)
         raise SystemExit(2)
     return w, h
+
+
+def add_look(ap: argparse.ArgumentParser, more: str) -> None:
+    """--look, as the scripts that set pyjulia4d beside POV-Ray take it (peers.py, peer_error.py);
+    ``more`` ends its help: what else the choice changes in that script."""
+    ap.add_argument("--look", choices=("matched", "default"), default="matched",
+                    help="matched: a light at the eye, no shadows or occlusion; default: pyjulia4d's own look "
+                         "(soft shadows, occlusion) against POV-Ray with its shadows on, from the same point light"
+                         + more)

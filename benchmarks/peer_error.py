@@ -62,7 +62,7 @@ if str(ROOT / "benchmarks") not in sys.path:
 
 import peers  # noqa: E402
 import pov_compare  # noqa: E402
-from bench_args import Parser, size_of  # noqa: E402
+from bench_args import Parser, add_look, size_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 PRECISIONS = (10, 20, 40, 100)   # POV-Ray's default is 20
@@ -292,10 +292,7 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=4000, help="pixels compared with the truth (1 to 100000)")
     ap.add_argument("--repeats", type=int, default=3, help="alternating timed runs of each row (1 to 50)")
     ap.add_argument("--renders", type=int, default=3, help="timed renders per pyjulia4d run, median (1 to 50)")
-    ap.add_argument("--look", choices=("matched", "default"), default="matched",
-                    help="matched: a shadowless light at the eye; default: pyjulia4d's own look (soft shadows, "
-                         "occlusion) against POV-Ray's shadows from the same point light, on the quaternion scenes "
-                         "(the depths, and so the errors, are the same)")
+    add_look(ap, ", on the quaternion scenes (the depths, and so the errors, are the same)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")

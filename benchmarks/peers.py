@@ -73,7 +73,7 @@ if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from run_log import append_run, git_commit, utc_now  # noqa: E402
-from bench_args import Parser, size_of  # noqa: E402
+from bench_args import Parser, add_look, size_of  # noqa: E402
 
 POV_SCENE = """#version 3.7;
 global_settings {{ assumed_gamma 1.0 }}
@@ -299,10 +299,7 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="change the scene for all three renderers (fractal.max_iter=20; keys POV-Ray's "
                          "and Mandelbulber2's translations take: fractal.c, fractal.max_iter, camera.*)")
-    ap.add_argument("--look", choices=("matched", "default"), default="matched",
-                    help="matched: a light at the eye, no shadows or occlusion (all three renderers); default: "
-                         "pyjulia4d's own look (soft shadows, occlusion) against POV-Ray with its shadows on, "
-                         "Mandelbulber2 left out")
+    add_look(ap, " (Mandelbulber2 left out; matched: all three renderers)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     SCENE_SET[:] = a.set
