@@ -8,8 +8,9 @@ the set, where pyjulia4d's distance-estimate march stops within epsilon 1e-3 of 
 each renderer runs at several settings, and each setting's error is measured:
 
 * The scenes: ``matched`` is ``peers.py``'s POV-Ray scene (pyjulia4d's default scene at 640x480,
-  a shadowless light at the eye), ``max_iter 20`` the same at ``max_iteration 20``, and
-  ``hypercomplex sqr`` is ``pov_compare.py``'s.  pyjulia4d renders what ``import-pov`` makes of
+  a shadowless light at the eye) and ``max_iter 20``, the same at ``max_iteration 20``;
+  ``hypercomplex sqr`` and ``documentation example`` (POV-Ray's own quaternion example, seed
+  003, written at precision 15) are ``pov_compare.py``'s.  pyjulia4d renders what ``import-pov`` makes of
   each, so both render the same truncated set (POV-Ray's escape radius and iteration count).
 * The truth: ``measure.truth.brute_force_depth`` (float64, a chord scan at 2e-4 through the
   bounding ball, a scan at 2e-6 over the chord before the first inside sample, bisection) on
@@ -97,7 +98,12 @@ def pov_hypercomplex(w: int, h: int, precision: float) -> str:
     return pov_compare.pov_text("hypercomplex sqr", precision=precision)
 
 
-SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex}
+def pov_documentation(w: int, h: int, precision: float) -> str:
+    return pov_compare.pov_text("documentation example (quaternion sqr)", precision=precision)
+
+
+SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex,
+          "documentation example": pov_documentation}
 LIT = ("matched", "max_iter 20")   # the scenes --look default lights (peers.py's point light)
 LOOK: list[str] = []               # --look default: pyjulia4d's soft shadows and occlusion
 
