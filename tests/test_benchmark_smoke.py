@@ -184,7 +184,7 @@ def test_peer_error_report_runs(tmp_path, monkeypatch):
     assert pe.main(["--size", "32x24", "--repeats", "1", "--renders", "1", "--samples", "100",
                     "--out", str(tmp_path)]) == 0
     md = (tmp_path / "peer_error.md").read_text()
-    assert "| default (de, epsilon 1e-3, 4 ITP steps) |" in md and "wrong by > 0.1 px" in md
+    assert "| default (march.quality auto) |" in md and "default march here: the distance estimate" in md and "wrong by > 0.1 px" in md
     assert pe.main(["--size", "32x24", "--repeats", "1", "--renders", "1", "--samples", "100", "--look", "default",
                     "--scenes", "matched", "--out", str(tmp_path)]) == 0
     assert "pyjulia4d's default look" in (tmp_path / "peer_error.md").read_text()
