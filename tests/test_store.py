@@ -143,3 +143,55 @@ def test_a_folder_without_room_keeps_the_image_in_memory(tmp_path: Path, monkeyp
     store.release()
     assert np.all(a == 2.0) and store.mapped == 0
     assert list(tmp_path.iterdir()) == []
+
+
+def test_kept_memory_comes_back_only_when_no_view_is_left() -> None:
+    """store.Reuse: an image's memory is kept for the next image of its size once every array
+    over it is gone - not while any view (a slice, a transpose, a channel) of it lives."""
+    from pyjulia4d.pipeline.store import Reuse
+
+    keep = Reuse(keep=1 << 20)
+    a = keep.empty(4096).view(np.float32).reshape(4, 16, 16).transpose(1, 2, 0)
+    a[...] = 7
+    where = a.__array_interface__["data"][0]
+    channel = a[..., 2]
+    del a
+    b = keep.empty(4096)                       # the first image's channel is still in use
+    assert b.__array_interface__["data"][0] != where and keep.held == 0
+    assert np.all(channel == 7)
+    del channel
+    assert keep.held == 4096
+    c = keep.empty(4096)
+    assert c.__array_interface__["data"][0] == where and keep.held == 0
+    del b, c
+    assert keep.held == 8192
+    d = keep.empty(64)                         # another size: new memory
+    assert keep.held == 8192 and d.nbytes == 64
+
+
+def test_kept_memory_is_bounded() -> None:
+    from pyjulia4d.pipeline.store import Reuse
+
+    keep = Reuse(keep=10_000, per_size=2)
+    images = [keep.empty(4000) for _ in range(4)]
+    del images
+    assert keep.held == 8000                   # two of a size, within 10,000 bytes
+    images = [keep.empty(3000) for _ in range(2)]
+    del images
+    assert keep.held == 8000                   # 11,000 would pass the bound: let go
+
+
+def test_a_later_render_leaves_an_earlier_result_alone() -> None:
+    """Two results alive at once never share memory; a result rendered into kept memory is
+    the same as one rendered into new memory."""
+    from pyjulia4d import render
+
+    one = render(Scene.default().with_overrides(SMALL), calibrate=False)
+    kept = {k: np.array(getattr(one, k)) for k in ("color", "alpha", "depth", "normal", "status")}
+    other = render(Scene.default().with_overrides(SMALL + ["fractal.c=-0.5,0.5,0,0"]), calibrate=False)
+    for k, v in kept.items():
+        np.testing.assert_array_equal(getattr(one, k), v, err_msg=k)
+    del one, other
+    again = render(Scene.default().with_overrides(SMALL), calibrate=False)   # into kept memory
+    for k, v in kept.items():
+        np.testing.assert_array_equal(getattr(again, k), v, err_msg=k)
