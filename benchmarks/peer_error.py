@@ -18,10 +18,10 @@ each renderer runs at several settings, and each setting's error is measured:
 * POV-Ray's depth: the same scene with the fractal's pigment replaced by a function of the
   distance to the camera, ``finish { ambient 1 diffuse 0 }``, no light, written as a linear
   16-bit PNG: red holds v = (distance - lo) / (hi - lo) over the truth's depth range, green
-  frac(256 v), which together give the depth to about 1e-8 (OpenImageIO reads the file; Pillow
-  would cut it to 8 bits).  Its hit mask is the alpha.  Its CPU seconds are its own report of
-  the trace of the scene with its own look ("Trace Time ... CPU-seconds total"), at each
-  ``precision``.
+  frac(256 v), which together give v to 1 / (256 x 65535) of the range, about 2e-7 in depth
+  here (OpenImageIO reads the file; Pillow would cut it to 8 bits).  Its hit mask is the
+  alpha.  Its CPU seconds are its own report of the trace of the scene with its own look
+  ("Trace Time ... CPU-seconds total"), at each ``precision``.
 * pyjulia4d's depth: the ``depth`` output of a render at each setting (the same march as the
   timed render, which keeps colour and alpha as ``peers.py``'s does); CPU seconds of a warm
   render in a child process (``peers.py``'s measure), median of ``--renders`` renders, and the
@@ -30,7 +30,7 @@ each renderer runs at several settings, and each setting's error is measured:
   truth's (silhouette); over the pixels both hit, |depth - truth| at the median, 90th and
   99th percentiles (scene units); and the share of pixels that are wrong: in the silhouette,
   or in depth by more than 0.1 (and 1) pixel's worth, t 2 tan(fov/2) / height at the truth's
-  depth t.  POV-Ray polishes each hit by bisection to about 1e-7, below float32's spacing at
+  depth t.  POV-Ray polishes each hit by bisection to within that readout, below float32's spacing at
   these depths (2.4e-7 at t = 3) and far below what a picture shows, so its median is not
   what separates the renderers; its misses of thin parts (precision is its step, 1/precision)
   are.  A row is at least as good as another where it has no more wrong pixels at either
@@ -168,7 +168,7 @@ def pov_time(text: str, w: int, h: int, tmp: Path) -> float:
 def depth_text(text: str, lo: float, hi: float) -> str:
     """``text`` with the fractal coloured by its distance to the camera, unlit (ambient 1, no
     light): v = (distance - lo) / (hi - lo) in red, frac(256 v) in green (POV-Ray's functions
-    are double precision; two 16-bit channels hold v to about 2e-7 of [lo, hi])."""
+    are double precision; two 16-bit channels hold v to 1 / (256 x 65535), 6e-8 of hi - lo)."""
     m = re.search(r"camera \{[^}]*?location <([^>]*)>", text)
     ex, ey, ez = (float(v) for v in m.group(1).split(","))
     lo, hi = float(lo), float(hi)

@@ -148,7 +148,7 @@ def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
     """POV-Ray's depth as benchmarks/peer_error.py reads it (a distance pigment in two 16-bit
     channels) against the float64 brute force of the same set: at precision 1000 POV-Ray
     steps over nothing at this size, so every pixel both hit agrees to 1e-6 (its bisection
-    polishes to about 1e-7) - which checks the encoding, the decoding and the view mapping."""
+    polishes to within the readout's 2e-7) - which checks the encoding, the decoding and the view mapping."""
     import shutil
 
     import numpy as np
