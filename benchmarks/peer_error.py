@@ -37,8 +37,9 @@ each renderer runs at several settings, and each setting's error is measured:
   tolerance.  The shares carry their standard error over the draw of pixels.
 
 For each POV-Ray row the table names the fastest pyjulia4d row at least as good, and the ratio
-of the two rates.  Writes benchmarks/results/peer_error.md (a section per run).  POV-Ray is
-skipped with a message where it is not installed.
+of the two rates.  Writes benchmarks/results/peer_error.md (a section per run) and
+peer_error.png (peer_error_default_look.png with ``--look default``): wrong pixels against
+CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
 
     python benchmarks/peer_error.py [--scenes all] [--samples 4000] [--repeats 3] [--look default]
 """
@@ -297,7 +298,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
             lines.append(f"| {k} | {best or 'none'} | {ratio} | {rows[default]['rate'] / rows[k]['rate']:.2f} "
                          f"| {wrong} |")
             print(lines[-1], flush=True)
-    return lines, device
+    return lines, device, rows
 
 
 def main(argv=None) -> int:
@@ -336,11 +337,11 @@ def main(argv=None) -> int:
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
-    lines, device = [], "?"
+    lines, device, plotted = [], "?", {}
     try:
         with tempfile.TemporaryDirectory() as td:
             for n in names:
-                more, device = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
+                more, device, plotted[n] = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
                 lines += more
     finally:   # peers.py's look, and this module's, as they were for the next caller in this process
         peers.LOOK[:] = peers.MATCHED
@@ -354,7 +355,52 @@ def main(argv=None) -> int:
                "(see its docstring: the truth, how each depth is read, what is timed).\n",
                head + "\n".join(lines) + "\n")
     print(f"wrote {md}")
+    png = a.out / ("peer_error.png" if a.look == "matched" else "peer_error_default_look.png")
+    write_plot(png, plotted, f"{w}x{h}{look}, {device}, {utc_now()}, commit {git_commit()}")
+    print(f"wrote {png}")
     return 0
+
+
+def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> None:
+    """Wrong pixels against CPU-seconds, a panel per scene: POV-Ray's precisions joined by a
+    line, pyjulia4d's settings as points, its default starred.  Written atomically (a
+    temporary file in the folder, renamed over ``path``)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4.4 * len(scenes), 4.0), squeeze=False)
+    for ax, (name, rows) in zip(axes[0], scenes.items()):
+        pov = [(k, r) for k, r in rows.items() if k.startswith("POV-Ray")]
+        ours = [(k, r) for k, r in rows.items() if not k.startswith("POV-Ray")]
+        if pov:
+            ax.plot([r["cpu"] for _, r in pov], [100 * r["wrong01"] for _, r in pov], "o-", color="tab:red",
+                    label="POV-Ray 3.7, precision 10 / 20 / 40 / 100")
+            for k, r in pov:
+                ax.annotate(k.rsplit(" ", 1)[1], (r["cpu"], 100 * r["wrong01"]), fontsize=6,
+                            xytext=(3, 3), textcoords="offset points", color="tab:red")
+        ax.plot([r["cpu"] for _, r in ours], [100 * r["wrong01"] for _, r in ours], "s", color="tab:blue",
+                ms=4, label="pyjulia4d, its march settings")
+        r0 = ours[0][1]   # SETTINGS' first: the scene's default
+        ax.plot([r0["cpu"]], [100 * r0["wrong01"]], "*", color="tab:blue", ms=12, label="pyjulia4d's default")
+        ax.set_xscale("log")
+        ax.set_title(name, fontsize=8)
+        ax.set_xlabel("CPU seconds per render", fontsize=7)
+        ax.set_ylabel("pixels wrong by more than 0.1 px (%)", fontsize=7)
+        ax.tick_params(labelsize=6)
+        ax.grid(True, alpha=0.3)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, frameon=False)
+    fig.suptitle(f"Depth error against time: {title}", fontsize=8)
+    fig.tight_layout(rect=(0, 0.07, 1, 0.95))
+    with tempfile.NamedTemporaryFile(dir=path.parent, prefix=f".{path.stem}.", suffix=".png", delete=False) as f:
+        tmp = Path(f.name)
+    try:
+        fig.savefig(tmp, dpi=90)
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
+        plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -178,6 +178,8 @@ def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
 
 @pytest.mark.slow   # a child process per setting
 def test_peer_error_report_runs(tmp_path, monkeypatch):
+    from PIL import Image
+
     pe = load("peer_error")
     monkeypatch.setattr(pe, "PRECISIONS", (20,))
     monkeypatch.setattr(pe, "SETTINGS", {k: pe.SETTINGS[k] for k in list(pe.SETTINGS)[:2]})
@@ -188,6 +190,10 @@ def test_peer_error_report_runs(tmp_path, monkeypatch):
     assert pe.main(["--size", "32x24", "--repeats", "1", "--renders", "1", "--samples", "100", "--look", "default",
                     "--scenes", "matched", "--out", str(tmp_path)]) == 0
     assert "pyjulia4d's default look" in (tmp_path / "peer_error.md").read_text()
+    for png in ("peer_error.png", "peer_error_default_look.png"):
+        with Image.open(tmp_path / png) as im:
+            assert im.size[0] > 300 and im.size[1] > 300
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]   # no temporary file left
     assert pe.peers.LOOK == pe.peers.MATCHED and pe.LOOK == []
 
 
