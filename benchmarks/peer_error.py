@@ -369,8 +369,14 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(scenes), figsize=(4.4 * len(scenes), 4.0), squeeze=False)
-    for ax, (name, rows) in zip(axes[0], scenes.items()):
+    from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullFormatter
+
+    ncol = min(2, len(scenes))
+    nrow = -(-len(scenes) // ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.6 * nrow + 0.6), squeeze=False)
+    for ax in axes.ravel()[len(scenes):]:
+        ax.axis("off")
+    for ax, (name, rows) in zip(axes.ravel(), scenes.items()):
         pov = [(k, r) for k, r in rows.items() if k.startswith("POV-Ray")]
         ours = [(k, r) for k, r in rows.items() if not k.startswith("POV-Ray")]
         if pov:
@@ -384,6 +390,9 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
         r0 = ours[0][1]   # SETTINGS' first: the scene's default
         ax.plot([r0["cpu"]], [100 * r0["wrong01"]], "*", color="tab:blue", ms=12, label="pyjulia4d's default")
         ax.set_xscale("log")
+        ax.xaxis.set_major_locator(FixedLocator([0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10]))
+        ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_title(name, fontsize=8)
         ax.set_xlabel("CPU seconds per render", fontsize=7)
         ax.set_ylabel("pixels wrong by more than 0.1 px (%)", fontsize=7)
@@ -392,7 +401,7 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, frameon=False)
     fig.suptitle(f"Depth error against time: {title}", fontsize=8)
-    fig.tight_layout(rect=(0, 0.07, 1, 0.95))
+    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
     with tempfile.NamedTemporaryFile(dir=path.parent, prefix=f".{path.stem}.", suffix=".png", delete=False) as f:
         tmp = Path(f.name)
     try:
