@@ -27,6 +27,17 @@ inline lmask julia_inside(quat p, julia_params jp)
     lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
     lmask live_a = m2a <= (bailout2), live_b = m2b <= (bailout2)
 
+/* two packets' orbits one step on under q -> f(q, c) where live (the pair estimates below;
+ * kind/mandelbrot.cl's with its own f and a c per packet) */
+#define PAIR_ORBIT_STEP(f, qa, qb, ca, cb, m2a, m2b, live_a, live_b, bailout2) do { \
+        qa = QSEL(qa, f(qa, ca), live_a); \
+        qb = QSEL(qb, f(qb, cb), live_b); \
+        m2a = ALG_NORM2(qa); \
+        m2b = ALG_NORM2(qb); \
+        live_a = m2a <= (bailout2); \
+        live_b = m2b <= (bailout2); \
+    } while (0)
+
 /* one step of the level function's orbit where live, counting the steps done */
 #define LEVEL_ORBIT_STEP(q, m2, steps, live, c, bailout2) do { \
         q = QSEL(q, julia_f(q, c), live); \
@@ -125,16 +136,6 @@ inline lreal de_value(lreal m2, lreal dm2, lmask e)
             DE_RESCALE(dm2, e, big_); \
     } while (0)
 
-/* two packets' orbits one step on where live (the pair estimates below) */
-#define PAIR_ORBIT_STEP(qa, qb, m2a, m2b, live_a, live_b, c, bailout2) do { \
-        qa = QSEL(qa, julia_f(qa, c), live_a); \
-        qb = QSEL(qb, julia_f(qb, c), live_b); \
-        m2a = ALG_NORM2(qa); \
-        m2b = ALG_NORM2(qb); \
-        live_a = m2a <= (bailout2); \
-        live_b = m2b <= (bailout2); \
-    } while (0)
-
 #ifndef ALG_SPLIT
 /* one step of the estimate's orbit where live: q <- f(q) + c, |q'|^2 (dm2 * 2^e) grown */
 #define DE_ORBIT_STEP(q, m2, dm2, e, live, c, bailout2) do { \
@@ -180,7 +181,7 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
             DE_RESCALE(dm2a, ea, big_a);
             DE_RESCALE(dm2b, eb, big_b);
         }
-        PAIR_ORBIT_STEP(qa, qb, m2a, m2b, live_a, live_b, c, jp.bailout2);
+        PAIR_ORBIT_STEP(julia_f, qa, qb, c, c, m2a, m2b, live_a, live_b, jp.bailout2);
     }
     *escaped_a = m2a > jp.bailout2;
     *escaped_b = m2b > jp.bailout2;
@@ -252,7 +253,7 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
             DE_RESCALE(a1, ea1, ga1);
             DE_RESCALE(b1, eb1, gb1);
         }
-        PAIR_ORBIT_STEP(q0, q1, m0, m1, live0, live1, c, jp.bailout2);
+        PAIR_ORBIT_STEP(julia_f, q0, q1, c, c, m0, m1, live0, live1, jp.bailout2);
     }
     *escaped_a = m0 > jp.bailout2;
     *escaped_b = m1 > jp.bailout2;

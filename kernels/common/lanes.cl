@@ -50,13 +50,12 @@ typedef struct {
 
 /* Dot products and unit vectors of one work-item's vectors, written out.  Intel's CPU
  * compiler runs a kernel of one ray per work-item 16 work-items at a time (AVX-512), but not
- * where it calls the builtin dot, length or normalize: then its build log says "was not
- * vectorized" and it runs one pixel at a time (the shade kernel took 2.6x its time so).
+ * where it calls the builtin dot, length, normalize or cross: then its build log says "was
+ * not vectorized" and it runs one pixel at a time (the shade kernel took 2.1x its time so).
  * UNIT3 takes ``fallback`` where a has no direction (|a|^2 is 0, or not finite). */
 #define DOT3(a, b) ((a).x * (b).x + (a).y * (b).y + (a).z * (b).z)
 #define DOT4(a, b) ((a).x * (b).x + (a).y * (b).y + (a).z * (b).z + (a).w * (b).w)
-#define UNIT3(a, fallback) unit3_or((a), (fallback))
-inline float3 unit3_or(float3 a, float3 fallback)
+inline float3 UNIT3(float3 a, float3 fallback)
 {
     float aa = DOT3(a, a);
     return aa > 0.0f && aa <= FLT_MAX ? a * rsqrt(aa) : fallback;

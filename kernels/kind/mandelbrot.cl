@@ -53,9 +53,7 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
         live = m2 <= jp.bailout2;
     }
     COUNT_ITER(jp, n - 1);
-    *inside = m2 <= jp.bailout2;
-    lreal out = kind_level(m2, jp.bailout2, jp.max_iter - steps, JULIA_GROWTH);
-    return L_SEL(out, m2 / jp.bailout2 - (real)1, *inside);
+    return level_value(m2, steps, jp, inside);
 }
 
 #ifdef PACKET_PAIRS
@@ -65,14 +63,7 @@ inline lreal mandel_level(quat p, julia_params jp, lmask *inside)
     quat qa = MANDEL_START(ca), qb = MANDEL_START(cb); \
     lreal m2a = ALG_NORM2(qa), m2b = ALG_NORM2(qb); \
     lmask live_a = m2a <= jp.bailout2, live_b = m2b <= jp.bailout2
-#define MANDEL_PAIR_STEP() do { \
-        qa = QSEL(qa, mandel_f(qa, ca), live_a); \
-        qb = QSEL(qb, mandel_f(qb, cb), live_b); \
-        m2a = ALG_NORM2(qa); \
-        m2b = ALG_NORM2(qb); \
-        live_a = m2a <= jp.bailout2; \
-        live_b = m2b <= jp.bailout2; \
-    } while (0)
+#define MANDEL_PAIR_STEP() PAIR_ORBIT_STEP(mandel_f, qa, qb, ca, cb, m2a, m2b, live_a, live_b, jp.bailout2)
 
 /* mandel_level at two packets' points in one loop (march/refine.cl refine_bracket_pair) */
 inline void mandel_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b,
@@ -85,12 +76,8 @@ inline void mandel_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a
         steps_b = L_SEL(steps_b, steps_b + 1, live_b);
         MANDEL_PAIR_STEP();
     }
-    *inside_a = m2a <= jp.bailout2;
-    *inside_b = m2b <= jp.bailout2;
-    *fa = L_SEL(kind_level(m2a, jp.bailout2, jp.max_iter - steps_a, JULIA_GROWTH), m2a / jp.bailout2 - (real)1,
-                *inside_a);
-    *fb = L_SEL(kind_level(m2b, jp.bailout2, jp.max_iter - steps_b, JULIA_GROWTH), m2b / jp.bailout2 - (real)1,
-                *inside_b);
+    *fa = level_value(m2a, steps_a, jp, inside_a);
+    *fb = level_value(m2b, steps_b, jp, inside_b);
 }
 #define julia_level_pair mandel_level_pair
 #endif

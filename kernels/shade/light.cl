@@ -105,6 +105,17 @@ inline void shadow_ray_pair(const quat *o, const quat *l, const lreal *tmax, con
  * the estimate without its 1/2 factor); without an estimate, the share of the five points
  * inside the set (w_i-weighted occupancy). */
 #ifdef AO
+/* one sample's weighted occlusion, w max(h - 2 d, 0) / h, and the ambient factor of their sum */
+inline lreal ao_sample(real w, real h, lreal d)
+{
+    return w * fmax((real)h - (real)2 * d, (real)0) / h;
+}
+
+inline lreal ao_value(lreal occ, real wsum, real strength)
+{
+    return clamp((real)1 - strength * occ / wsum, (real)0, (real)1);
+}
+
 inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real strength)
 {
     lreal occ = (lreal)0;
@@ -113,15 +124,14 @@ inline lreal ambient_occlusion(quat p, quat n, julia_params jp, real dist, real 
         real h = dist * (real)i / (real)5;
         quat x = QRAY(p, n, (lreal)h);
 #ifdef ALG_HAS_DE
-        lreal d = julia_distance(x, jp);
-        occ += w * fmax((real)h - (real)2 * d, (real)0) / h;
+        occ += ao_sample(w, h, julia_distance(x, jp));
 #else
         occ += L_SEL((lreal)0, (lreal)w, julia_inside(x, jp));
 #endif
         wsum += w;
         w *= (real)0.5;
     }
-    return clamp((real)1 - strength * occ / wsum, (real)0, (real)1);
+    return ao_value(occ, wsum, strength);
 }
 
 #ifdef LIGHT_PAIRS
@@ -136,13 +146,13 @@ inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp
         lmask ea, eb;
         lreal da, db;
         julia_distance_formula_pair(QRAY(p[0], n[0], (lreal)h), QRAY(p[1], n[1], (lreal)h), jp, &ea, &eb, &da, &db);
-        occ_a += w * fmax((real)h - (real)2 * L_SEL((lreal)0, da, ea), (real)0) / h;
-        occ_b += w * fmax((real)h - (real)2 * L_SEL((lreal)0, db, eb), (real)0) / h;
+        occ_a += ao_sample(w, h, L_SEL((lreal)0, da, ea));   /* julia_distance: 0 inside */
+        occ_b += ao_sample(w, h, L_SEL((lreal)0, db, eb));
         wsum += w;
         w *= (real)0.5;
     }
-    amb[0] = clamp((real)1 - strength * occ_a / wsum, (real)0, (real)1);
-    amb[1] = clamp((real)1 - strength * occ_b / wsum, (real)0, (real)1);
+    amb[0] = ao_value(occ_a, wsum, strength);
+    amb[1] = ao_value(occ_b, wsum, strength);
 }
 #endif
 #endif

@@ -77,7 +77,8 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
 def march_items(n: int, tile_w: int, lanes: int, packets: int = 1) -> int:
     """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
     per ``packets`` neighbouring blocks of pixels in a row (kernels/march/march.cl,
-    kernel_config.march_packets; the light terms and normals take one block each)."""
+    kernel_config.march_packets; the light terms take the march's, the Jacobian normals one
+    block each)."""
     if lanes == 1:
         return n
     bw, bh = kernel_config.packet_block(lanes)

@@ -9,7 +9,7 @@ real bailout2;
 real epsilon;
 int max_iter;
 } julia_params;
-inline float3 unit3_or(float3 a, float3 fallback)
+inline float3 UNIT3(float3 a, float3 fallback)
 {
 float aa = ((a).x * (a).x + (a).y * (a).y + (a).z * (a).z);
 return aa > 0.0f && aa <= FLT_MAX ? a * rsqrt(aa) : fallback;
