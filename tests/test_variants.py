@@ -140,6 +140,35 @@ def test_a_damaged_cache_is_found_again(tmp_path, monkeypatch, junk):
     devices.forget_remembered()
 
 
+def test_a_probe_that_ran_out_of_time_is_not_cached(tmp_path, monkeypatch):
+    """A width whose probe only timed out (a busy machine) is not known to fail: this process
+    marches one ray per work-item with a warning, and nothing is written, so the next process
+    probes again; a width that ran and failed is an answer, cached as 1."""
+    import subprocess
+    from harness import device
+    from pyjulia4d.opencl import devices
+    dev = device()
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    devices.forget_remembered()
+    calls = []
+
+    def timed_out(cmd, **kw):
+        calls.append(cmd[4])
+        raise subprocess.TimeoutExpired(cmd, kw.get("timeout"))
+
+    monkeypatch.setattr(lanes_mod.subprocess, "run", timed_out)
+    with pytest.warns(RuntimeWarning, match="ran out of time"):
+        assert lanes_mod.lanes_for(dev, "packet", False) == 1
+    assert calls == [str(w) for w in lanes_mod.WIDTHS]
+    assert not (tmp_path / "lanes.json").exists()
+    devices.forget_remembered()
+    monkeypatch.setattr(lanes_mod.subprocess, "run",
+                        lambda cmd, **kw: subprocess.CompletedProcess(cmd, 1, "", "build failed"))
+    assert lanes_mod.lanes_for(dev, "packet", False) == 1
+    assert json.loads((tmp_path / "lanes.json").read_text())[devices.device_key(dev)] == 1
+    devices.forget_remembered()
+
+
 def test_scene_variant_key():
     s = Scene.default().with_overrides(["render.variant=scalar", "image.width=9", "image.height=7"])
     assert render(s).lanes == 1

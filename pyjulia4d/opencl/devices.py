@@ -76,7 +76,9 @@ def remembered_path(name: str) -> Path:
 def remembered(name: str, device: cl.Device, kind: type, find: Callable[[cl.Device], object]):
     """An answer about ``device`` found once per driver: kept in this process and in
     ``<cache>/<name>.json`` under its device_key, found by ``find(device)`` where neither
-    holds one of type ``kind``.  An unreadable or unwritable cache only costs finding it."""
+    holds one of type ``kind``.  An unreadable or unwritable cache only costs finding it.
+    ``find`` returns None where it could not decide (a probe that ran out of time on a busy
+    machine): None is then kept for this process only, and the next one asks again."""
     key = device_key(device)
     if (name, key) in _remembered:
         return _remembered[name, key]
@@ -87,7 +89,11 @@ def remembered(name: str, device: cl.Device, kind: type, find: Callable[[cl.Devi
         known = {}
     known = known if isinstance(known, dict) else {}
     if not isinstance(known.get(key), kind):
-        known[key] = find(device)
+        found = find(device)
+        if found is None:
+            _remembered[name, key] = None
+            return None
+        known[key] = found
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             with atomic_write(path) as tmp:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import warnings
 
 import pyopencl as cl
 
@@ -59,19 +60,23 @@ def device_spec(device: cl.Device) -> str:
     raise ValueError("device not found among the platforms")
 
 
-def probe(device: cl.Device, timeout: float = 120.0, double: bool = False) -> int:
+def probe(device: cl.Device, timeout: float = 120.0, double: bool = False) -> int | None:
     """The widest of WIDTHS (DOUBLE_WIDTHS with ``double``) whose packet march builds, runs and
-    agrees with one ray per work-item in a child process; 1 if none does."""
+    agrees with one ray per work-item in a child process; 1 if none does; None where no width
+    passed and one ran out of ``timeout`` (undecided: a width that only timed out on a busy
+    machine is not known to fail, so the answer is not cached)."""
     spec = device_spec(device)
+    undecided = False
     for lanes in DOUBLE_WIDTHS if double else WIDTHS:
         try:
             p = subprocess.run([sys.executable, "-c", _PROBE, spec, str(lanes), "double" if double else "single"],
                                capture_output=True, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
+            undecided = True
             continue
         if p.returncode == 0 and p.stdout.strip().endswith("ok"):
             return lanes
-    return 1
+    return None if undecided else 1
 
 
 # The proven march's lanes part ways more than the scan's or the estimate's (each proves
@@ -97,8 +102,15 @@ def lanes_for(device: cl.Device, variant: str, double: bool) -> int:
     if variant == "auto" and device_type(device) != "CPU":
         return 1
     if double:
-        return int(remembered("lanes_double", device, int, lambda d: probe(d, double=True)))
-    return int(remembered("lanes", device, int, probe))
+        width = remembered("lanes_double", device, int, lambda d: probe(d, double=True))
+    else:
+        width = remembered("lanes", device, int, probe)
+    if width is None:
+        warnings.warn("render.variant: the packet-width probe ran out of time (a busy machine?); "
+                      "this process marches one ray per work-item, and the next one probes again",
+                      RuntimeWarning, stacklevel=2)
+        return 1
+    return int(width)
 
 
 def packet_pairs(device: cl.Device, lanes: int, double: bool) -> bool:
