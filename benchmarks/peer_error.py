@@ -85,6 +85,14 @@ SETTINGS = {
                                       "march.post_steps=8"],
     "de, epsilon 5e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
                                       "march.post_steps=8"],
+    # bisection: at these epsilons the march's brackets are all about epsilon wide, where
+    # ITP converges no faster than bisection and costs two level evaluations more a ray
+    "de, epsilon 3e-2, 8 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.03",
+                                            "march.post_steps=8", "march.refine=bisect"],
+    "de, epsilon 5e-2, 8 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
+                                            "march.post_steps=8", "march.refine=bisect"],
+    "de, epsilon 5e-2, 10 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
+                                             "march.post_steps=10", "march.refine=bisect"],
     "fixed, z 50, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=50",
                                  "march.post_steps=8"],
     "fixed, z 100, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=100",
