@@ -65,11 +65,11 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
         with np.errstate(all="ignore"):
             J[live] = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
             q[live] = F.julia_f(ql, c)
-            s = np.linalg.norm(J[live], axis=-1).max(axis=-1)
-        big = (s > 1e12) | ((s < 1e-12) & (s > 0))
+            s2 = np.sum(J[live] * J[live], axis=-1).max(axis=-1)   # the largest column's |.|^2
+        big = (s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0))
         if big.any():
             Jl = J[live]
-            Jl[big] /= s[big][:, None, None]
+            Jl[big] /= np.sqrt(s2[big])[:, None, None]
             J[live] = Jl
     if guard is not None:
         guard |= np.where(tiny, GUARD_JACOBIAN_TINY, 0)

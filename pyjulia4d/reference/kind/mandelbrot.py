@@ -126,12 +126,13 @@ def mandel_normal_jacobian(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             Jl = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
             Jl = Jl + unit[live][:, None, None] * E
             q[live] = mandel_f(F, ql, c[live])
-            s = np.linalg.norm(Jl, axis=-1).max(axis=-1)
-        big = (s > 1e12) | ((s < 1e-12) & (s > 0))
+            s2 = np.sum(Jl * Jl, axis=-1).max(axis=-1)   # the largest column's |.|^2 (normals/jacobian.cl)
+        big = (s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0))
         if big.any():
-            Jl[big] /= s[big][:, None, None]
+            s = np.sqrt(s2[big])
+            Jl[big] /= s[:, None, None]
             ul = unit[live]
-            ul[big] /= s[big]
+            ul[big] /= s
             unit[live] = ul
         J[live] = Jl
     if guard is not None:
