@@ -166,6 +166,13 @@ inline quat QSEL(quat a, quat b, lmask m)
 #define PACKETS 1
 #endif
 
+/* A derivative carried only up to scale (the normals' Jacobians: normals/jacobian.cl,
+ * kind/julia_stack.cl, kind/cubic_locus.cl) is rescaled on the live lanes where the squared
+ * length s2 of its largest part leaves [1e-24, 1e24] (lengths 1e-12 to 1e12), by 1 / sqrt(s2):
+ * no overflow or underflow at any max_iter, and no square root until one is due. */
+#define L_RESCALE_DUE(live, s2) \
+    ((live) & (((s2) > (real)1e24) | (((s2) < (real)1e-24) & ((s2) > (real)0))))
+
 #if LANES > 1
 /* The pixels of packet p of work-item g, which takes `packets` neighbouring BLOCK_W x BLOCK_H
  * blocks of a tile tile_w wide and n_items / tile_w high (rows of blocks, each row's blocks

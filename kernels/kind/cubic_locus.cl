@@ -89,10 +89,10 @@ inline quat locus_normal(quat p, julia_params jp, lmask *guard)
         ar = L_SEL(ar, nar, live); ai = L_SEL(ai, nai, live);
         br = L_SEL(br, nbr, live); bi = L_SEL(bi, nbi, live);
         LOCUS_STEP(zr, zi, a2r, a2i, p.z, p.w, live);
-        lreal s = fmax(sqrt(ar * ar + ai * ai), sqrt(br * br + bi * bi));
-        lmask rescale = live & ((s > (real)1e12) | ((s < (real)1e-12) & (s > (real)0)));
+        lreal s2 = fmax(ar * ar + ai * ai, br * br + bi * bi);
+        lmask rescale = L_RESCALE_DUE(live, s2);
         if (L_ANY(rescale)) {
-            lreal inv = (real)1 / s;
+            lreal inv = (real)1 / sqrt(s2);
             ar = L_SEL(ar, ar * inv, rescale); ai = L_SEL(ai, ai * inv, rescale);
             br = L_SEL(br, br * inv, rescale); bi = L_SEL(bi, bi * inv, rescale);
             unit = L_SEL(unit, unit * inv, rescale);

@@ -66,12 +66,11 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
 #else
         q = QSEL(q, julia_f(q, c), live);
 #endif
-        /* the largest column's squared length: the test needs no square root, which was
-         * four of them every iteration (sqrt is monotonic, so sqrt(s2) is the largest length) */
-        lreal s2 = fmax(fmax(QNORM2(j0), QNORM2(j1)), fmax(QNORM2(j2), QNORM2(j3)));
-        /* rescale both ways: J shrinks geometrically on orbits drawn to an attracting
+        /* the largest column's squared length (sqrt is monotonic: sqrt(s2) is the largest
+         * length); rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
-        lmask rescale = live & ((s2 > (real)1e24) | ((s2 < (real)1e-24) & (s2 > (real)0)));
+        lreal s2 = fmax(fmax(QNORM2(j0), QNORM2(j1)), fmax(QNORM2(j2), QNORM2(j3)));
+        lmask rescale = L_RESCALE_DUE(live, s2);
         if (L_ANY(rescale)) {
             lreal inv = (real)1 / sqrt(s2);
             j0 = QSEL(j0, QSCALE(inv, j0), rescale);

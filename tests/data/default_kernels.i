@@ -370,7 +370,7 @@ j2 = ((live) ? (julia_f_jvp(q, j2)) : (j2));
 j3 = ((live) ? (julia_f_jvp(q, j3)) : (j3));
 q = ((live) ? (julia_f(q, c)) : (q));
 lreal s2 = fmax(fmax((((j0)).x * ((j0)).x + ((j0)).y * ((j0)).y + ((j0)).z * ((j0)).z + ((j0)).w * ((j0)).w), (((j1)).x * ((j1)).x + ((j1)).y * ((j1)).y + ((j1)).z * ((j1)).z + ((j1)).w * ((j1)).w)), fmax((((j2)).x * ((j2)).x + ((j2)).y * ((j2)).y + ((j2)).z * ((j2)).z + ((j2)).w * ((j2)).w), (((j3)).x * ((j3)).x + ((j3)).y * ((j3)).y + ((j3)).z * ((j3)).z + ((j3)).w * ((j3)).w)));
-lmask rescale = live & ((s2 > (real)1e24) | ((s2 < (real)1e-24) & (s2 > (real)0)));
+lmask rescale = ((live) & (((s2) > (real)1e24) | (((s2) < (real)1e-24) & ((s2) > (real)0))));
 if ((rescale)) {
 lreal inv = (real)1 / sqrt(s2);
 j0 = ((rescale) ? (((inv) * (j0))) : (j0));

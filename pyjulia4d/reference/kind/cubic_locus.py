@@ -81,11 +81,12 @@ def locus_normal(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             A[live] = d * A[live] - unit[live] * 6 * (al * zl)
             B[live] = d * B[live] + unit[live]
             z[live] = locus_f(zl, al, b[live])
-            s = np.maximum(np.abs(A), np.abs(B))
-            big = live & ((s > 1e12) | ((s < 1e-12) & (s > 0)))
-            A[big] /= s[big]
-            B[big] /= s[big]
-            unit[big] /= s[big]
+            s2 = np.maximum(np.abs(A) ** 2, np.abs(B) ** 2)   # common/lanes.cl L_RESCALE_DUE
+            big = live & ((s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0)))
+            s = np.sqrt(s2[big])
+            A[big] /= s
+            B[big] /= s
+            unit[big] /= s
     zc = np.conj(z)
     g = np.stack([(zc * A).real, (zc * 1j * A).real, (zc * B).real, (zc * 1j * B).real], axis=-1)
     cut = (z.real ** 2 + z.imag ** 2 <= b2) & ~ball

@@ -83,11 +83,12 @@ def stack_normal(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             A[live] = 2 * zl * A[live]
             B[live] = 2 * zl * B[live] + unit[live] * ch
             z[live] = zl * zl + c[live]
-            s = np.maximum(np.abs(A), np.abs(B))
-            big = live & ((s > 1e12) | ((s < 1e-12) & (s > 0)))
-            A[big] /= s[big]
-            B[big] /= s[big]
-            unit[big] /= s[big]
+            s2 = np.maximum(np.abs(A) ** 2, np.abs(B) ** 2)   # common/lanes.cl L_RESCALE_DUE
+            big = live & ((s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0)))
+            s = np.sqrt(s2[big])
+            A[big] /= s
+            B[big] /= s
+            unit[big] /= s
     if guard is not None:
         guard |= np.where(tiny, tiny_flag, 0)
     cap = (z.real ** 2 + z.imag ** 2 <= b2) & (np.abs(u) > 1)
