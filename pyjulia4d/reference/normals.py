@@ -11,6 +11,7 @@ from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula
 from pyjulia4d.reference.kind import cubic_locus as _locus
 from pyjulia4d.reference.kind import julia_stack as _stack
 from pyjulia4d.reference.kind import mandelbrot as _mandelbrot
+from pyjulia4d.reference.kind.level import rescale_due
 
 def to_camera(g, frame: Frame):
     return np.stack([g @ frame.right, g @ frame.up, -(g @ frame.forward)], axis=-1)
@@ -66,7 +67,7 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
             J[live] = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
             q[live] = F.julia_f(ql, c)
             s2 = np.sum(J[live] * J[live], axis=-1).max(axis=-1)   # the largest column's |.|^2
-        big = (s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0))
+        big = rescale_due(s2)
         if big.any():
             Jl = J[live]
             Jl[big] /= np.sqrt(s2[big])[:, None, None]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.kind.level import kind_level
+from pyjulia4d.reference.kind.level import kind_level, rescale_pair
 
 
 def _start(p, F):
@@ -81,12 +81,7 @@ def locus_normal(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             A[live] = d * A[live] - unit[live] * 6 * (al * zl)
             B[live] = d * B[live] + unit[live]
             z[live] = locus_f(zl, al, b[live])
-            s2 = np.maximum(np.abs(A) ** 2, np.abs(B) ** 2)   # common/lanes.cl L_RESCALE_DUE
-            big = live & ((s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0)))
-            s = np.sqrt(s2[big])
-            A[big] /= s
-            B[big] /= s
-            unit[big] /= s
+            rescale_pair(A, B, unit, live)
     zc = np.conj(z)
     g = np.stack([(zc * A).real, (zc * 1j * A).real, (zc * B).real, (zc * 1j * B).real], axis=-1)
     cut = (z.real ** 2 + z.imag ** 2 <= b2) & ~ball

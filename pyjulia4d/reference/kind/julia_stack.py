@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.kind.level import kind_level
+from pyjulia4d.reference.kind.level import kind_level, rescale_pair
 
 REAL_MIN = np.finfo(np.float64).tiny
 
@@ -83,12 +83,7 @@ def stack_normal(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             A[live] = 2 * zl * A[live]
             B[live] = 2 * zl * B[live] + unit[live] * ch
             z[live] = zl * zl + c[live]
-            s2 = np.maximum(np.abs(A) ** 2, np.abs(B) ** 2)   # common/lanes.cl L_RESCALE_DUE
-            big = live & ((s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0)))
-            s = np.sqrt(s2[big])
-            A[big] /= s
-            B[big] /= s
-            unit[big] /= s
+            rescale_pair(A, B, unit, live)
     if guard is not None:
         guard |= np.where(tiny, tiny_flag, 0)
     cap = (z.real ** 2 + z.imag ** 2 <= b2) & (np.abs(u) > 1)

@@ -1,6 +1,7 @@
 """float64 twin of kernels/kind/level.cl: the level (m2 / b2)^(D^k) - 1 of an orbit that escaped
 k steps before max_iter, capped at 1e30 (k > 60 or an exponent above 69); also
-reference.julia_level's, as iterate.cl computes it."""
+reference.julia_level's, as iterate.cl computes it.  And the rescale of the derivatives the
+normals carry (common/lanes.cl L_RESCALE_DUE), which every kind's normal shares."""
 from __future__ import annotations
 
 import numpy as np
@@ -17,3 +18,21 @@ def kind_level(m2, b2, k, growth):
         # the kernel's fmin(e, 69) takes 69 for a NaN e (an orbit gone to NaN)
         e = np.where(np.isnan(e), 69.0, e)
         return np.where((k > 60) | (e > 69), 1e30, np.expm1(np.minimum(e, 69)))
+
+
+def rescale_due(s2):
+    """Where a derivative carried up to scale, its largest part's squared length s2, is
+    rescaled by 1 / sqrt(s2): s2 outside [1e-24, 1e24] (common/lanes.cl L_RESCALE_DUE)."""
+    return (s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0))
+
+
+def rescale_pair(A, B, unit, live):
+    """A kind's two complex derivatives (and the 1 / scale ``unit`` they are kept at) divided,
+    in place, by the larger length where it is due on the live points
+    (kind/julia_stack.cl, kind/cubic_locus.cl)."""
+    s2 = np.maximum(np.abs(A) ** 2, np.abs(B) ** 2)
+    big = live & rescale_due(s2)
+    s = np.sqrt(s2[big])
+    A[big] /= s
+    B[big] /= s
+    unit[big] /= s

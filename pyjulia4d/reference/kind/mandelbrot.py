@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.kind.level import kind_level
+from pyjulia4d.reference.kind.level import kind_level, rescale_due
 
 REAL_MIN = np.finfo(np.float64).tiny
 
@@ -127,7 +127,7 @@ def mandel_normal_jacobian(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             Jl = Jl + unit[live][:, None, None] * E
             q[live] = mandel_f(F, ql, c[live])
             s2 = np.sum(Jl * Jl, axis=-1).max(axis=-1)   # the largest column's |.|^2 (normals/jacobian.cl)
-        big = (s2 > 1e24) | ((s2 < 1e-24) & (s2 > 0))
+        big = rescale_due(s2)
         if big.any():
             s = np.sqrt(s2[big])
             Jl[big] /= s[:, None, None]
