@@ -64,14 +64,14 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
             break
         ql = q[live]
         with np.errstate(all="ignore"):
-            J[live] = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
+            Jl = J[live]
+            Jl = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], Jl.shape), Jl)
             q[live] = F.julia_f(ql, c)
-            s2 = np.sum(J[live] * J[live], axis=-1).max(axis=-1)   # the largest column's |.|^2
+            s2 = np.sum(Jl * Jl, axis=-1).max(axis=-1)   # the largest column's |.|^2
         big = rescale_due(s2)
         if big.any():
-            Jl = J[live]
             Jl[big] /= np.sqrt(s2[big])[:, None, None]
-            J[live] = Jl
+        J[live] = Jl
     if guard is not None:
         guard |= np.where(tiny, GUARD_JACOBIAN_TINY, 0)
     with np.errstate(all="ignore"):
