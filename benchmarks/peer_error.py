@@ -1,5 +1,5 @@
-"""POV-Ray and pyjulia4d at equal depth error: each one's error against a float64 brute
-force, beside its pixels per CPU-second.
+"""POV-Ray, Mandelbulber2 and pyjulia4d at equal depth error: each one's error against a
+float64 brute force, beside its pixels per CPU-second.
 
 The speed targets ask for pyjulia4d's rate as a multiple of POV-Ray's "at equal or better
 depth error".  ``peers.py`` times both at their defaults, which are not equally accurate:
@@ -36,12 +36,24 @@ each renderer runs at several settings, and each setting's error is measured:
   are.  A row is at least as good as another where it has no more wrong pixels at either
   tolerance.  The shares carry their standard error over the draw of pixels.
 
-For each POV-Ray row the table names the fastest pyjulia4d row at least as good, and the ratio
+* Mandelbulber2 (Debian's 2.20, its OpenCL path on PoCL, never a dependency): the scenes
+  ``matched, Mandelbulber2's set`` and ``max_iter 20, Mandelbulber2's set`` are pyjulia4d's
+  matched scene as ``peers.py`` writes it for Mandelbulber2 (12 or 20 iterations, escape
+  radius 4: POV-Ray's import keeps POV-Ray's own count and bailout, a different truncated
+  set), and pyjulia4d's settings are rendered again on them.  Its depth is read from its
+  16-bit z-buffer through two reference spheres and checked on a third
+  (``benchmarks/mb_depth.py``), against the truth along its own rays, which pass through the
+  pixels' corners; its CPU seconds are ``peers.py``'s (the process's, less those of the same
+  command at 8x6 pixels), at its default threshold (detail_level 1), finer and coarser ones,
+  and constant thresholds 1e-3 to 1e-5.
+
+For each peer's row the table names the fastest pyjulia4d row at least as good, and the ratio
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run) and
 peer_error.png (peer_error_default_look.png with ``--look default``): wrong pixels against
 CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
 
     python benchmarks/peer_error.py [--scenes all] [--samples 4000] [--repeats 3] [--look default]
+    python benchmarks/peer_error.py --scenes Mandelbulber2     # its two scenes alone
 """
 from __future__ import annotations
 
@@ -62,12 +74,15 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
+import mb_depth  # noqa: E402
 import peers  # noqa: E402
 import pov_compare  # noqa: E402
 from bench_args import Parser, add_look, size_of  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 
 PRECISIONS = (10, 20, 40, 100)   # POV-Ray's default is 20
+
+PEERS = ("POV-Ray", "Mandelbulber2")
 
 # pyjulia4d's settings: name -> overrides of the imported scene
 SETTINGS = {
@@ -123,6 +138,7 @@ def pov_documentation(w: int, h: int, precision: float) -> str:
 
 SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex,
           "documentation example": pov_documentation}
+ALL = list(SCENES) + list(mb_depth.SCENES)
 LIT = ("matched", "max_iter 20")   # the scenes --look default lights (peers.py's point light)
 LOOK: list[str] = []               # --look default: pyjulia4d's soft shadows and occlusion
 
@@ -246,19 +262,26 @@ def as_good(a: dict, b: dict) -> bool:
 
 
 def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: int, have_pov: bool,
-              tmp: Path) -> tuple[list[str], str]:
+              have_mb: bool, tmp: Path) -> tuple[list[str], str]:
     from pyjulia4d import reference as ref
     from pyjulia4d.geometry.camera import camera_frame
     from pyjulia4d.interop.povray import import_pov
     from pyjulia4d.measure.truth import brute_force_depth
 
-    make = SCENES[name]
-    src = tmp / "scene.pov"
-    src.write_text(make(w, h, 20))
-    imported = import_pov(src, w, h)
     toml = tmp / "scene.toml"
-    toml.write_text(imported.toml)
-    scene = imported.scene
+    if name in mb_depth.SCENES:
+        from pyjulia4d.scene.model import Scene
+
+        scene = Scene.default().with_overrides(peers.MATCHED + mb_depth.SCENES[name] + [f"image.width={w}",
+                                                                                  f"image.height={h}"])
+        toml.write_text(scene.to_toml())
+    else:
+        make = SCENES[name]
+        src = tmp / "scene.pov"
+        src.write_text(make(w, h, 20))
+        imported = import_pov(src, w, h)
+        toml.write_text(imported.toml)
+        scene = imported.scene
     o, d = ref.generate_rays(camera_frame(scene), w, h)
     idx = np.random.default_rng(1).choice(w * h, min(samples, w * h), replace=False)
     truth = brute_force_depth(scene, o[idx], d[idx])
@@ -267,14 +290,20 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
     fin = truth[np.isfinite(truth)]
     lo, hi = (float(fin.min()) - 0.5, float(fin.max()) + 0.5) if fin.size else (0.0, 10.0)
     rows: dict[str, dict] = {}
-    if have_pov:
+    timers = {}   # a peer's row -> its timed run (CPU s)
+    if have_pov and name in SCENES:
         for p in PRECISIONS:
             rows[f"POV-Ray, precision {p}"] = errors(pov_depth(make(w, h, p), w, h, tmp, lo, hi), idx, truth, pixel)
+            timers[f"POV-Ray, precision {p}"] = lambda p=p: pov_time(make(w, h, p), w, h, tmp)
+    if have_mb and name in mb_depth.SCENES:
+        more, overs = mb_depth.peer_rows(name, scene, w, h, idx, tmp, errors)
+        rows.update(more)
+        timers.update({k: (lambda over=over: mb_depth.cpu_seconds(name, w, h, tmp, over)) for k, over in overs.items()})
     times: dict[str, list[float]] = {k: [] for k in list(rows) + list(SETTINGS)}
     device = "?"
     for _ in range(repeats):   # alternate, so the shared machine's load falls on all alike
-        for p in PRECISIONS if have_pov else ():
-            times[f"POV-Ray, precision {p}"].append(pov_time(make(w, h, p), w, h, tmp))
+        for k, timed in timers.items():
+            times[k].append(timed())
         for k, over in SETTINGS.items():
             r = run_pyjulia4d(toml, LOOK + over, tmp / "depth.npy", renders)
             device = r["device"]
@@ -296,13 +325,13 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
         lines.append(f"| {k} | {r['cpu']:.3f} | {r['rate']:.3g} | {share(r['sil'], n)} | {r['p50']:.1e} "
                      f"| {r['p90']:.1e} | {r['p99']:.1e} | {share(r['wrong01'], n)} | {share(r['wrong1'], n)} |")
         print(lines[-1], flush=True)
-    pov_rows = [k for k in rows if k.startswith("POV-Ray")]
-    if pov_rows:
+    peer_rows = [k for k in rows if k.startswith(PEERS)]
+    if peer_rows:
         default = next(iter(SETTINGS))
-        lines += ["", "| POV-Ray row | fastest pyjulia4d setting at least as good | rate / POV-Ray's "
-                  "| pyjulia4d's default: rate / POV-Ray's | its wrong pixels (0.1 px) / POV-Ray's |",
+        lines += ["", "| peer's row | fastest pyjulia4d setting at least as good | rate / the peer's "
+                  "| pyjulia4d's default: rate / the peer's | its wrong pixels (0.1 px) / the peer's |",
                   "|---|---|---|---|---|"]
-        for k in pov_rows:
+        for k in peer_rows:
             good = [s for s in SETTINGS if as_good(rows[s], rows[k])]
             best = max(good, key=lambda s: rows[s]["rate"]) if good else None
             ratio = f"{rows[best]['rate'] / rows[k]['rate']:.2f}" if best else "-"
@@ -316,7 +345,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
 def main(argv=None) -> int:
     ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="640x480")
-    ap.add_argument("--scenes", default="matched", help="comma-separated: " + ", ".join(SCENES)
+    ap.add_argument("--scenes", default="matched", help="comma-separated: " + ", ".join(ALL)
                     + " (substrings), or all")
     ap.add_argument("--samples", type=int, default=4000, help="pixels compared with the truth (1 to 100000)")
     ap.add_argument("--repeats", type=int, default=3, help="alternating timed runs of each row (1 to 50)")
@@ -329,9 +358,10 @@ def main(argv=None) -> int:
         if not 1 <= v <= top:
             ap.error(f"{flag}: expected 1 to {top}, got {v}")
     want = [s.strip() for s in a.scenes.split(",")]
-    names = [n for n in SCENES if "all" in want or any(s and s in n for s in want)]
+    # a scene's whole name picks it alone; a part of one, every scene it is part of
+    names = [n for n in ALL if "all" in want or n in want or any(s and s not in ALL and s in n for s in want)]
     if not names:
-        ap.error(f"--scenes: expected some of {', '.join(SCENES)} or all, got {a.scenes!r}")
+        ap.error(f"--scenes: expected some of {', '.join(ALL)} or all, got {a.scenes!r}")
     if a.look == "default":
         from pyjulia4d.scene.model import Scene
 
@@ -349,11 +379,16 @@ def main(argv=None) -> int:
     have_pov = shutil.which("povray") is not None
     if not have_pov:
         print("povray not installed (Debian: apt-get install povray): POV-Ray skipped", file=sys.stderr)
+    have_mb = shutil.which("mandelbulber2") is not None
+    if not have_mb:
+        print("mandelbulber2 not installed (Debian: apt-get install mandelbulber2): Mandelbulber2 skipped",
+              file=sys.stderr)
     lines, device, plotted = [], "?", {}
     try:
         with tempfile.TemporaryDirectory() as td:
             for n in names:
-                more, device, plotted[n] = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, Path(td))
+                more, device, plotted[n] = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, have_mb,
+                                                     Path(td))
                 lines += more
     finally:   # peers.py's look, and this module's, as they were for the next caller in this process
         peers.LOOK[:] = peers.MATCHED
@@ -390,7 +425,15 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
         ax.axis("off")
     for ax, (name, rows) in zip(axes.ravel(), scenes.items()):
         pov = [(k, r) for k, r in rows.items() if k.startswith("POV-Ray")]
-        ours = [(k, r) for k, r in rows.items() if not k.startswith("POV-Ray")]
+        mb = [(k, r) for k, r in rows.items() if k.startswith("Mandelbulber2")]
+        ours = [(k, r) for k, r in rows.items() if not k.startswith(PEERS)]
+        if mb:
+            ax.plot([r["cpu"] for _, r in mb], [100 * r["wrong01"] for _, r in mb], "^", color="tab:green",
+                    label="Mandelbulber2 2.20 OpenCL, detail levels / threshold 1e-3")
+            for k, r in mb:
+                ax.annotate(k.split(", ", 1)[1].split(" (")[0].replace("detail ", "d").replace("threshold ", ""),
+                            (r["cpu"], 100 * r["wrong01"]), fontsize=6, xytext=(3, -8), textcoords="offset points",
+                            color="tab:green")
         if pov:
             ax.plot([r["cpu"] for _, r in pov], [100 * r["wrong01"] for _, r in pov], "o-", color="tab:red",
                     label="POV-Ray 3.7, precision 10 / 20 / 40 / 100")

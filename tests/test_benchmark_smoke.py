@@ -337,3 +337,34 @@ def test_bad_flags_are_one_line_and_exit_2(script, args, tmp_path):
     lines = p.stderr.strip().splitlines()
     assert p.returncode == 2 and len(lines) == 1 and script in lines[0], p.stderr
     assert "Traceback" not in p.stderr and not list(tmp_path.iterdir())
+
+
+def test_mandelbulber_depth_reads_to_the_mathematics(tmp_path):
+    """Mandelbulber2's depth as benchmarks/mb_depth.py reads it (its log-scaled 16-bit
+    z-buffer, fixed by a near sphere and an empty sphere about the camera) on a third sphere
+    in the set's depth range, against the exact depth where each ray meets that sphere grown
+    by the threshold: within 0.05 of a pixel's footprint at the default threshold and at a
+    constant one - which checks the decoding, the rays through the pixels' corners and the
+    stop rule together.  Its CPU path: the same march as its OpenCL one, without the build."""
+    import shutil
+
+    if shutil.which("mandelbulber2") is None:
+        pytest.skip("mandelbulber2 not installed (Debian: apt-get install mandelbulber2)")
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        mb = load("mb_depth")
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    from pyjulia4d.scene.model import Scene
+
+    w, h = 160, 120
+    scene = Scene.default().with_overrides(mb.peers.MATCHED + [f"image.width={w}", f"image.height={h}"])
+    text = mb.peers.mb_settings(w, h)
+    for kw in ({}, {"threshold": 1e-3}):
+        ro = mb.Readout(scene, w, h, **kw)
+        assert ro.z_min < ro.z_max
+        assert mb.check(ro, text, mb.peers.MB_CPU, tmp_path) < 0.05
+    import numpy as np
+
+    hit = np.isfinite(mb.render_depth(ro, text, mb.peers.MB_CPU, tmp_path))
+    assert 0.2 < hit.mean() < 0.6 and not hit[0, 0]   # the set, and not the reference spheres
