@@ -402,9 +402,14 @@ def main(argv=None) -> int:
                "(see its docstring: the truth, how each depth is read, what is timed).\n",
                head + "\n".join(lines) + "\n")
     print(f"wrote {md}")
-    png = a.out / ("peer_error.png" if a.look == "matched" else "peer_error_default_look.png")
-    write_plot(png, plotted, f"{w}x{h}{look}, {device}, {utc_now()}, commit {git_commit()}")
-    print(f"wrote {png}")
+    # POV-Ray's scenes and Mandelbulber2's each have their own plot, so a run of one leaves the other's
+    stem = "peer_error" if a.look == "matched" else "peer_error_default_look"
+    for suffix, panels in (("", {n: r for n, r in plotted.items() if n not in mb_depth.SCENES}),
+                           ("_mandelbulber2", {n: r for n, r in plotted.items() if n in mb_depth.SCENES})):
+        if panels:
+            png = a.out / f"{stem}{suffix}.png"
+            write_plot(png, panels, f"{w}x{h}{look}, {device}, {utc_now()}, commit {git_commit()}")
+            print(f"wrote {png}")
     return 0
 
 
@@ -428,12 +433,13 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
         mb = [(k, r) for k, r in rows.items() if k.startswith("Mandelbulber2")]
         ours = [(k, r) for k, r in rows.items() if not k.startswith(PEERS)]
         if mb:
-            ax.plot([r["cpu"] for _, r in mb], [100 * r["wrong01"] for _, r in mb], "^", color="tab:green",
-                    label="Mandelbulber2 2.20 OpenCL, detail levels / threshold 1e-3")
-            for k, r in mb:
-                ax.annotate(k.split(", ", 1)[1].split(" (")[0].replace("detail ", "d").replace("threshold ", ""),
-                            (r["cpu"], 100 * r["wrong01"]), fontsize=6, xytext=(3, -8), textcoords="offset points",
-                            color="tab:green")
+            ax.plot([r["cpu"] for _, r in mb], [100 * r["wrong01"] for _, r in mb], "^-", color="tab:green",
+                    ms=5, label="Mandelbulber2 2.20 OpenCL: detail level 0.5 to 4, then thresholds 1e-3 to 1e-5")
+            for k, r in mb:   # its default and the thresholds; the detail levels between crowd together
+                tag = k.split(", ", 1)[1].replace("detail 1 (default)", "default").replace("threshold ", "")
+                if tag not in ("detail 2", "detail 4"):
+                    ax.annotate(tag, (r["cpu"], 100 * r["wrong01"]), fontsize=6, xytext=(4, -2),
+                                textcoords="offset points", color="tab:green")
         if pov:
             ax.plot([r["cpu"] for _, r in pov], [100 * r["wrong01"] for _, r in pov], "o-", color="tab:red",
                     label="POV-Ray 3.7, precision 10 / 20 / 40 / 100")
