@@ -66,6 +66,7 @@ SCENES = {"matched, Mandelbulber2's set": [], "max_iter 20, Mandelbulber2's set"
 T_NEAR = 0.75       # the near sphere's front, as a share of the camera's distance to the ball
 R_NEAR = 1e-3       # its radius, as a share of that distance: a pixel or two on screen
 STOP = 0.9995       # the stop's estimate, as a share of the threshold: the middle of (0.999, 1)
+MIN_HEIGHT = 96     # below, the check sphere covers too few pixels to check anything
 
 
 def mb_rays(scene, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
@@ -213,6 +214,10 @@ def peer_rows(name: str, scene, w: int, h: int, idx: np.ndarray, tmp: Path, erro
     spheres."""
     from pyjulia4d.measure.truth import brute_force_depth
 
+    if h < MIN_HEIGHT:
+        print(f"Mandelbulber2's rows skipped: its depth check needs {MIN_HEIGHT} pixels of height or more, "
+              f"got {h}", file=sys.stderr)
+        return {}, {}
     peers.SCENE_SET[:] = SCENES[name]
     try:
         why = peers.mb_warm(w, h, tmp, peers.MB_OPENCL, True)

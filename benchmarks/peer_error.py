@@ -45,7 +45,8 @@ each renderer runs at several settings, and each setting's error is measured:
   (``benchmarks/mb_depth.py``), against the truth along its own rays, which pass through the
   pixels' corners; its CPU seconds are ``peers.py``'s (the process's, less those of the same
   command at 8x6 pixels), at its default threshold (detail_level 1), finer and coarser ones,
-  and constant thresholds 1e-3 to 1e-5.
+  and constant thresholds 1e-3 to 1e-5 (skipped below 96 pixels of height, where the check
+  has too few pixels to check).
 
 For each peer's row the table names the fastest pyjulia4d row at least as good, and the ratio
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run) and
@@ -390,6 +391,9 @@ def main(argv=None) -> int:
                 more, device, plotted[n] = run_scene(n, w, h, a.samples, a.repeats, a.renders, have_pov, have_mb,
                                                      Path(td))
                 lines += more
+    except RuntimeError as e:   # a peer or a pyjulia4d child failed: one line, nothing written
+        print(f"peer_error.py: {e}", file=sys.stderr)
+        return 1
     finally:   # peers.py's look, and this module's, as they were for the next caller in this process
         peers.LOOK[:] = peers.MATCHED
         LOOK[:] = []
