@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -106,10 +107,15 @@ class Readout:
         self.r_far = gap + 2 * ball + 0.5
         self.z_min, self.z_max = self.stop(self.t_near), self.stop(self.r_far)
 
+    def threshold_at(self, t):
+        """Mandelbulber2's threshold at depth t: t fov / (height detail_level), or the constant."""
+        return t * self.fov / (self.h * self.detail) if self.threshold is None else self.threshold
+
     def stop(self, t: float) -> float:
-        """Where a ray stops on an exact surface it meets head-on at depth t."""
+        """Where a ray stops on an exact surface it meets head-on at depth t: s = t - STOP
+        threshold_at(s), which is linear in s."""
         if self.threshold is None:
-            return t / (1 + STOP * self.fov / (self.h * self.detail))
+            return t / (1 + STOP * self.threshold_at(1.0))
         return t - STOP * self.threshold
 
     def primitives(self, check: tuple[np.ndarray, float] | None = None) -> str:
@@ -194,9 +200,7 @@ def check(readout: Readout, settings: str, over: str, tmp: Path) -> float:
     pixel = readout.fov / readout.h
     tt = -b - np.sqrt(np.maximum(b * b - (oc @ oc - r * r), 0))
     for _ in range(4):   # the grown radius depends on t with the default threshold
-        grow = STOP * (tt * readout.fov / (readout.h * readout.detail) if readout.threshold is None
-                       else readout.threshold)
-        disc = b * b - (oc @ oc - (r + grow) ** 2)
+        disc = b * b - (oc @ oc - (r + STOP * readout.threshold_at(tt)) ** 2)
         tt = -b - np.sqrt(np.maximum(disc, 0))
     on = b * b - oc @ oc > -(2 * r / 3) ** 2   # the ray passes within 2 r / 3 of the centre
     rows = np.abs(depth[on] - tt[on]) / (tt[on] * pixel)
@@ -205,49 +209,47 @@ def check(readout: Readout, settings: str, over: str, tmp: Path) -> float:
     return float(rows.max())
 
 
-def peer_rows(name: str, scene, w: int, h: int, idx: np.ndarray, tmp: Path, errors) -> tuple[dict, dict]:
-    """Mandelbulber2's OpenCL rows of scene ``name``: ({row: its errors}, {row: the --override
-    its timed runs take}), or two empty dicts, with a message, where its OpenCL does not start.
-    Its depth is read through the reference spheres (``render_depth``) once ``check`` has
-    passed to within 0.05 of a pixel, and compared by ``errors`` (peer_error.py's) with the
-    truth along its own rays (``mb_rays``); its timed runs are peers.py's, without the
-    spheres."""
-    from pyjulia4d.measure.truth import brute_force_depth
+@contextmanager
+def scene_set(name: str):
+    """peers.py's --set for scene ``name`` while the block runs (peers.mb_settings reads it)."""
+    peers.SCENE_SET[:] = SCENES[name]
+    try:
+        yield
+    finally:
+        peers.SCENE_SET[:] = []
 
+
+def peer_depths(name: str, scene, w: int, h: int, tmp: Path) -> tuple[dict, dict]:
+    """Mandelbulber2's OpenCL rows of scene ``name``: ({row: its depth (h, w), +inf on a
+    miss}, {row: the --override its timed runs take}), or two empty dicts, with a message,
+    where its OpenCL does not start or the image is too small to check.  Each depth is read
+    through the reference spheres (``render_depth``) once ``check`` has passed to within 0.05
+    of a pixel; it looks along ``mb_rays``.  The timed runs are peers.py's, without the
+    spheres."""
     if h < MIN_HEIGHT:
         print(f"Mandelbulber2's rows skipped: its depth check needs {MIN_HEIGHT} pixels of height or more, "
               f"got {h}", file=sys.stderr)
         return {}, {}
-    peers.SCENE_SET[:] = SCENES[name]
-    try:
+    with scene_set(name):
         why = peers.mb_warm(w, h, tmp, peers.MB_OPENCL, True)
         if why:
             print(f"Mandelbulber2's OpenCL rows skipped: {why}", file=sys.stderr)
             return {}, {}
-        eye, dirs = mb_rays(scene, w, h)
-        n = len(idx)
-        truth = brute_force_depth(scene, np.tile(np.append(eye, 0.0), (n, 1)), np.hstack([dirs[idx], np.zeros((n, 1))]))
-        pixel = np.where(np.isfinite(truth), truth, 0.0) * 2 * math.tan(math.radians(scene.camera.fov) / 2) / h
         settings = peers.mb_settings(w, h)
-        rows, overs = {}, {}
+        depths, overs = {}, {}
         for k, (detail, threshold) in ROWS.items():
             ro = Readout(scene, w, h, detail, threshold)
             off = check(ro, settings, peers.MB_OPENCL, tmp)
             if off > 0.05:
                 raise RuntimeError(f"{k}: the depth readout's check sphere is off by {off:.3f} of a pixel")
-            rows[k] = errors(render_depth(ro, settings, peers.MB_OPENCL, tmp), idx, truth, pixel)
+            depths[k] = render_depth(ro, settings, peers.MB_OPENCL, tmp)
             overs[k] = peers.MB_OPENCL + "#" + ro.threshold_override()
             if peers.mb_warm(w, h, tmp, overs[k], True):
                 raise RuntimeError(f"{k}: Mandelbulber2's OpenCL did not start")
-        return rows, overs
-    finally:
-        peers.SCENE_SET[:] = []
+        return depths, overs
 
 
 def cpu_seconds(name: str, w: int, h: int, tmp: Path, over: str) -> float:
     """Mandelbulber2's CPU seconds for scene ``name`` with ``over`` (peers.run_mandelbulber)."""
-    peers.SCENE_SET[:] = SCENES[name]
-    try:
+    with scene_set(name):
         return peers.run_mandelbulber(w, h, tmp, over)["cpu"]
-    finally:
-        peers.SCENE_SET[:] = []

@@ -50,8 +50,8 @@ each renderer runs at several settings, and each setting's error is measured:
 
 For each peer's row the table names the fastest pyjulia4d row at least as good, and the ratio
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run) and
-peer_error.png (peer_error_default_look.png with ``--look default``): wrong pixels against
-CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
+peer_error.png (peer_error_default_look.png with ``--look default``; Mandelbulber2's scenes in
+peer_error_mandelbulber2.png): wrong pixels against CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
 
     python benchmarks/peer_error.py [--scenes all] [--samples 4000] [--repeats 3] [--look default]
     python benchmarks/peer_error.py --scenes Mandelbulber2     # its two scenes alone
@@ -229,6 +229,12 @@ def pov_depth(text: str, w: int, h: int, tmp: Path, lo: float, hi: float) -> np.
     return np.where(a[..., 3] > 0, lo + v * (hi - lo), np.inf)
 
 
+def footprint(truth: np.ndarray, scene, h: int) -> np.ndarray:
+    """A pixel's footprint at the truth's depth t (0 on a miss): t 2 tan(fov / 2) / height, fov
+    the vertical angle."""
+    return np.where(np.isfinite(truth), truth, 0.0) * 2 * math.tan(math.radians(scene.camera.fov) / 2) / h
+
+
 def errors(depth: np.ndarray, idx: np.ndarray, truth: np.ndarray, pixel: np.ndarray) -> dict:
     """The error of ``depth`` (H, W; inf on a miss) at the flat pixel indices ``idx`` against
     ``truth`` (inf on a miss): the silhouette error (share of pixels whose hit or miss differs),
@@ -286,8 +292,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
     o, d = ref.generate_rays(camera_frame(scene), w, h)
     idx = np.random.default_rng(1).choice(w * h, min(samples, w * h), replace=False)
     truth = brute_force_depth(scene, o[idx], d[idx])
-    # a pixel's footprint at depth t: t 2 tan(fov / 2) / height (fov: the vertical angle)
-    pixel = np.where(np.isfinite(truth), truth, 0.0) * 2 * math.tan(math.radians(scene.camera.fov) / 2) / h
+    pixel = footprint(truth, scene, h)
     fin = truth[np.isfinite(truth)]
     lo, hi = (float(fin.min()) - 0.5, float(fin.max()) + 0.5) if fin.size else (0.0, 10.0)
     rows: dict[str, dict] = {}
@@ -297,8 +302,13 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
             rows[f"POV-Ray, precision {p}"] = errors(pov_depth(make(w, h, p), w, h, tmp, lo, hi), idx, truth, pixel)
             timers[f"POV-Ray, precision {p}"] = lambda p=p: pov_time(make(w, h, p), w, h, tmp)
     if have_mb and name in mb_depth.SCENES:
-        more, overs = mb_depth.peer_rows(name, scene, w, h, idx, tmp, errors)
-        rows.update(more)
+        depths, overs = mb_depth.peer_depths(name, scene, w, h, tmp)
+        if depths:   # its pixels look along their corners: its own truth along its own rays
+            eye, dirs = mb_depth.mb_rays(scene, w, h)
+            n = len(idx)
+            mb_truth = brute_force_depth(scene, np.tile(np.append(eye, 0.0), (n, 1)),
+                                         np.hstack([dirs[idx], np.zeros((n, 1))]))
+            rows.update({k: errors(v, idx, mb_truth, footprint(mb_truth, scene, h)) for k, v in depths.items()})
         timers.update({k: (lambda over=over: mb_depth.cpu_seconds(name, w, h, tmp, over)) for k, over in overs.items()})
     times: dict[str, list[float]] = {k: [] for k in list(rows) + list(SETTINGS)}
     device = "?"

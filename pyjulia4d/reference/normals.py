@@ -11,7 +11,7 @@ from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula
 from pyjulia4d.reference.kind import cubic_locus as _locus
 from pyjulia4d.reference.kind import julia_stack as _stack
 from pyjulia4d.reference.kind import mandelbrot as _mandelbrot
-from pyjulia4d.reference.kind.level import rescale_due
+from pyjulia4d.reference.kind.level import rescale_columns
 
 def to_camera(g, frame: Frame):
     return np.stack([g @ frame.right, g @ frame.up, -(g @ frame.forward)], axis=-1)
@@ -67,10 +67,7 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
             Jl = J[live]
             Jl = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], Jl.shape), Jl)
             q[live] = F.julia_f(ql, c)
-            s2 = np.sum(Jl * Jl, axis=-1).max(axis=-1)   # the largest column's |.|^2
-        big = rescale_due(s2)
-        if big.any():
-            Jl[big] /= np.sqrt(s2[big])[:, None, None]
+        rescale_columns(Jl)
         J[live] = Jl
     if guard is not None:
         guard |= np.where(tiny, GUARD_JACOBIAN_TINY, 0)

@@ -36,3 +36,18 @@ def rescale_pair(A, B, unit, live):
     A[big] /= s
     B[big] /= s
     unit[big] /= s
+
+
+def rescale_columns(J, unit=None):
+    """The live points' Jacobians J (n, 4, 4), and the 1 / scale ``unit`` (n,) they are kept
+    at if given, divided in place by the largest column's length where it is due
+    (normals/jacobian.cl, whose KIND_MANDELBROT build carries unit); the squared lengths are
+    compared before any square root is taken."""
+    with np.errstate(all="ignore"):
+        s2 = np.sum(J * J, axis=-1).max(axis=-1)
+    big = rescale_due(s2)
+    if big.any():
+        s = np.sqrt(s2[big])
+        J[big] /= s[:, None, None]
+        if unit is not None:
+            unit[big] /= s

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.kind.level import kind_level, rescale_due
+from pyjulia4d.reference.kind.level import kind_level, rescale_columns
 
 REAL_MIN = np.finfo(np.float64).tiny
 
@@ -126,14 +126,9 @@ def mandel_normal_jacobian(p, max_iter, bailout, F, guard=None, tiny_flag=0):
             Jl = F.julia_f_jvp(np.broadcast_to(ql[:, None, :], J[live].shape), J[live])
             Jl = Jl + unit[live][:, None, None] * E
             q[live] = mandel_f(F, ql, c[live])
-            s2 = np.sum(Jl * Jl, axis=-1).max(axis=-1)   # the largest column's |.|^2 (normals/jacobian.cl)
-        big = rescale_due(s2)
-        if big.any():
-            s = np.sqrt(s2[big])
-            Jl[big] /= s[:, None, None]
-            ul = unit[live]
-            ul[big] /= s
-            unit[live] = ul
+        ul = unit[live]
+        rescale_columns(Jl, ul)
+        unit[live] = ul
         J[live] = Jl
     if guard is not None:
         guard |= np.where(tiny, tiny_flag, 0)
