@@ -61,8 +61,8 @@ ROWS = {"Mandelbulber2 OpenCL, detail 0.5": (0.5, None),
 # Mandelbulber2 renders pyjulia4d's scene (peers.mb_settings: N and bailout are its max_iter and
 # escape radius), not POV-Ray's (whose import keeps POV-Ray's own iteration count and bailout):
 # these scenes are pyjulia4d's matched scene, with these overrides, and pyjulia4d's rows are
-# rendered again on them
-SCENES = {"matched, Mandelbulber2's set": [], "max_iter 20, Mandelbulber2's set": ["fractal.max_iter=20"]}
+# rendered again on them (no comma in a name: peer_error.py's --scenes is split at commas)
+SCENES = {"matched (Mandelbulber2's set)": [], "max_iter 20 (Mandelbulber2's set)": ["fractal.max_iter=20"]}
 
 T_NEAR = 0.75       # the near sphere's front, as a share of the camera's distance to the ball
 R_NEAR = 1e-3       # its radius, as a share of that distance: a pixel or two on screen

@@ -37,7 +37,7 @@ each renderer runs at several settings, and each setting's error is measured:
   tolerance.  The shares carry their standard error over the draw of pixels.
 
 * Mandelbulber2 (Debian's 2.20, its OpenCL path on PoCL, never a dependency): the scenes
-  ``matched, Mandelbulber2's set`` and ``max_iter 20, Mandelbulber2's set`` are pyjulia4d's
+  ``matched (Mandelbulber2's set)`` and ``max_iter 20 (Mandelbulber2's set)`` are pyjulia4d's
   matched scene as ``peers.py`` writes it for Mandelbulber2 (12 or 20 iterations, escape
   radius 4: POV-Ray's import keeps POV-Ray's own count and bailout, a different truncated
   set), and pyjulia4d's settings are rendered again on them.  Its depth is read from its
