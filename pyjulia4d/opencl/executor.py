@@ -160,7 +160,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
                 guard = guard | nw.astype(np.int32)
         add_counts(guards, count_guards(st, got["depth"][own], guard))
         if "color" in keep:
-            img["color"][dst] = got["rgba"][own][..., :3]
+            copy_xyz(img["color"][dst], got["rgba"][own])
         if "alpha" in keep:
             img["alpha"][dst] = got["rgba"][own][..., 3] if "rgba" in got else (st == STATUS_HIT)
         for k, src in (("depth", "depth"), ("bracket", "bracket"), ("unresolved", "unresolved"), ("status", "status"),
@@ -168,7 +168,7 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
             if k in keep:
                 img[k][dst] = got[src][own]
         if "normal" in keep:
-            img["normal"][dst] = got["normal"][own][..., :3]
+            copy_xyz(img["normal"][dst], got["normal"][own])
         if "position" in keep:
             img["position"][dst] = got["point"][own]
         if t.x0 + t.w == rx + W:   # the last tile of its row (make_tiles: row by row)
@@ -257,6 +257,14 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
     return result
 
 
+def copy_xyz(dst: np.ndarray, src: np.ndarray) -> None:
+    """dst[..., k] = src[..., k] for k < 3: a tile's (h, w, 4) colour or normal into the
+    image's (h, w, 3), one channel at a time (numpy's copy of a [..., :3] slice as one
+    strided block took 4.5x as long: 1.15 against 0.26 ms for 512x480 pixels)."""
+    for k in range(3):
+        dst[..., k] = src[..., k]
+
+
 def _centre_values(got: dict[str, np.ndarray], own, shaded: bool):
     """A tile's centre colour (None where the plan does not shade) and alpha over its own
     pixels, as the render keeps them (``file``): what antialias.flag_edges compares."""
@@ -289,5 +297,8 @@ def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -
     t, slot, kernels, copies = pending
     cl.wait_for_events([e for e in copies])
     kernel_events.extend(kernels)
-    file(t, runner.collect(t, slot))
+    try:
+        file(t, runner.collect(t, slot))
+    finally:
+        runner.release(slot)
     bar.update(t.w * t.h)
