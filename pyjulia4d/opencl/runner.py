@@ -8,6 +8,8 @@ is the one place a kernel is enqueued.
 """
 from __future__ import annotations
 
+from collections import OrderedDict
+
 import numpy as np
 import pyopencl as cl
 import pyopencl.array as cla
@@ -86,12 +88,42 @@ def march_items(n: int, tile_w: int, lanes: int, packets: int = 1) -> int:
     return -(-blocks_x // packets) * -(-(n // tile_w) // bh)
 
 
+# Kernels whose scalar arguments' types pyopencl knows (set_scalar_arg_dtypes): it then packs
+# them itself, where its generic path took 7-10 us an argument (0.46 ms a 640x480 tile's
+# four launches on Intel's runtime, before the first kernel could start; 0.03 ms typed).
+# Keyed by handle, holding the kernel so that no other takes its address; the oldest let go.
+_typed: "OrderedDict[int, cl.Kernel]" = OrderedDict()
+TYPED_KEEP = 256
+
+
+def type_arguments(kernel: cl.Kernel, args: tuple) -> None:
+    """Tell pyopencl the types of ``kernel``'s arguments, from a first call's ``args`` (numpy
+    scalars and vectors, buffers, None), once per kernel: 0.25 ms, repaid by its second launch."""
+    key = kernel.int_ptr
+    if _typed.get(key) is kernel:
+        return
+    types = []
+    for a in args:
+        if a is None or isinstance(a, cl.MemoryObjectHolder):
+            types.append(None)
+        elif isinstance(a, (np.generic, np.ndarray)):
+            types.append(a.dtype)
+        else:   # a Python number would be packed at a guessed width
+            raise TypeError(f"kernel {kernel.function_name}: argument of type {type(a).__name__}; "
+                            "pass a numpy scalar or a buffer")
+    kernel.set_scalar_arg_dtypes(types)
+    _typed[key] = kernel
+    while len(_typed) > TYPED_KEEP:
+        _typed.popitem(last=False)
+
+
 def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
            items: int | None = None) -> cl.Event | None:
     """Enqueue ``kernel`` over n items, ``lanes`` per work-item (packets of rays) or
     ``items`` work-items: n_items = n first, then ``args``.  Returns the launch's event."""
     if n <= 0:
         return None
+    type_arguments(kernel, (np.int32(n),) + args)
     loc = local_size(kernel, queue.device)
     items = -(-n // lanes) if items is None else items
     return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
