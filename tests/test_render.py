@@ -117,6 +117,47 @@ def test_tiles_give_the_same_image(normals):
     assert tiled.guards == whole.guards
 
 
+@pytest.mark.parametrize("ahead", [False, True])
+def test_tiles_queued_ahead_or_not_give_the_same_image(monkeypatch, ahead):
+    # executor._run_tiles: a CPU device has the next tile queued once the last one is done,
+    # a GPU before the host waits for it; either order gives the same pixels, filed from
+    # buffers mapped while the next tile's kernels write the other slot's
+    from pyjulia4d.opencl import executor
+
+    s = Scene.default().with_overrides(["image.width=53", "image.height=41", "image.samples=2"])
+    want = render(s, tile=512)
+    monkeypatch.setattr(executor, "queue_ahead", lambda dev: ahead)
+    got = render(s, tile=16)
+    for k in ("depth", "bracket", "status", "samples", "normal", "position", "color", "alpha"):
+        np.testing.assert_array_equal(getattr(got, k), getattr(want, k), err_msg=k)
+    assert got.guards == want.guards and got.counts == want.counts
+
+
+def test_kernel_arguments_are_typed_once_and_checked():
+    # runner.launch tells pyopencl each kernel's argument types on its first launch; a
+    # Python number (whose width would be guessed) is refused by name
+    from harness import device
+    from pyjulia4d.opencl import build
+    from pyjulia4d.opencl.runner import constant, launch, queue_for, type_arguments
+
+    ctx, q = queue_for(device())
+    src = ("__kernel void twice(const int n, const float a, __global float *out)"
+           " { size_t i = get_global_id(0); if (i < (size_t)n) out[i] = 2 * a; }")
+    k = build.kernel(cl.Program(ctx, src).build(), "twice")
+    out = cl.Buffer(ctx, cl.mem_flags.WRITE_ONLY, 4 * 8)
+    launch(q, k, 8, np.float32(1.5), out).wait()
+    launch(q, k, 8, np.float32(2.5), out).wait()
+    got = np.empty(8, np.float32)
+    cl.enqueue_copy(q, got, out)
+    assert np.all(got == 5)
+    with pytest.raises(TypeError, match="twice: argument of type float"):
+        type_arguments(cl.Kernel(cl.Program(ctx, src).build(), "twice"), (np.int32(8), 2.5, out))
+    a = constant(q, np.arange(4, dtype=np.float32))
+    assert constant(q, np.arange(4, dtype=np.float32)) is a
+    assert constant(q, np.arange(4, dtype=np.float64)) is not a
+    assert np.array_equal(a.get(), np.arange(4))
+
+
 def test_image_too_large_for_memory_refused_before_rendering():
     from pyjulia4d.pipeline import workload
     from pyjulia4d.scene.checks import SceneError

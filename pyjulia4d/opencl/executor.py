@@ -278,6 +278,12 @@ def _render_line(n: int, total: int, spent: float, left: float, note: str) -> st
     return f"render: {100 * n / total:.0f}% of {total} pixels, {spent:.0f} s, about {left:.0f} s left"
 
 
+def queue_ahead(dev: cl.Device) -> bool:
+    """Whether a tile's kernels are queued before the host waits for the tile before
+    (``_run_tiles``): on any device but a CPU."""
+    return not dev.type & cl.device_type.CPU
+
+
 def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample: int = 0,
                samples: int = 1) -> None:
     """Every tile through ``runner`` in two slots: tile i + 1's kernels run while tile i is
@@ -286,7 +292,7 @@ def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample
     done: Intel's CPU runtime runs queued kernels in the thread that waits for an event
     until its queue is empty, so with a tile queued ahead every tile was filed after the
     last kernel, the other core idle (a 640x480 render's last 3-4 ms of 30)."""
-    ahead = not runner.queue.device.type & cl.device_type.CPU
+    ahead = queue_ahead(runner.queue.device)
     pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
     for i, t in enumerate(tiles):
         slot = i % TileRunner.SLOTS
