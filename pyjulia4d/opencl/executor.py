@@ -1,8 +1,9 @@
 """Execute a render plan (plan.py): per tile, march -> normals -> shade, then assemble.
 
 Every per-pixel step is an OpenCL kernel (the march makes its own rays); Python only
-enqueues tiles and copies back the outputs the plan keeps.  Two tiles are in flight: the
-kernels of one run while the host files the other, with no finish() between them.
+enqueues tiles and files the outputs the plan keeps from their mapped buffers.  Two tiles are
+in flight: the kernels of one run while the host files the other, with no finish() between
+them (``_run_tiles``: on a CPU device the next tile is queued once the last one is done).
 ``reference.render`` is the float64 numpy twin of this module's ``render``.
 """
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Tile buffers kept between a process's renders.
 
-A render's tile runner holds two slots of device buffers and host staging arrays (about 150
-bytes a pixel of a 512 x 512 tile: 40 MB), and a CPU device's buffers are host memory too.
+A render's tile runner holds two slots of device buffers (about 100 bytes a pixel of a
+512 x 512 tile; the host reads them through maps), and a CPU device's buffers are host memory.
 Made afresh for every render, their pages were faulted in and zeroed by the kernel each time:
 a quarter of the CPU time of a warm 640x480 render on Intel's runtime (perf, cpu-clock
 samples in the kernel's page-fault and page-clearing code).  The explorer, animations and

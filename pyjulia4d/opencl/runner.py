@@ -3,7 +3,7 @@
 ``TileRunner`` holds a plan's programs, its argument records cast to the device's precision
 (pipeline/plan.py) and two slots of tile buffers (opencl/pool.py keeps them between renders);
 ``enqueue`` queues one tile's kernels - the march (rays made in the kernel), normals, light
-terms and shading, the mirror bounce - and the copies back of what the plan keeps.  ``launch``
+terms and shading, the mirror bounce - and the maps of what the plan reads back.  ``launch``
 is the one place a kernel is enqueued.
 """
 from __future__ import annotations
@@ -187,8 +187,8 @@ _READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket
 
 
 class TileRunner:
-    """The kernels of one plan on one device, with two slots of tile buffers (device and
-    host staging) so that one tile's kernels run while the previous one is filed."""
+    """The kernels of one plan on one device, with two slots of tile buffers (and the host's
+    maps of them) so that one tile's kernels run while the previous one is filed."""
 
     SLOTS = 2
 
@@ -311,8 +311,8 @@ class TileRunner:
     def enqueue(self, tile: Tile, slot: int, sample: int = 0, samples: int = 1
                 ) -> tuple[list[cl.Event], list[cl.Event]]:
         """Queue the tile's kernels - rays through sample ``sample`` of ``samples`` of each
-        pixel (rays.cl; one: the centre) - and the copies of what is read back into ``slot``:
-        (kernel events, copy events); nothing waits."""
+        pixel (rays.cl; one: the centre) - and the maps of what is read back from ``slot``:
+        (kernel events, map events); nothing waits."""
         plan, pr, q = self.plan, self.pr, self.queue
         bufs, maps = self.slots[slot]
         n = tile.n
