@@ -6,15 +6,45 @@
  * its rays with camera_ray (nothing per pixel on the device but the outputs); the
  * generate_rays kernel writes them out for the tests and benchmarks. */
 
+/* camera_ray_at's (u, v) of the point (x + ox, y + oy) of the image plane: the direction is
+ * forward + u right + v up, normalised. */
+inline void camera_uv(int x, int y, real ox, real oy, real tan_half_fov, int width, int height, real *u, real *v)
+{
+    real aspect = (real)width / (real)height;
+    *u = ((real)2 * ((real)x + ox) / (real)width - (real)1) * tan_half_fov * aspect;
+    *v = ((real)1 - (real)2 * ((real)y + oy) / (real)height) * tan_half_fov;
+}
+
+/* The direction forward + u right + v up over its length (|u|, |v| <= tan(fov / 2) aspect keep
+ * the squares far from overflow), written out so that a packet's lanes (camera_dirs) make
+ * each ray as one ray per work-item does, operation for operation. */
+#define CAMERA_DIR(T, u, v, forward, right, up, x, y, z, w) \
+    T x = forward.x + u * right.x + v * up.x, y = forward.y + u * right.y + v * up.y; \
+    T z = forward.z + u * right.z + v * up.z, w = forward.w + u * right.w + v * up.w; \
+    T l_ = sqrt(x * x + y * y + z * z + w * w)
+
+inline real4 camera_dir(real u, real v, real4 forward, real4 right, real4 up)
+{
+    CAMERA_DIR(real, u, v, forward, right, up, x, y, z, w);
+    return (real4)(x / l_, y / l_, z / l_, w / l_);
+}
+
+/* camera_dir in a packet's lanes, from each lane's (u, v) (camera_uv); one normalize a lane
+ * had cost a sixth of a march whose rays all missed the ball */
+inline quat camera_dirs(lreal u, lreal v, real4 forward, real4 right, real4 up)
+{
+    CAMERA_DIR(lreal, u, v, forward, right, up, x, y, z, w);
+    return QUAT(x / l_, y / l_, z / l_, w / l_);
+}
+
 /* The ray through the point (x + ox, y + oy) of the image plane, (ox, oy) in [0, 1)^2 the
  * sample's place in the pixel (0.5, 0.5: its centre). */
 inline real4 camera_ray_at(int x, int y, real ox, real oy, real4 forward, real4 right, real4 up,
                            real tan_half_fov, int width, int height)
 {
-    real aspect = (real)width / (real)height;
-    real u = ((real)2 * ((real)x + ox) / (real)width - (real)1) * tan_half_fov * aspect;
-    real v = ((real)1 - (real)2 * ((real)y + oy) / (real)height) * tan_half_fov;
-    return normalize(forward + u * right + v * up);
+    real u, v;
+    camera_uv(x, y, ox, oy, tan_half_fov, width, height, &u, &v);
+    return camera_dir(u, v, forward, right, up);
 }
 
 inline real4 camera_ray(int x, int y, real4 forward, real4 right, real4 up, real tan_half_fov,

@@ -41,13 +41,14 @@ PACKET_KERNEL void cone_starts(const int n_items, const int blocks_w, const int 
                           forward, right, up, tan_half_fov, image_w, image_h);
     }
 #else
+    lreal u, v;
     for (int j = 0; j < LANES; ++j) {   /* gather; a lane past the end repeats block i0 */
         size_t i = i0 + j < (size_t)n_items ? i0 + j : i0;
         int bx = bx0 + (int)(i % (size_t)blocks_w), by = by0 + (int)(i / (size_t)blocks_w);
-        real4 dk = camera_ray_at(bx * CONE_BLOCK, by * CONE_BLOCK, (real)(CONE_BLOCK / 2), (real)(CONE_BLOCK / 2),
-                                 forward, right, up, tan_half_fov, image_w, image_h);
-        ((real *)&d.x)[j] = dk.x; ((real *)&d.y)[j] = dk.y; ((real *)&d.z)[j] = dk.z; ((real *)&d.w)[j] = dk.w;
+        camera_uv(bx * CONE_BLOCK, by * CONE_BLOCK, (real)(CONE_BLOCK / 2), (real)(CONE_BLOCK / 2), tan_half_fov,
+                  image_w, image_h, &((real *)&u)[j], &((real *)&v)[j]);
     }
+    d = camera_dirs(u, v, forward, right, up);   /* as the march's packets make theirs */
 #endif
     lreal t, far;   /* the ray's entry and exit of the bounding ball, as march/march.cl takes them */
     lmask active = ball_span(o, d, radius, near_set, far_set, &t, &far) & (far >= t);

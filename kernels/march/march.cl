@@ -25,6 +25,14 @@
         ok = eye; \
         dk = camera_ray_at(px_, py_, ox_, oy_, forward, right, up, tan_half_fov, image_w, image_h); \
     } while (0)
+/* a lane's (u, v) on the image plane (rays.cl camera_uv); the packet's directions are then
+ * made in its lanes (rays.cl camera_dirs) */
+#define RAY_UV(i, u, v) do { \
+        int px_ = x0 + (int)((i) % (size_t)tile_w), py_ = y0 + (int)((i) / (size_t)tile_w); \
+        real ox_, oy_; \
+        sample_offset(px_, py_, pixel_sample, pixel_samples, &ox_, &oy_); \
+        camera_uv(px_, py_, ox_, oy_, tan_half_fov, image_w, image_h, &u, &v); \
+    } while (0)
 #endif
 
 /* -D CLIP: up to 4 half-spaces clip_n[k] . p <= clip_off[k] cut the set open (scene.Clip):
@@ -90,7 +98,7 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
 #if LANES == 1
         RAY_AT(i0, o[p], d[p]);
         valid = 1;
-#else
+#elif defined(RAYS_FROM_BUFFERS)
         for (int k = 0; k < LANES; ++k) {  /* gather into structure-of-arrays lanes */
             size_t i = lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0;
             real4 ok, dk;
@@ -101,6 +109,15 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
             ((real *)&d[p].z)[k] = dk.z; ((real *)&d[p].w)[k] = dk.w;
             ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
         }
+#else
+        lreal u, v;
+        for (int k = 0; k < LANES; ++k) {  /* each lane's place on the image plane */
+            size_t i = lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0;
+            RAY_UV(i, ((real *)&u)[k], ((real *)&v)[k]);
+            ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
+        }
+        o[p] = QUAT((lreal)eye.x, (lreal)eye.y, (lreal)eye.z, (lreal)eye.w);
+        d[p] = camera_dirs(u, v, forward, right, up);
 #endif
         live[p] = valid & ball_span(o[p], d[p], radius, near_set, far_set, &near[p], &far[p]);
 #ifdef CLIP

@@ -205,8 +205,9 @@ def _build() -> list[Case]:
              "depth within 1e-5 of float64 (median one ulp); the hit is the max_iter-"
              "truncated surface itself, rough at max_iter 100 (normals speckled, as in a "
              "float64 fixed scan); the first crossing of that rough surface differs from "
-             "float64's on ~6 % of rays",
-             0.08, 1e-5, "", small, fixed_depth_tol=1e-3),
+             "float64's on ~4 % of rays (3.5-3.7 % of 3085 at 96x72; 6-8 % of the 49 both hit "
+             "at the checked 12x9, where one ray is 2 %)",
+             0.1, 1e-5, "", small, fixed_depth_tol=1e-3),
         Case("z_resolution_1", ("march.z_resolution=1",),
              "z_resolution 1: only the near and far samples",
              "fixed: almost nothing hit (first sample inside only); de unaffected",
