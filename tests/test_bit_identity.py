@@ -8,7 +8,9 @@ estimate's over-relaxed steps, march/de.cl; c78ebbb: the cone starts of its came
 march/cone.cl; 34a8817: complex.cl's own hypot, whose last-bit differences moved the depth of
 hypercomplex pwr by at most 5e-6, no pixel's status; f7640c5: dot products written out in the
 kernels of one pixel per work-item, which moved colours by at most 6e-5 and the gradient and
-z-buffer normals by at most 3.4e-5, no depth), and the commit message says so.
+z-buffer normals by at most 3.4e-5, no depth; 9864e24: the camera rays' directions written
+out, the same in a packet's lanes as one ray per work-item, which moved their last bits),
+and the commit message says so.
 
 Skipped where git or BASE is not at hand (an installed package, a shallow clone)."""
 from __future__ import annotations
@@ -24,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BASE = "f7640c53d3237226fe067ea4ed31377dcd84b0a8"
+BASE = "9864e2436cfdb13a7f9f2e5b624f123a69862266"
 ROOT = Path(__file__).resolve().parent.parent
 
 SCENES = {
