@@ -94,6 +94,7 @@ def march_items(n: int, tile_w: int, lanes: int, packets: int = 1) -> int:
 # four launches on Intel's runtime, before the first kernel could start; 0.03 ms typed).
 # Keyed by handle, holding the kernel so that no other takes its address; the oldest let go.
 _typed: "OrderedDict[int, cl.Kernel]" = OrderedDict()
+_kept_lock = threading.Lock()   # _typed and _constants (below) are shared by renders in threads
 TYPED_KEEP = 256
 
 
@@ -113,9 +114,10 @@ def type_arguments(kernel: cl.Kernel, args: tuple) -> None:
             raise TypeError(f"kernel {kernel.function_name}: argument of type {type(a).__name__}; "
                             "pass a numpy scalar or a buffer")
     kernel.set_scalar_arg_dtypes(types)
-    _typed[key] = kernel
-    while len(_typed) > TYPED_KEEP:
-        _typed.popitem(last=False)
+    with _kept_lock:
+        _typed[key] = kernel
+        while len(_typed) > TYPED_KEEP:
+            _typed.popitem(last=False)
 
 
 def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int = 1,
@@ -156,7 +158,6 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
 # Small read-only arrays the kernels take (colour map, lights), kept by context and content:
 # each upload waited for its copy, 0.09 ms a buffer, three a render before its first kernel.
 _constants: "OrderedDict[tuple, cla.Array]" = OrderedDict()
-_constants_lock = threading.Lock()
 CONSTANTS_KEEP = 32
 
 
@@ -164,13 +165,13 @@ def constant(queue: cl.CommandQueue, ary: np.ndarray) -> cla.Array:
     """``ary`` on ``queue``'s device, uploaded once per context and content; the kernels only
     read it."""
     key = (queue.context.int_ptr, ary.dtype.str, ary.shape, ary.tobytes())
-    with _constants_lock:
+    with _kept_lock:
         got = _constants.get(key)
         if got is not None:
             _constants.move_to_end(key)
             return got
     got = cla.to_device(queue, ary)
-    with _constants_lock:
+    with _kept_lock:
         _constants[key] = got
         while len(_constants) > CONSTANTS_KEEP:
             _constants.popitem(last=False)
