@@ -18,20 +18,19 @@
 #define RAY_ARGS const real4 eye, const real4 forward, const real4 right, const real4 up, \
                  const real tan_half_fov, const int image_w, const int image_h, const int x0, const int y0, \
                  const int pixel_sample, const int pixel_samples
-#define RAY_AT(i, ok, dk) do { \
-        int px_ = x0 + (int)((i) % (size_t)tile_w), py_ = y0 + (int)((i) / (size_t)tile_w); \
-        real ox_, oy_; \
-        sample_offset(px_, py_, pixel_sample, pixel_samples, &ox_, &oy_); \
-        ok = eye; \
-        dk = camera_ray_at(px_, py_, ox_, oy_, forward, right, up, tan_half_fov, image_w, image_h); \
-    } while (0)
-/* a lane's (u, v) on the image plane (rays.cl camera_uv); the packet's directions are then
- * made in its lanes (rays.cl camera_dirs) */
+/* pixel i's (u, v) on the image plane (rays.cl camera_uv); a packet makes its directions from
+ * its lanes' in its lanes (rays.cl camera_dirs), one ray per work-item its own (camera_dir) */
 #define RAY_UV(i, u, v) do { \
         int px_ = x0 + (int)((i) % (size_t)tile_w), py_ = y0 + (int)((i) / (size_t)tile_w); \
         real ox_, oy_; \
         sample_offset(px_, py_, pixel_sample, pixel_samples, &ox_, &oy_); \
         camera_uv(px_, py_, ox_, oy_, tan_half_fov, image_w, image_h, &u, &v); \
+    } while (0)
+#define RAY_AT(i, ok, dk) do { \
+        real u_, v_; \
+        RAY_UV(i, u_, v_); \
+        ok = eye; \
+        dk = camera_dir(u_, v_, forward, right, up); \
     } while (0)
 #endif
 

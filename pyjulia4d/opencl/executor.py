@@ -294,23 +294,23 @@ def _run_tiles(runner: TileRunner, tiles, file, kernel_events: list, bar, sample
     until its queue is empty, so with a tile queued ahead every tile was filed after the
     last kernel, the other core idle (a 640x480 render's last 3-4 ms of 30)."""
     ahead = queue_ahead(runner.queue.device)
-    pending = None   # (tile, slot, kernel events, copy events) queued, not yet filed
+    pending = None   # (tile, slot, kernel events, map events) queued, not yet filed
     for i, t in enumerate(tiles):
         slot = i % TileRunner.SLOTS
         if pending is not None and not ahead:
             cl.wait_for_events(pending[3])
-        kernels, copies = runner.enqueue(t, slot, sample, samples)
+        kernels, mapped = runner.enqueue(t, slot, sample, samples)
         runner.queue.flush()   # running while the host files the tile before
         if pending is not None:
             _file_pending(runner, pending, file, kernel_events, bar)
-        pending = (t, slot, kernels, copies)
+        pending = (t, slot, kernels, mapped)
     if pending is not None:
         _file_pending(runner, pending, file, kernel_events, bar)
 
 
 def _file_pending(runner: TileRunner, pending, file, kernel_events: list, bar) -> None:
-    t, slot, kernels, copies = pending
-    cl.wait_for_events([e for e in copies])
+    t, slot, kernels, mapped = pending
+    cl.wait_for_events(mapped)
     kernel_events.extend(kernels)
     try:
         file(t, runner.collect(t, slot))

@@ -355,15 +355,15 @@ class TileRunner:
                                   self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
                                   vis_extra.data, refl.data, np.float32(plan.shade.reflection),
                                   bufs["rgba"].data))
-        # read back by mapping: no copy on a CPU device (0.1-0.5 ms a buffer of 512x480 pixels
-        # on Intel's runtime, in line between this tile's kernels and the next's)
-        self.release(slot)
-        copies = []
+        # read back by mapping (the slot's last maps were let go once its tile was filed): no
+        # copy on a CPU device, where copies took 0.1-0.5 ms a buffer of 512x480 pixels on
+        # Intel's runtime, in line between this tile's kernels and the next's
+        mapped = []
         for k in self.read:
             maps[k], ev = cl.enqueue_map_buffer(q, bufs[k].data, cl.map_flags.READ, 0, (n,), bufs[k].dtype,
                                                 is_blocking=False)
-            copies.append(ev)
-        return kernels, copies
+            mapped.append(ev)
+        return kernels, mapped
 
     def enqueue_reflection(self, tile: Tile, bufs: dict) -> list:
         """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
