@@ -14,8 +14,13 @@ OpenCL runtime, framing, the tiny render and the write), 640x480 PNG, and 3840x2
   user's setting, which the command leaves alone, so every runtime is loaded as before) and
   OpenBLAS at one thread per core.
 
-Reports medians and the ratio of each case to its "every runtime" twin; writes
-benchmarks/results/command_cost.md (a section per run: device, date, commit).
+Reports medians and the ratio of each case to its "every runtime" twin.  Then the start-up's
+floor: what the command cannot avoid before its first kernel, as children that stop at each
+stage (OpenBLAS at one thread, as the command runs; cumulative CPU-s, medians of the same
+repeats): Python alone; numpy and pyopencl imported; the render's own modules imported; the
+default device's runtime loaded and its context made (the device remembered, so that
+runtime alone, as the command loads it).  Writes benchmarks/results/command_cost.md (a
+section per run: device, date, commit).
 
     python benchmarks/command_cost.py [--repeats 5] [--big 3840x2160] [--no-big]
 """
@@ -37,10 +42,22 @@ from run_log import append_run, git_commit, utc_now  # noqa: E402
 from bench_args import Parser, size_of  # noqa: E402
 
 
+# The start-up's floor, stage by stage: each a child that stops there (cumulative)
+_MODULES = "import pyjulia4d.__main__\nfrom pyjulia4d.app import cli, output\nfrom pyjulia4d.opencl import executor\n"
+FLOOR = [("Python alone", "pass"),
+         ("numpy and pyopencl imported", "import numpy, pyopencl"),
+         ("the render's own modules imported", _MODULES),
+         ("the default device's runtime loaded, its context made",
+          _MODULES + "from pyjulia4d.opencl import default_device\nfrom pyjulia4d.opencl.runner import queue_for\n"
+                     "default_device.allow()\nqueue_for(cli.select_device(None))\n")]
+
+
 def run(args: list[str], env: dict[str, str], cwd: str) -> dict:
-    """One command: CPU-s (user + system), wall s, peak MiB; raises if it fails."""
+    """One command (``python -m pyjulia4d ARGS``, or ``python -c CODE`` where args is ["-c",
+    CODE]): CPU-s (user + system), wall s, peak MiB; raises if it fails."""
     t = time.perf_counter()
-    p = subprocess.Popen([sys.executable, "-m", "pyjulia4d", *args], cwd=cwd, env=env,
+    head = [] if args[:1] == ["-c"] else ["-m", "pyjulia4d"]
+    p = subprocess.Popen([sys.executable, *head, *args], cwd=cwd, env=env,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     _, status, ru = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t
@@ -74,6 +91,7 @@ def main(argv=None) -> int:
     every = dict(base, OCL_ICD_VENDORS=runtimes.registered["folder"] or runtimes.SYSTEM_VENDORS,
                  OPENBLAS_NUM_THREADS=str(os.cpu_count() or 1))
     modes = [("as run", base), ("every runtime", every)]
+    floor_env = dict(base, OPENBLAS_NUM_THREADS="1")   # as __main__.py sets it for the command
     got: dict[tuple[str, str], list[dict]] = {}
     device = "?"
     with tempfile.TemporaryDirectory() as tmp:
@@ -87,6 +105,8 @@ def main(argv=None) -> int:
                     r = run(["render", *args], env, tmp)
                     got.setdefault((name, mode), []).append(r)
                     device = r["line"].split(" on ", 1)[-1].split(" (", 1)[0]
+            for name, code in FLOOR:
+                got.setdefault((name, "floor"), []).append(run(["-c", code], floor_env, tmp))
     rows = ["| case | CPU-s | wall s | peak MiB | CPU-s, every runtime | peak MiB, every runtime | CPU ratio | "
             "memory ratio |", "|---|---|---|---|---|---|---|---|"]
     for name, _ in cases:
@@ -95,6 +115,16 @@ def main(argv=None) -> int:
         s, e = m["as run"], m["every runtime"]
         rows.append(f"| {name} | {s['cpu']:.3f} | {s['wall']:.3f} | {s['mib']:.0f} | {e['cpu']:.3f} | "
                     f"{e['mib']:.0f} | {s['cpu'] / e['cpu']:.2f} | {s['mib'] / e['mib']:.2f} |")
+    start = statistics.median(r["cpu"] for r in got[cases[0][0], "as run"])
+    rows += ["", f"The start-up's floor (cumulative, against the start-up's {start:.3f} CPU-s):", "",
+             "| stage | CPU-s | this stage | share of the start-up |", "|---|---|---|---|"]
+    before = 0.0
+    for name, _ in FLOOR:
+        cpu = statistics.median(r["cpu"] for r in got[name, "floor"])
+        rows.append(f"| {name} | {cpu:.3f} | {cpu - before:+.3f} | {cpu / start:.0%} |")
+        before = cpu
+    rows.append(f"| the rest: programs from the disk cache, framing, the render, the PNG | {start:.3f} | "
+                f"{start - before:+.3f} | 100% |")
     table = "\n".join(rows)
     print(table)
     section = (f"\n## {utc_now()}, {device}, commit {git_commit()}, median of {a.repeats} alternating runs\n\n"
