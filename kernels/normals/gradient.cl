@@ -23,12 +23,8 @@ __kernel void normals_gradient(const int n_items, __global const real4 *point, _
                                const real4 forward, __global real4 *normal)
 {
     size_t i = get_global_id(0);
-    if (i >= (size_t)n_items)
-        return;
-    if (status[i] != STATUS_HIT) {
-        normal[i] = (real4)(0);
-        return;
-    }
+    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
+    HITS_ONLY(i, n_items, hit, normal[i] = (real4)(0));
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 n = normal_gradient(point[i], jp, h, right, up, forward);
     real l = sqrt(DOT4(n, n));   /* not length(): common/lanes.cl DOT3 */

@@ -119,19 +119,17 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
                                __global real4 *normal)
 {
     size_t i0 = get_global_id(0) * LANES;
-    if (i0 >= (size_t)n_items)
-        return;
     julia_params jp = { c, bailout * bailout, 0, max_iter };
 #if LANES == 1
-    if (status[i0] != STATUS_HIT) {
-        normal[i0] = (real4)(0);
-        return;
-    }
+    int hit = i0 < (size_t)n_items && status[i0] == STATUS_HIT;
+    HITS_ONLY(i0, n_items, hit, normal[i0] = (real4)(0));
     int guard = 0;
     real nx, ny, nz;
     to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
     normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (common/codes.cl) */
 #else
+    if (i0 >= (size_t)n_items)
+        return;
     quat p;
     int any_hit = 0;
     for (int k = 0; k < LANES; ++k) {  /* gather; a miss or a lane past the end takes point 0 */

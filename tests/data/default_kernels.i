@@ -397,13 +397,9 @@ const real4 right, const real4 up, const real4 forward,
 __global real4 *normal)
 {
 size_t i0 = get_global_id(0) * 1;
-if (i0 >= (size_t)n_items)
-return;
 julia_params jp = { c, bailout * bailout, 0, max_iter };
-if (status[i0] != 1) {
-normal[i0] = (real4)(0);
-return;
-}
+int hit = i0 < (size_t)n_items && status[i0] == 1;
+do { if (!(hit)) { if ((i0) < (size_t)(n_items)) normal[i0] = (real4)(0); return; } if ((i0) >= (size_t)(n_items)) return; if (!(hit)) { normal[i0] = (real4)(0); return; } } while (0);
 int guard = 0;
 real nx, ny, nz;
 to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
