@@ -47,6 +47,8 @@ SCENES = {
     "w_colour_adaptive": ["shading.coloring=w", "image.samples=3", "image.adaptive=true", "shading.light=eye"],
     "mandelbrot": ["fractal.kind=mandelbrot", "camera.position=1.8,1.6,-3.2"],
     "rotated": ["fractal.theta=40"],
+    # one pixel per work-item throughout: the light terms' and the Jacobian's one-ray kernels
+    "one_ray": ["render.variant=scalar", "shading.reflection=0.2"],
     "stack": ["fractal.kind=julia_stack", "fractal.max_iter=20"],
     "locus": ["fractal.kind=cubic_locus", "march.z_resolution=200"],
 }

@@ -61,7 +61,7 @@ inline float3 UNIT3(float3 a, float3 fallback)
     return aa > 0.0f && aa <= FLT_MAX ? a * rsqrt(aa) : fallback;
 }
 
-/* HITS_ONLY(i, n_items, hit, on_miss): the start of a kernel of one pixel per work-item:
+/* HITS_ONLY(i, n_items, hit, on_miss): the start of every kernel of one pixel per work-item:
  * past the end it returns, on a miss it runs the statement on_miss and returns.  Intel's CPU
  * compiler runs 16 work-items of such a kernel in the lanes of one vector (above), and a
  * branch on the pixel as both sides in every lane, so the vectors of misses did the hits'

@@ -45,14 +45,10 @@ __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __
                               const real4 forward, __global real4 *normal)
 {
     size_t i = get_global_id(0);
-    if (i >= (size_t)n_items)
-        return;
+    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
+    HITS_ONLY(i, n_items, hit, normal[i] = (real4)(0));
     int x = (int)(i % (size_t)width);
     int y = (int)(i / (size_t)width);
-    if (status[i] != STATUS_HIT) {
-        normal[i] = (real4)(0);
-        return;
-    }
     real3 p = cam_point(point, i, eye, right, up, forward);
     /* +x is right; +y in the image is down, so "up" is row y - 1 */
     real3 tx = zb_tangent(point, depth, status, i, i - 1, i + 1, x > 0, x < width - 1, p,

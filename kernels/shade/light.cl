@@ -228,8 +228,6 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     /* PACKETS blocks per work-item, as the march's (march/march.cl, PACKET_PAIRS) */
 #if LANES == 1
     size_t i0 = get_global_id(0);
-    if (i0 >= (size_t)n_items)
-        return;
 #else
     size_t lane_index[PACKETS][LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
     for (int k = 0; k < PACKETS; ++k)
@@ -240,11 +238,8 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     quat p[PACKETS], nw[PACKETS], pin[PACKETS];
     lmask hit[PACKETS];
 #if LANES == 1
-    hit[0] = status[i0] == STATUS_HIT;
-    if (!hit[0]) {
-        terms[i0] = (float4)(1, 1, 0, 0);
-        return;
-    }
+    hit[0] = i0 < (size_t)n_items && status[i0] == STATUS_HIT;
+    HITS_ONLY(i0, n_items, hit[0], terms[i0] = (float4)(1, 1, 0, 0));
     p[0] = point[i0];
     real4 nc = normal[i0];
     nw[0] = nc.x * right + nc.y * up - nc.z * forward;
