@@ -9,8 +9,10 @@ march/cone.cl; 34a8817: complex.cl's own hypot, whose last-bit differences moved
 hypercomplex pwr by at most 5e-6, no pixel's status; f7640c5: dot products written out in the
 kernels of one pixel per work-item, which moved colours by at most 6e-5 and the gradient and
 z-buffer normals by at most 3.4e-5, no depth; 9864e24: the camera rays' directions written
-out, the same in a packet's lanes as one ray per work-item, which moved their last bits),
-and the commit message says so.
+out, the same in a packet's lanes as one ray per work-item, which moved their last bits;
+NEXT: the Jacobian normals carried as three directional derivatives instead of J's four
+columns, which moved the normals by at most 1.3e-6 and the colours by at most 1.3e-5, no
+depth or status), and the commit message says so.
 
 Skipped where git or BASE is not at hand (an installed package, a shallow clone)."""
 from __future__ import annotations

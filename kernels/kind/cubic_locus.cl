@@ -12,8 +12,8 @@
  * (shadows and ambient occlusion test inside points).
  *
  * Compiled after iterate.cl (the pattern of kind/mandelbrot.cl): the set test, level function
- * and normal below take over julia_inside, julia_level and normal_jacobian (KIND_NORMAL,
- * defined at the end, makes normals/jacobian.cl use it). */
+ * and normal below take over julia_inside, julia_level and the Jacobian normal (KIND_NORMAL,
+ * defined at the end: normals/jacobian.cl projects its 4D gradient). */
 
 /* z <- z (z^2 - 3 a^2) + b on (re, im) lane pairs; a2 = a^2; lanes outside live keep z */
 #define LOCUS_STEP(zr, zi, a2r, a2i, br, bi, live) do { \

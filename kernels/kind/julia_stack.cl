@@ -10,8 +10,8 @@
  * The ends u = +-1 are flat caps showing the Julia sets of the end points.
  *
  * Compiled after iterate.cl (the pattern of kind/mandelbrot.cl): the set test, level function
- * and normal below take over julia_inside, julia_level and normal_jacobian (KIND_NORMAL,
- * defined at the end, makes normals/jacobian.cl use it).
+ * and normal below take over julia_inside, julia_level and the Jacobian normal (KIND_NORMAL,
+ * defined at the end: normals/jacobian.cl projects its 4D gradient).
  * No distance estimate is proven for a stack (seed 001 §5.1), so by default the estimate of
  * iterate.cl is switched off (ALG_HAS_DE undefined: shadows and ambient occlusion test inside
  * points); -D STACK_DE (march.method = "de") builds the seed's "empirical formula based on

@@ -1,19 +1,31 @@
 /* normals/jacobian.cl: the analytic normal (seed 004 "method 3", seed 002).
  * The surface is the level set |q_n|^2 = bailout^2, so the normal is
- *     grad |q_n|^2 = 2 J^T q_n,   J_{k+1} = f'(q_k) J_k,  J_0 = I,
- * with J carried column by column through julia_f_jvp() (in the algebra's coordinates:
- * J_0's columns are ALG_IN of the unit vectors, and J^T q_n is taken with ALG_DOT, the
- * bilinear form of the algebra's norm, so the result is the 4D gradient).  The gradient is only
- * needed up to scale, so J is rescaled whenever it grows large: no overflow at
- * any max_iter.  The 4D gradient is projected onto the 3D space the rays span
- * and returned in camera coordinates (x right, y up, z towards the eye). */
+ *     grad |q_n|^2 = 2 J^T q_n,   J_{k+1} = f'(q_k) J_k,  J_0 = I.
+ * The rays see only the 3D space spanned by the camera's right, up and forward, so only
+ * the gradient's components along them are needed:
+ *     grad |q_n|^2 . v = 2 q_n . (J v),   (J v)_{k+1} = f'(q_k) (J v)_k,  (J v)_0 = v,
+ * three directional derivatives carried forward through julia_f_jvp() instead of J's four
+ * columns (3/4 of the work; the float64 twin takes the whole gradient and projects it, so
+ * the tests check the one against the other).  In the algebra's coordinates: (J v)_0 is
+ * ALG_IN(v) (a linear map), and q . (J v) is ALG_DOT, the bilinear form of the algebra's
+ * norm.  The derivatives are only needed up to a common scale, so they are rescaled
+ * whenever they grow large: no overflow at any max_iter.  Returned as camera coordinates
+ * (x right, y up, z towards the eye). */
+
+/* a uniform 4D vector in every lane */
+#define QUAT_UNIFORM(v) QUAT((lreal)((v).x), (lreal)((v).y), (lreal)((v).z), (lreal)((v).w))
 
 #ifdef KIND_NORMAL
 /* a kind with a normal of its own (kind/julia_stack.cl, kind/cubic_locus.cl: KIND_NORMAL names
- * its function) */
-#define normal_jacobian KIND_NORMAL
+ * its function, which returns the 4D gradient): its components along right, up, forward */
+inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
+{
+    quat g = KIND_NORMAL(p, jp, guard);
+    return QUAT(QDOT_UNIFORM(g, right), QDOT_UNIFORM(g, up), QDOT_UNIFORM(g, forward), (lreal)0);
+}
 #else
-inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
+/* the gradient's components along right, up and forward, up to a common positive scale */
+inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
 {
     quat q = ALG_IN(p);
 #ifdef KIND_MANDELBROT
@@ -21,18 +33,16 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
      * J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings below) */
     quat c = q;
     q = MANDEL_START(c);            /* q_1 = v + c: J_1 is the same */
-    quat e0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
-    quat e1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
-    quat e2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));
-    quat e3 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1));
+    quat e0 = ALG_IN(QUAT_UNIFORM(right));
+    quat e1 = ALG_IN(QUAT_UNIFORM(up));
+    quat e2 = ALG_IN(QUAT_UNIFORM(forward));
     lreal unit = (lreal)1;          /* 1 / s: the added identity at the scale J is kept in */
 #else
     real4 c = ALG_C(jp.c);
 #endif
-    quat j0 = ALG_IN(QUAT((lreal)1, (lreal)0, (lreal)0, (lreal)0));
-    quat j1 = ALG_IN(QUAT((lreal)0, (lreal)1, (lreal)0, (lreal)0));
-    quat j2 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)1, (lreal)0));
-    quat j3 = ALG_IN(QUAT((lreal)0, (lreal)0, (lreal)0, (lreal)1));
+    quat j0 = ALG_IN(QUAT_UNIFORM(right));     /* J right, J up, J forward */
+    quat j1 = ALG_IN(QUAT_UNIFORM(up));
+    quat j2 = ALG_IN(QUAT_UNIFORM(forward));
     lmask live = L_TRUE;
 #ifdef KIND_MANDELBROT
     for (int n = 1; n < jp.max_iter && L_ANY(live); ++n) {
@@ -56,51 +66,47 @@ inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
         j0 = QSEL(j0, julia_f_jvp(q, j0), live);
         j1 = QSEL(j1, julia_f_jvp(q, j1), live);
         j2 = QSEL(j2, julia_f_jvp(q, j2), live);
-        j3 = QSEL(j3, julia_f_jvp(q, j3), live);
 #ifdef KIND_MANDELBROT
         j0 = QSEL(j0, QADD(j0, QSCALE(unit, e0)), live);
         j1 = QSEL(j1, QADD(j1, QSCALE(unit, e1)), live);
         j2 = QSEL(j2, QADD(j2, QSCALE(unit, e2)), live);
-        j3 = QSEL(j3, QADD(j3, QSCALE(unit, e3)), live);
         q = QSEL(q, mandel_f(q, c), live);
 #else
         q = QSEL(q, julia_f(q, c), live);
 #endif
-        /* the largest column's squared length (sqrt is monotonic: sqrt(s2) is the largest
+        /* the largest derivative's squared length (sqrt is monotonic: sqrt(s2) is the largest
          * length); rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
-        lreal s2 = fmax(fmax(QNORM2(j0), QNORM2(j1)), fmax(QNORM2(j2), QNORM2(j3)));
+        lreal s2 = fmax(QNORM2(j0), fmax(QNORM2(j1), QNORM2(j2)));
         lmask rescale = L_RESCALE_DUE(live, s2);
         if (L_ANY(rescale)) {
             lreal inv = (real)1 / sqrt(s2);
             j0 = QSEL(j0, QSCALE(inv, j0), rescale);
             j1 = QSEL(j1, QSCALE(inv, j1), rescale);
             j2 = QSEL(j2, QSCALE(inv, j2), rescale);
-            j3 = QSEL(j3, QSCALE(inv, j3), rescale);
 #ifdef KIND_MANDELBROT
             unit = L_SEL(unit, unit * inv, rescale);
 #endif
         }
     }
-    return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), ALG_DOT(q, j3));
+    return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), (lreal)0);
 }
 #endif  /* KIND_NORMAL */
 
-/* 4D vector -> camera coordinates (right, up, -forward), normalised: (*nx, *ny, *nz).
- * Degenerate (zero: the orbit hit the critical point 0 exactly, e.g. an eye at 0 inside
- * the set; or non-finite): the view axis (0, 0, 1), flagged GUARD_NORMAL_FALLBACK, never a
- * zero normal on a hit. */
-inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *guard,
-                           lreal *nx, lreal *ny, lreal *nz)
+/* the gradient's components along (right, up, forward) -> camera coordinates (right, up,
+ * -forward), normalised: (*nx, *ny, *nz).  Degenerate (zero: the orbit hit the critical point
+ * 0 exactly, e.g. an eye at 0 inside the set; or non-finite): the view axis (0, 0, 1),
+ * flagged GUARD_NORMAL_FALLBACK, never a zero normal on a hit. */
+inline void to_camera_unit(quat a, lmask *guard, lreal *nx, lreal *ny, lreal *nz)
 {
 #if LANES == 1
-    real4 n = (real4)(dot(g, right), dot(g, up), -dot(g, forward), 0);
+    real4 n = (real4)(a.x, a.y, -a.z, 0);
     real l = length(n);
     int ok = l > (real)0 && isfinite(l);
     n = ok ? n / l : (real4)(0, 0, 1, 0);
     *nx = n.x, *ny = n.y, *nz = n.z;
 #else
-    lreal x = QDOT_UNIFORM(g, right), y = QDOT_UNIFORM(g, up), z = -QDOT_UNIFORM(g, forward);
+    lreal x = a.x, y = a.y, z = -a.z;
     lreal m = fmax(fabs(x), fmax(fabs(y), fabs(z)));   /* scaled first, as length() does */
     x /= m, y /= m, z /= m;
     lreal l = sqrt(x * x + y * y + z * z);
@@ -125,7 +131,7 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
     HITS_ONLY(i0, n_items, hit, normal[i0] = (real4)(0));
     int guard = 0;
     real nx, ny, nz;
-    to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+    to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
     normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (common/codes.cl) */
 #else
     if (i0 >= (size_t)n_items)
@@ -143,7 +149,7 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
     lmask guard = 0;
     lreal nx = 0, ny = 0, nz = 0;
     if (any_hit)
-        to_camera_unit(normal_jacobian(p, jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+        to_camera_unit(normal_along(p, jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
     for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
         size_t i = i0 + k;
         normal[i] = status[i] == STATUS_HIT

@@ -347,14 +347,13 @@ lreal w;
 lreal a = refine_bracket(o, d, m.t_prev, m.t, todo, post_steps, jp, &w);
 return de_depth(&m, a, w, near, far, live, width, unresolved);
 }
-inline quat normal_jacobian(quat p, julia_params jp, lmask *guard)
+inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
 {
 quat q = (p);
 real4 c = (jp.c);
-quat j0 = (((real4)(((lreal)1), ((lreal)0), ((lreal)0), ((lreal)0))));
-quat j1 = (((real4)(((lreal)0), ((lreal)1), ((lreal)0), ((lreal)0))));
-quat j2 = (((real4)(((lreal)0), ((lreal)0), ((lreal)1), ((lreal)0))));
-quat j3 = (((real4)(((lreal)0), ((lreal)0), ((lreal)0), ((lreal)1))));
+quat j0 = (((real4)(((lreal)((right).x)), ((lreal)((right).y)), ((lreal)((right).z)), ((lreal)((right).w)))));
+quat j1 = (((real4)(((lreal)((up).x)), ((lreal)((up).y)), ((lreal)((up).z)), ((lreal)((up).w)))));
+quat j2 = (((real4)(((lreal)((forward).x)), ((lreal)((forward).y)), ((lreal)((forward).z)), ((lreal)((forward).w)))));
 lmask live = 1;
 for (int n = 0; n < jp.max_iter && (live); ++n) {
 lreal m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w);
@@ -367,24 +366,21 @@ break;
 j0 = ((live) ? (julia_f_jvp(q, j0)) : (j0));
 j1 = ((live) ? (julia_f_jvp(q, j1)) : (j1));
 j2 = ((live) ? (julia_f_jvp(q, j2)) : (j2));
-j3 = ((live) ? (julia_f_jvp(q, j3)) : (j3));
 q = ((live) ? (julia_f(q, c)) : (q));
-lreal s2 = fmax(fmax((((j0)).x * ((j0)).x + ((j0)).y * ((j0)).y + ((j0)).z * ((j0)).z + ((j0)).w * ((j0)).w), (((j1)).x * ((j1)).x + ((j1)).y * ((j1)).y + ((j1)).z * ((j1)).z + ((j1)).w * ((j1)).w)), fmax((((j2)).x * ((j2)).x + ((j2)).y * ((j2)).y + ((j2)).z * ((j2)).z + ((j2)).w * ((j2)).w), (((j3)).x * ((j3)).x + ((j3)).y * ((j3)).y + ((j3)).z * ((j3)).z + ((j3)).w * ((j3)).w)));
+lreal s2 = fmax((((j0)).x * ((j0)).x + ((j0)).y * ((j0)).y + ((j0)).z * ((j0)).z + ((j0)).w * ((j0)).w), fmax((((j1)).x * ((j1)).x + ((j1)).y * ((j1)).y + ((j1)).z * ((j1)).z + ((j1)).w * ((j1)).w), (((j2)).x * ((j2)).x + ((j2)).y * ((j2)).y + ((j2)).z * ((j2)).z + ((j2)).w * ((j2)).w)));
 lmask rescale = ((live) & (((s2) > (real)1e24) | (((s2) < (real)1e-24) & ((s2) > (real)0))));
 if ((rescale)) {
 lreal inv = (real)1 / sqrt(s2);
 j0 = ((rescale) ? (((inv) * (j0))) : (j0));
 j1 = ((rescale) ? (((inv) * (j1))) : (j1));
 j2 = ((rescale) ? (((inv) * (j2))) : (j2));
-j3 = ((rescale) ? (((inv) * (j3))) : (j3));
 }
 }
-return ((real4)(((((q)).x * ((j0)).x + ((q)).y * ((j0)).y + ((q)).z * ((j0)).z + ((q)).w * ((j0)).w)), ((((q)).x * ((j1)).x + ((q)).y * ((j1)).y + ((q)).z * ((j1)).z + ((q)).w * ((j1)).w)), ((((q)).x * ((j2)).x + ((q)).y * ((j2)).y + ((q)).z * ((j2)).z + ((q)).w * ((j2)).w)), ((((q)).x * ((j3)).x + ((q)).y * ((j3)).y + ((q)).z * ((j3)).z + ((q)).w * ((j3)).w))));
+return ((real4)(((((q)).x * ((j0)).x + ((q)).y * ((j0)).y + ((q)).z * ((j0)).z + ((q)).w * ((j0)).w)), ((((q)).x * ((j1)).x + ((q)).y * ((j1)).y + ((q)).z * ((j1)).z + ((q)).w * ((j1)).w)), ((((q)).x * ((j2)).x + ((q)).y * ((j2)).y + ((q)).z * ((j2)).z + ((q)).w * ((j2)).w)), ((lreal)0)));
 }
-inline void to_camera_unit(quat g, real4 right, real4 up, real4 forward, lmask *guard,
-lreal *nx, lreal *ny, lreal *nz)
+inline void to_camera_unit(quat a, lmask *guard, lreal *nx, lreal *ny, lreal *nz)
 {
-real4 n = (real4)(dot(g, right), dot(g, up), -dot(g, forward), 0);
+real4 n = (real4)(a.x, a.y, -a.z, 0);
 real l = length(n);
 int ok = l > (real)0 && isfinite(l);
 n = ok ? n / l : (real4)(0, 0, 1, 0);
@@ -402,6 +398,6 @@ int hit = i0 < (size_t)n_items && status[i0] == 1;
 do { if (!(hit)) { if ((i0) < (size_t)(n_items)) normal[i0] = (real4)(0); return; } if ((i0) >= (size_t)(n_items)) return; if (!(hit)) { normal[i0] = (real4)(0); return; } } while (0);
 int guard = 0;
 real nx, ny, nz;
-to_camera_unit(normal_jacobian(point[i0], jp, &guard), right, up, forward, &guard, &nx, &ny, &nz);
+to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
 normal[i0] = (real4)(nx, ny, nz, (real)guard);
 }
