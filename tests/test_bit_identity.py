@@ -10,7 +10,7 @@ hypercomplex pwr by at most 5e-6, no pixel's status; f7640c5: dot products writt
 kernels of one pixel per work-item, which moved colours by at most 6e-5 and the gradient and
 z-buffer normals by at most 3.4e-5, no depth; 9864e24: the camera rays' directions written
 out, the same in a packet's lanes as one ray per work-item, which moved their last bits;
-NEXT: the Jacobian normals carried as three directional derivatives instead of J's four
+2dc6e4b: the Jacobian normals carried as three directional derivatives instead of J's four
 columns, which moved the normals by at most 1.3e-6 and the colours by at most 1.3e-5, no
 depth or status), and the commit message says so.
 
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-BASE = "9864e2436cfdb13a7f9f2e5b624f123a69862266"
+BASE = "2dc6e4bb26fb15efd307b833a74e9ee90d3091cd"
 ROOT = Path(__file__).resolve().parent.parent
 
 SCENES = {
