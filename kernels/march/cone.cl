@@ -53,9 +53,10 @@ PACKET_KERNEL void cone_starts(const int n_items, const int blocks_w, const int 
     lreal t, far;   /* the ray's entry and exit of the bounding ball, as march/march.cl takes them */
     lmask active = ball_span(o, d, radius, near_set, far_set, &t, &far) & (far >= t);
     lreal t_lo = (lreal)INFINITY, t_last = (lreal)-1;
+    quat away = ORBIT_AWAY(jp);
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lmask escaped;
-        lreal dist = julia_distance_formula(QRAY(o, d, t), jp, &escaped);
+        lreal dist = julia_distance_formula(QSEL(away, QRAY(o, d, t), active), jp, &escaped);
         lreal r = k * t;
         lmask held = active & escaped & (dist > (real)2 * r);
         if (i == 0)

@@ -110,10 +110,11 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
                        lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
     de_march m = de_start(near, live);
+    quat away = ORBIT_AWAY(jp);
     for (int i = 0; i < max_steps && L_ANY(m.active); ++i) {
         de_leave(&m, i, far, samples);
         lmask escaped;
-        lreal dist = julia_distance_formula(QRAY(o, d, m.t), jp, &escaped);
+        lreal dist = julia_distance_formula(QSEL(away, QRAY(o, d, m.t), m.active), jp, &escaped);   /* ended: ORBIT_AWAY */
         de_advance(&m, i, dist, escaped, jp.epsilon, samples, flags);
     }
     lmask todo = de_close(&m, live, max_steps, status, samples, flags);
@@ -131,12 +132,14 @@ inline void march_ray_pair(const quat *o, const quat *d, const lreal *near, cons
                            lmask *flags, lreal *width, lreal *unresolved, lreal *depth)
 {
     de_march m[2] = {de_start(near[0], live[0]), de_start(near[1], live[1])};
+    quat away = ORBIT_AWAY(jp);
     for (int i = 0; i < max_steps && L_ANY(m[0].active | m[1].active); ++i) {
         de_leave(&m[0], i, far[0], &samples[0]);
         de_leave(&m[1], i, far[1], &samples[1]);
         lmask e0, e1;
         lreal d0, d1;
-        julia_distance_formula_pair(QRAY(o[0], d[0], m[0].t), QRAY(o[1], d[1], m[1].t), jp, &e0, &e1, &d0, &d1);
+        julia_distance_formula_pair(QSEL(away, QRAY(o[0], d[0], m[0].t), m[0].active),
+                                    QSEL(away, QRAY(o[1], d[1], m[1].t), m[1].active), jp, &e0, &e1, &d0, &d1);
         de_advance(&m[0], i, d0, e0, jp.epsilon, &samples[0], &flags[0]);
         de_advance(&m[1], i, d1, e1, jp.epsilon, &samples[1], &flags[1]);
     }

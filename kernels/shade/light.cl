@@ -56,8 +56,9 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, 
                         real softness, int max_steps)
 {
     shadow_march m = shadow_start(o, l, tmax, lit, radius, step);
+    quat away = ORBIT_AWAY(jp);
     for (int i = 0; i < max_steps && L_ANY(m.active); ++i) {
-        quat x = QRAY(o, l, m.t);
+        quat x = QSEL(away, QRAY(o, l, m.t), m.active);
 #ifdef ALG_HAS_DE
         lmask escaped;
         lreal d = julia_distance_formula(x, jp, &escaped);
@@ -81,10 +82,12 @@ inline void shadow_ray_pair(const quat *o, const quat *l, const lreal *tmax, con
 {
     shadow_march a = shadow_start(o[0], l[0], tmax[0], lit[0], radius, step);
     shadow_march b = shadow_start(o[1], l[1], tmax[1], lit[1], radius, step);
+    quat away = ORBIT_AWAY(jp);
     for (int i = 0; i < max_steps && L_ANY(a.active | b.active); ++i) {
         lmask ea, eb;
         lreal da, db;
-        julia_distance_formula_pair(QRAY(o[0], l[0], a.t), QRAY(o[1], l[1], b.t), jp, &ea, &eb, &da, &db);
+        julia_distance_formula_pair(QSEL(away, QRAY(o[0], l[0], a.t), a.active),
+                                    QSEL(away, QRAY(o[1], l[1], b.t), b.active), jp, &ea, &eb, &da, &db);
         shadow_advance(&a, da, ea, step, softness);
         shadow_advance(&b, db, eb, step, softness);
     }

@@ -336,10 +336,11 @@ int z_resolution, int post_steps, int max_steps, lmask *status,
 lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
 de_march m = de_start(near, live);
+quat away = ((real4)(((lreal)((real)4 * sqrt((jp).bailout2))), ((lreal)0), ((lreal)0), ((lreal)0)));
 for (int i = 0; i < max_steps && (m.active); ++i) {
 de_leave(&m, i, far, samples);
 lmask escaped;
-lreal dist = julia_distance_formula(((o) + (m.t) * (d)), jp, &escaped);
+lreal dist = julia_distance_formula(((m.active) ? (((o) + (m.t) * (d))) : (away)), jp, &escaped);
 de_advance(&m, i, dist, escaped, jp.epsilon, samples, flags);
 }
 lmask todo = de_close(&m, live, max_steps, status, samples, flags);
