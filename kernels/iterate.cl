@@ -104,6 +104,17 @@ inline void julia_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a,
     *fa = level_value(m2a, steps_a, jp, inside_a);
     *fb = level_value(m2b, steps_b, jp, inside_b);
 }
+
+/* julia_inside at two packets' points in one loop (march/refine.cl's bisection in pairs) */
+inline void julia_inside_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b)
+{
+    real4 c = ALG_C(jp.c);
+    PAIR_ORBIT_START(pa, pb, qa, qb, m2a, m2b, live_a, live_b, jp.bailout2);
+    for (int n = 0; n < jp.max_iter && L_ANY(live_a | live_b); ++n)
+        PAIR_ORBIT_STEP(julia_f, qa, qb, c, c, m2a, m2b, live_a, live_b, jp.bailout2);
+    *inside_a = live_a;
+    *inside_b = live_b;
+}
 #endif
 
 #ifdef ALG_HAS_DE

@@ -35,6 +35,8 @@ SCENES = {
     "default": [],
     "fit": None,   # the command line's built-in scene: camera.fit's pass included
     "fixed_bisect": ["march.method=fixed", "march.z_resolution=120", "march.refine=bisect"],
+    # the estimate's march with bisection: two packets' set tests side by side on a CPU
+    "de_bisect": ["march.refine=bisect", "march.post_steps=7", "march.epsilon=0.05", "fractal.max_iter=20"],
     "quaternion_cube_gradient": ["fractal.function=cube", "fractal.c=-0.3,0.6,0.2,0.1", "normals.method=gradient"],
     "hypercomplex_sin": ["fractal.algebra=hypercomplex", "fractal.function=sin", "fractal.c=-0.5,0.4,0,0",
                          "fractal.max_iter=6", "camera.position=6,6,-8"],
@@ -48,6 +50,7 @@ SCENES = {
                 "shading.sky=0.6,0.7,1", "clip.planes=0,0,1,0.2", "image.samples=2"],
     "w_colour_adaptive": ["shading.coloring=w", "image.samples=3", "image.adaptive=true", "shading.light=eye"],
     "mandelbrot": ["fractal.kind=mandelbrot", "camera.position=1.8,1.6,-3.2"],
+    "mandelbrot_bisect": ["fractal.kind=mandelbrot", "camera.position=1.8,1.6,-3.2", "march.refine=bisect"],
     "rotated": ["fractal.theta=40"],
     # one pixel per work-item throughout: the light terms' and the Jacobian's one-ray kernels
     "one_ray": ["render.variant=scalar", "shading.reflection=0.2"],

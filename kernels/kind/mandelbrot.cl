@@ -80,6 +80,17 @@ inline void mandel_level_pair(quat pa, quat pb, julia_params jp, lmask *inside_a
     *fb = level_value(m2b, steps_b, jp, inside_b);
 }
 #define julia_level_pair mandel_level_pair
+
+/* mandel_inside at two packets' points in one loop (march/refine.cl's bisection in pairs) */
+inline void mandel_inside_pair(quat pa, quat pb, julia_params jp, lmask *inside_a, lmask *inside_b)
+{
+    MANDEL_PAIR_START(pa, pb);
+    for (int n = 1; n < jp.max_iter && L_ANY(live_a | live_b); ++n)
+        MANDEL_PAIR_STEP();
+    *inside_a = live_a;
+    *inside_b = live_b;
+}
+#define julia_inside_pair mandel_inside_pair
 #endif
 
 #ifdef ALG_HAS_DE

@@ -76,16 +76,17 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
         *width = b - a;
         return a;
     }
+    quat away = ORBIT_AWAY(jp);   /* where lanes not refining take their set tests (iterate.cl) */
 #ifdef REFINE_ITP
     lmask inside;
-    lreal fa = julia_level(QRAY(o, d, a), jp, &inside);
-    lreal fb = julia_level(QRAY(o, d, b), jp, &inside);
+    lreal fa = julia_level(QSEL(away, QRAY(o, d, a), todo), jp, &inside);
+    lreal fb = julia_level(QSEL(away, QRAY(o, d, b), todo), jp, &inside);
     itp_state s = itp_start(a, b, fa, fb, todo, steps);
     for (int j = 0; j <= steps && L_ANY(s.live); ++j) {
         lreal x = itp_point(&s, j, steps);
         if (!L_ANY(s.live))
             break;
-        lreal f = julia_level(QRAY(o, d, x), jp, &inside);
+        lreal f = julia_level(QSEL(away, QRAY(o, d, x), s.live), jp, &inside);
         itp_take(&s, x, f, inside);
     }
     a = s.a;
@@ -97,7 +98,7 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
         live &= (m > a) & (m < b);             /* adjacent numbers: nothing left to split */
         if (!L_ANY(live))
             break;
-        lmask got_in = julia_inside(QRAY(o, d, m), jp);
+        lmask got_in = julia_inside(QSEL(away, QRAY(o, d, m), live), jp);
         b = L_SEL(b, m, live & got_in);
         a = L_SEL(a, m, live & !got_in);
     }
@@ -107,15 +108,11 @@ inline lreal refine_bracket(quat o, quat d, lreal a, lreal b, lmask todo, int st
 }
 
 #ifdef PACKET_PAIRS
-/* refine_bracket of two packets, [0] and [1]: ITP's set tests side by side (iterate.cl
- * julia_level_pair), lane for lane the same brackets; bisection one packet after the other. */
+/* refine_bracket of two packets, [0] and [1]: their set tests side by side (iterate.cl
+ * julia_level_pair for ITP, julia_inside_pair for bisection), lane for lane the same brackets. */
 inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, const lreal *b, const lmask *todo,
                                 int steps, julia_params jp, lreal *out, lreal *width)
 {
-#ifndef REFINE_ITP
-    for (int k = 0; k < 2; ++k)
-        out[k] = refine_bracket(o[k], d[k], a[k], b[k], todo[k], steps, jp, &width[k]);
-#else
     if (!L_ANY(todo[0] | todo[1])) {   /* nothing bracketed: no set tests at all */
         out[0] = a[0];
         out[1] = a[1];
@@ -123,10 +120,35 @@ inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, co
         width[1] = b[1] - a[1];
         return;
     }
+    quat away = ORBIT_AWAY(jp);   /* where lanes not refining take their set tests (iterate.cl) */
+#ifndef REFINE_ITP
+    lreal a0 = a[0], b0 = b[0], a1 = a[1], b1 = b[1];
+    lmask live0 = todo[0], live1 = todo[1];
+    for (int j = 0; j < steps && L_ANY(live0 | live1); ++j) {
+        lreal m0 = (real)0.5 * (a0 + b0), m1 = (real)0.5 * (a1 + b1);
+        live0 &= (m0 > a0) & (m0 < b0);        /* adjacent numbers: nothing left to split */
+        live1 &= (m1 > a1) & (m1 < b1);
+        if (!L_ANY(live0 | live1))
+            break;
+        lmask in0, in1;
+        julia_inside_pair(QSEL(away, QRAY(o[0], d[0], m0), live0), QSEL(away, QRAY(o[1], d[1], m1), live1), jp,
+                          &in0, &in1);
+        b0 = L_SEL(b0, m0, live0 & in0);
+        a0 = L_SEL(a0, m0, live0 & !in0);
+        b1 = L_SEL(b1, m1, live1 & in1);
+        a1 = L_SEL(a1, m1, live1 & !in1);
+    }
+    out[0] = a0;
+    out[1] = a1;
+    width[0] = b0 - a0;
+    width[1] = b1 - a1;
+#else
     lmask ia, ib;
     lreal fa0, fa1, fb0, fb1;
-    julia_level_pair(QRAY(o[0], d[0], a[0]), QRAY(o[1], d[1], a[1]), jp, &ia, &ib, &fa0, &fa1);
-    julia_level_pair(QRAY(o[0], d[0], b[0]), QRAY(o[1], d[1], b[1]), jp, &ia, &ib, &fb0, &fb1);
+    julia_level_pair(QSEL(away, QRAY(o[0], d[0], a[0]), todo[0]), QSEL(away, QRAY(o[1], d[1], a[1]), todo[1]), jp,
+                     &ia, &ib, &fa0, &fa1);
+    julia_level_pair(QSEL(away, QRAY(o[0], d[0], b[0]), todo[0]), QSEL(away, QRAY(o[1], d[1], b[1]), todo[1]), jp,
+                     &ia, &ib, &fb0, &fb1);
     itp_state s0 = itp_start(a[0], b[0], fa0, fb0, todo[0], steps);
     itp_state s1 = itp_start(a[1], b[1], fa1, fb1, todo[1], steps);
     for (int j = 0; j <= steps && L_ANY(s0.live | s1.live); ++j) {
@@ -134,7 +156,8 @@ inline void refine_bracket_pair(const quat *o, const quat *d, const lreal *a, co
         if (!L_ANY(s0.live | s1.live))
             break;
         lreal f0, f1;
-        julia_level_pair(QRAY(o[0], d[0], x0), QRAY(o[1], d[1], x1), jp, &ia, &ib, &f0, &f1);
+        julia_level_pair(QSEL(away, QRAY(o[0], d[0], x0), s0.live), QSEL(away, QRAY(o[1], d[1], x1), s1.live), jp,
+                         &ia, &ib, &f0, &f1);
         itp_take(&s0, x0, f0, ia);
         itp_take(&s1, x1, f1, ib);
     }

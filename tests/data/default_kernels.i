@@ -254,15 +254,16 @@ if (!(todo)) {
 *width = b - a;
 return a;
 }
+quat away = ((real4)(((lreal)((real)4 * sqrt((jp).bailout2))), ((lreal)0), ((lreal)0), ((lreal)0)));
 lmask inside;
-lreal fa = julia_level(((o) + (a) * (d)), jp, &inside);
-lreal fb = julia_level(((o) + (b) * (d)), jp, &inside);
+lreal fa = julia_level(((todo) ? (((o) + (a) * (d))) : (away)), jp, &inside);
+lreal fb = julia_level(((todo) ? (((o) + (b) * (d))) : (away)), jp, &inside);
 itp_state s = itp_start(a, b, fa, fb, todo, steps);
 for (int j = 0; j <= steps && (s.live); ++j) {
 lreal x = itp_point(&s, j, steps);
 if (!(s.live))
 break;
-lreal f = julia_level(((o) + (x) * (d)), jp, &inside);
+lreal f = julia_level(((s.live) ? (((o) + (x) * (d))) : (away)), jp, &inside);
 itp_take(&s, x, f, inside);
 }
 a = s.a;
