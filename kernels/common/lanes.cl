@@ -172,6 +172,9 @@ inline quat QSEL(quat a, quat b, lmask m)
 }
 #endif
 
+/* a uniform 4D vector (a real4 or float4) in every lane */
+#define QUAT_UNIFORM(v) QUAT((lreal)((v).x), (lreal)((v).y), (lreal)((v).z), (lreal)((v).w))
+
 /* A kernel whose work-items each run a packet (march, cone, light terms, Jacobian normals):
  * vec_type_hint says that it is vectorized by hand, so Intel's CPU compiler spends no time on
  * vectorizing it again across work-items: the default scene's march program of 16 lanes

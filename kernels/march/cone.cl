@@ -33,7 +33,7 @@ PACKET_KERNEL void cone_starts(const int n_items, const int blocks_w, const int 
         return;
     julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_NONE };
     real k = CONE_SPREAD * (real)2 * tan_half_fov / (real)image_h;
-    quat o = QUAT((lreal)eye.x, (lreal)eye.y, (lreal)eye.z, (lreal)eye.w), d;   /* every ray leaves the eye */
+    quat o = QUAT_UNIFORM(eye), d;   /* every ray leaves the eye */
 #if LANES == 1
     {
         int bx = bx0 + (int)(i0 % (size_t)blocks_w), by = by0 + (int)(i0 / (size_t)blocks_w);

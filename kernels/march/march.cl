@@ -115,7 +115,7 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
             RAY_UV(i, ((real *)&u)[k], ((real *)&v)[k]);
             ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
         }
-        o[p] = QUAT((lreal)eye.x, (lreal)eye.y, (lreal)eye.z, (lreal)eye.w);
+        o[p] = QUAT_UNIFORM(eye);
         d[p] = camera_dirs(u, v, forward, right, up);
 #endif
         live[p] = valid & ball_span(o[p], d[p], radius, near_set, far_set, &near[p], &far[p]);

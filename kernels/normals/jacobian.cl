@@ -12,9 +12,6 @@
  * whenever they grow large: no overflow at any max_iter.  Returned as camera coordinates
  * (x right, y up, z towards the eye). */
 
-/* a uniform 4D vector in every lane */
-#define QUAT_UNIFORM(v) QUAT((lreal)((v).x), (lreal)((v).y), (lreal)((v).z), (lreal)((v).w))
-
 #ifdef KIND_NORMAL
 /* a kind with a normal of its own (kind/julia_stack.cl, kind/cubic_locus.cl: KIND_NORMAL names
  * its function, which returns the 4D gradient): its components along right, up, forward */

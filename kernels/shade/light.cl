@@ -202,7 +202,7 @@ inline lreal orbit_value(quat p, julia_params jp)
 inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 {
     ORBIT_START(p);
-    quat tq = QSCALE((lreal)-1, ALG_IN(QUAT((lreal)trap.x, (lreal)trap.y, (lreal)trap.z, (lreal)trap.w)));
+    quat tq = QSCALE((lreal)-1, ALG_IN(QUAT_UNIFORM(trap)));
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
     lreal best = ALG_NORM2(QADD(q, tq));
@@ -288,7 +288,7 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
             o[b] = QRAY(p[b], nw[b], (lreal)bias);
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
         {
-            quat lp = QUAT((lreal)light_pos.x, (lreal)light_pos.y, (lreal)light_pos.z, (lreal)light_pos.w);
+            quat lp = QUAT_UNIFORM(light_pos);
             quat l[PACKETS];
             lreal dist[PACKETS];
             lmask facing[PACKETS];
@@ -312,7 +312,7 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
         {
             for (int j = 0; j < EXTRA_LIGHTS; ++j) {
                 real4 g = lights_geo[j];
-                quat gq = QUAT((lreal)g.x, (lreal)g.y, (lreal)g.z, (lreal)g.w);
+                quat gq = QUAT_UNIFORM(g);
                 quat l[PACKETS];
                 lreal dist[PACKETS];
                 lmask facing[PACKETS];
