@@ -23,8 +23,7 @@ __kernel void normals_gradient(const int n_items, __global const real4 *point, _
                                const real4 forward, __global real4 *normal)
 {
     size_t i = get_global_id(0);
-    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
-    HITS_ONLY(i, n_items, hit, normal[i] = (real4)(0));
+    HITS_ONLY(i, n_items, status, normal[i] = (real4)(0));
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 n = normal_gradient(point[i], jp, h, right, up, forward);
     real l = sqrt(DOT4(n, n));   /* not length(): common/lanes.cl DOT3 */

@@ -25,21 +25,19 @@ inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 f
 inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
 {
     quat q = ALG_IN(p);
+    quat j0 = ALG_IN(QUAT_UNIFORM(right));     /* J right, J up, J forward */
+    quat j1 = ALG_IN(QUAT_UNIFORM(up));
+    quat j2 = ALG_IN(QUAT_UNIFORM(forward));
 #ifdef KIND_MANDELBROT
     /* the point is c (kind/mandelbrot.cl): q_1 = c, J_1 = dq_1/dp = ALG_IN, and
      * J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings below) */
     quat c = q;
     q = MANDEL_START(c);            /* q_1 = v + c: J_1 is the same */
-    quat e0 = ALG_IN(QUAT_UNIFORM(right));
-    quat e1 = ALG_IN(QUAT_UNIFORM(up));
-    quat e2 = ALG_IN(QUAT_UNIFORM(forward));
+    quat e0 = j0, e1 = j1, e2 = j2;   /* the added ALG_IN v, each direction's */
     lreal unit = (lreal)1;          /* 1 / s: the added identity at the scale J is kept in */
 #else
     real4 c = ALG_C(jp.c);
 #endif
-    quat j0 = ALG_IN(QUAT_UNIFORM(right));     /* J right, J up, J forward */
-    quat j1 = ALG_IN(QUAT_UNIFORM(up));
-    quat j2 = ALG_IN(QUAT_UNIFORM(forward));
     lmask live = L_TRUE;
 #ifdef KIND_MANDELBROT
     for (int n = 1; n < jp.max_iter && L_ANY(live); ++n) {
@@ -124,8 +122,7 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
     size_t i0 = get_global_id(0) * LANES;
     julia_params jp = { c, bailout * bailout, 0, max_iter };
 #if LANES == 1
-    int hit = i0 < (size_t)n_items && status[i0] == STATUS_HIT;
-    HITS_ONLY(i0, n_items, hit, normal[i0] = (real4)(0));
+    HITS_ONLY(i0, n_items, status, normal[i0] = (real4)(0));
     int guard = 0;
     real nx, ny, nz;
     to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);

@@ -45,8 +45,7 @@ __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __
                               const real4 forward, __global real4 *normal)
 {
     size_t i = get_global_id(0);
-    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
-    HITS_ONLY(i, n_items, hit, normal[i] = (real4)(0));
+    HITS_ONLY(i, n_items, status, normal[i] = (real4)(0));
     int x = (int)(i % (size_t)width);
     int y = (int)(i / (size_t)width);
     real3 p = cam_point(point, i, eye, right, up, forward);

@@ -241,8 +241,8 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     quat p[PACKETS], nw[PACKETS], pin[PACKETS];
     lmask hit[PACKETS];
 #if LANES == 1
-    hit[0] = i0 < (size_t)n_items && status[i0] == STATUS_HIT;
-    HITS_ONLY(i0, n_items, hit[0], terms[i0] = (float4)(1, 1, 0, 0));
+    HITS_ONLY(i0, n_items, status, terms[i0] = (float4)(1, 1, 0, 0));
+    hit[0] = L_TRUE;
     p[0] = point[i0];
     real4 nc = normal[i0];
     nw[0] = nc.x * right + nc.y * up - nc.z * forward;

@@ -15,9 +15,8 @@ __kernel void reflect_rays(const int n_items, __global const real4 *point, __glo
                            __global real4 *origins, __global real4 *dirs)
 {
     size_t i = get_global_id(0);
-    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
     /* a miss: outside the bounding ball, leaving it (march.cl finds an empty interval) */
-    HITS_ONLY(i, n_items, hit, (origins[i] = (real4)(4 * radius, 0, 0, 0), dirs[i] = (real4)(1, 0, 0, 0)));
+    HITS_ONLY(i, n_items, status, (origins[i] = (real4)(4 * radius, 0, 0, 0), dirs[i] = (real4)(1, 0, 0, 0)));
     real4 p = point[i];
     real4 nc = normal[i];
     real4 n = nc.x * right + nc.y * up - nc.z * forward;
@@ -38,8 +37,7 @@ __kernel void reflect_color(const int n_items, __global const int *status, __glo
                             __global float4 *refl)
 {
     size_t i = get_global_id(0);
-    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
-    HITS_ONLY(i, n_items, hit, refl[i] = (float4)(background.xyz, 0.0f));
+    HITS_ONLY(i, n_items, status, refl[i] = (float4)(background.xyz, 0.0f));
     real4 nc = normal[i];
     real4 n = nc.x * right + nc.y * up - nc.z * forward;
 #ifdef LIGHT_POINT

@@ -27,8 +27,7 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
                     const float reflection, __global float4 *rgba)
 {
     size_t i = get_global_id(0);
-    int hit = i < (size_t)n_items && status[i] == STATUS_HIT;
-    HITS_ONLY(i, n_items, hit, rgba[i] = (float4)(background.xyz, 0.0f));
+    HITS_ONLY(i, n_items, status, rgba[i] = (float4)(background.xyz, 0.0f));
     real4 pv = point[i] - eye;
     float3 p = (float3)(DOT4(pv, right), DOT4(pv, up), -DOT4(pv, forward));
     /* the hit is the eye itself (camera inside the set, depth 0): no eye-to-point

@@ -352,10 +352,10 @@ return de_depth(&m, a, w, near, far, live, width, unresolved);
 inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
 {
 quat q = (p);
-real4 c = (jp.c);
 quat j0 = (((real4)(((lreal)((right).x)), ((lreal)((right).y)), ((lreal)((right).z)), ((lreal)((right).w)))));
 quat j1 = (((real4)(((lreal)((up).x)), ((lreal)((up).y)), ((lreal)((up).z)), ((lreal)((up).w)))));
 quat j2 = (((real4)(((lreal)((forward).x)), ((lreal)((forward).y)), ((lreal)((forward).z)), ((lreal)((forward).w)))));
+real4 c = (jp.c);
 lmask live = 1;
 for (int n = 0; n < jp.max_iter && (live); ++n) {
 lreal m2 = (((q)).x * ((q)).x + ((q)).y * ((q)).y + ((q)).z * ((q)).z + ((q)).w * ((q)).w);
@@ -396,8 +396,7 @@ __global real4 *normal)
 {
 size_t i0 = get_global_id(0) * 1;
 julia_params jp = { c, bailout * bailout, 0, max_iter };
-int hit = i0 < (size_t)n_items && status[i0] == 1;
-do { if (!(hit)) { if ((i0) < (size_t)(n_items)) normal[i0] = (real4)(0); return; } if ((i0) >= (size_t)(n_items)) return; if (!(hit)) { normal[i0] = (real4)(0); return; } } while (0);
+do { int hit_ = (i0) < (size_t)(n_items) && (status)[i0] == 1; if (!(hit_)) { if ((i0) < (size_t)(n_items)) normal[i0] = (real4)(0); return; } if ((i0) >= (size_t)(n_items)) return; if (!hit_) { normal[i0] = (real4)(0); return; } } while (0);
 int guard = 0;
 real nx, ny, nz;
 to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
