@@ -242,7 +242,8 @@ class NormalKernels:
         status = cla.to_device(q, np.ascontiguousarray(res.status.reshape(n), np.int32))
         depth = cla.to_device(q, np.ascontiguousarray(res.depth.reshape(n).astype(pr.scalar)))
         normal = cla.empty(q, n, pr.vec_dtype)
-        launch_normals(q, prg, scene, method, fr, pr, point, depth, status, normal)
+        flags = cla.zeros(q, n, np.int32)
+        launch_normals(q, prg, scene, method, fr, pr, point, depth, status, normal, flags)
         q.finish()
         return normal.get().view(pr.scalar).reshape(h, w, 4)[..., :3].astype(np.float64)
 

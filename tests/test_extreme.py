@@ -208,7 +208,8 @@ def test_derivative_beyond_range_is_rescaled(fl):
     fr = camera_frame(s)
     out = R.out4(n)
     R("normals_jacobian", (n,), R.buf4(p), R.buf(np.ones(n), np.int32), R.vec(s.fractal.c),
-      np.int32(10000), R.scalar(4.0), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), out)
+      np.int32(10000), R.scalar(4.0), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), out,
+      R.buf(np.zeros(n), np.int32))
     nrm = R.get4(out)
     assert np.all(np.isfinite(nrm))
     np.testing.assert_allclose(np.linalg.norm(nrm[:, :3], axis=1), 1, atol=1e-5)

@@ -20,14 +20,17 @@ inline real4 normal_gradient(real4 p, julia_params jp, real h, real4 right, real
 __kernel void normals_gradient(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real h, const real4 right, const real4 up,
-                               const real4 forward, __global real4 *normal)
+                               const real4 forward, __global real4 *normal, __global int *flags)
 {
     size_t i = get_global_id(0);
     HITS_ONLY(i, n_items, status, normal[i] = (real4)(0));
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 n = normal_gradient(point[i], jp, h, right, up, forward);
     real l = sqrt(DOT4(n, n));   /* not length(): common/lanes.cl DOT3 */
-    /* a flat or non-finite difference: the view axis, flagged (common/codes.cl), never 0 on a hit */
-    normal[i] = l > (real)0 && isfinite(l) ? n / l
-                                           : (real4)(0, 0, 1, (real)GUARD_NORMAL_FALLBACK);
+    /* a flat or non-finite difference: the view axis, flagged (common/codes.cl) in the pixel's
+     * flags word (normals/jacobian.cl), never 0 on a hit */
+    int ok = l > (real)0 && isfinite(l);
+    normal[i] = ok ? n / l : (real4)(0, 0, 1, 0);
+    if (!ok)
+        flags[i] |= GUARD_NORMAL_FALLBACK;
 }

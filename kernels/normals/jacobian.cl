@@ -113,11 +113,13 @@ inline void to_camera_unit(quat a, lmask *guard, lreal *nx, lreal *ny, lreal *nz
     *guard |= L_SEL((lmask)GUARD_NORMAL_FALLBACK, (lmask)0, ok);
 }
 
-/* LANES hit points per work-item (common/lanes.cl), like the march. */
+/* LANES hit points per work-item (common/lanes.cl), like the march.  Each hit's guard flags are
+ * ORed into its flags word (the march's flags buffer, as the float64 twin's ``guard``): the
+ * host counts them there, and reads no normal it does not keep. */
 PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real4 right, const real4 up, const real4 forward,
-                               __global real4 *normal)
+                               __global real4 *normal, __global int *flags)
 {
     size_t i0 = get_global_id(0) * LANES;
     julia_params jp = { c, bailout * bailout, 0, max_iter };
@@ -126,7 +128,9 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
     int guard = 0;
     real nx, ny, nz;
     to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
-    normal[i0] = (real4)(nx, ny, nz, (real)guard);   /* guard flags ride in the unused w (common/codes.cl) */
+    normal[i0] = (real4)(nx, ny, nz, 0);
+    if (guard)
+        flags[i0] |= guard;
 #else
     if (i0 >= (size_t)n_items)
         return;
@@ -146,10 +150,11 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
         to_camera_unit(normal_along(p, jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
     for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
         size_t i = i0 + k;
-        normal[i] = status[i] == STATUS_HIT
-                        ? (real4)(((real *)&nx)[k], ((real *)&ny)[k], ((real *)&nz)[k],
-                                  (real)((mask_t *)&guard)[k])
-                        : (real4)(0);
+        int hit = status[i] == STATUS_HIT;
+        normal[i] = hit ? (real4)(((real *)&nx)[k], ((real *)&ny)[k], ((real *)&nz)[k], 0) : (real4)(0);
+        int g = (int)((mask_t *)&guard)[k];
+        if (hit && g)
+            flags[i] |= g;
     }
 #endif
 }

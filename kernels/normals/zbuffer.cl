@@ -42,7 +42,7 @@ inline real3 zb_tangent(__global const real4 *point, __global const real *depth,
 __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __global const real *depth,
                               __global const int *status, const int width, const int height,
                               const real4 eye, const real4 right, const real4 up,
-                              const real4 forward, __global real4 *normal)
+                              const real4 forward, __global real4 *normal, __global int *flags)
 {
     size_t i = get_global_id(0);
     HITS_ONLY(i, n_items, status, normal[i] = (real4)(0));
@@ -68,5 +68,7 @@ __kernel void normals_zbuffer(const int n_items, __global const real4 *point, __
         if (!(l > (real)0) || !isfinite(l))
             n = (real3)(0, 0, 1), l = 1;
     }
-    normal[i] = (real4)(n / l, (real)guard);
+    normal[i] = (real4)(n / l, 0);
+    if (guard)
+        flags[i] |= guard;   /* the pixel's flags word (normals/jacobian.cl) */
 }

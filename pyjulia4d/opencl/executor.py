@@ -154,12 +154,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
         st = got["status"][own]
         for name, code in (("miss", STATUS_MISS), ("hit", STATUS_HIT), ("capped", STATUS_CAPPED)):
             counts[name] += int(np.count_nonzero(st == code))
-        guard = got["flags"][own]
-        if "normal" in got:  # guard flags (kernels/common/codes.cl): the march's buffer and the normals' w
-            nw = got["normal"][own][..., 3]
-            if nw.any():   # rarely: most tiles' normals raise no flag
-                guard = guard | nw.astype(np.int32)
-        add_counts(guards, count_guards(st, got["depth"][own], guard))
+        # guard flags (kernels/common/codes.cl): the march's, and the normals kernels' ORed in
+        add_counts(guards, count_guards(st, got["depth"][own], got["flags"][own]))
         if "color" in keep:
             copy_xyz(img["color"][dst], got["rgba"][own])
         if "alpha" in keep:

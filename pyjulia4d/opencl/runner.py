@@ -133,11 +133,12 @@ def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int 
 
 
 def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
-                   point, depth, status, normal, size: tuple[int, int] | None = None,
+                   point, depth, status, normal, flags, size: tuple[int, int] | None = None,
                    lanes: int = 1) -> cl.Event | None:
-    """Enqueue the normals kernel of ``method`` (kernels/normals_<method>.cl) on the march's
+    """Enqueue the normals kernel of ``method`` (kernels/normals/<method>.cl) on the march's
     device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
-    image); writes ``normal`` (unit camera-coordinate normal, guard flags in w)."""
+    image); writes ``normal`` (unit camera-coordinate normal, w 0) and ORs each hit's guard
+    flags into ``flags`` (the march's)."""
     f = scene.fractal
     w, h = size or (scene.image.width, scene.image.height)
     n = w * h
@@ -146,12 +147,13 @@ def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
     kernel = build.kernel(prg, f"normals_{method}")
     if method == "jacobian":
         return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
-                      pr.scalar(f.bailout), right, up, fwd, normal.data, lanes=lanes)
+                      pr.scalar(f.bailout), right, up, fwd, normal.data, flags.data, lanes=lanes)
     if method == "gradient":
         return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
-                      pr.scalar(f.bailout), pr.scalar(gradient_step(scene)), right, up, fwd, normal.data)
+                      pr.scalar(f.bailout), pr.scalar(gradient_step(scene)), right, up, fwd, normal.data,
+                      flags.data)
     return launch(queue, kernel, n, point.data, depth.data, status.data, np.int32(w), np.int32(h), eye,
-                  right, up, fwd, normal.data)
+                  right, up, fwd, normal.data, flags.data)
 
 
 
@@ -201,8 +203,6 @@ class TileRunner:
         self.pr = pr = Precision(plan.double)
         nmax = max(t.n for t in plan.tiles)
         read = {"status", "flags", "depth", "bracket", "unresolved"} | {b for k in plan.outputs for b in _READ[k]}
-        if plan.normals:
-            read.add("normal")
         self.read = read
         nb = max(bw * bh for _, _, bw, bh in (t.cone_blocks() for t in plan.tiles)) if plan.march.cone else 0
         extra = "EXTRA_SHADOWS" in plan.config.defines
@@ -333,7 +333,7 @@ class TileRunner:
             packet = plan.normals_in_march_config
             kernels.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, method,
                                           plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
-                                          bufs["normal"], size=(tile.aw, tile.ah),
+                                          bufs["normal"], bufs["flags"], size=(tile.aw, tile.ah),
                                           lanes=plan.lanes if packet else 1))
             if self.clip_k is not None:
                 kernels.append(launch(q, self.clip_k, n, bufs["flags"].data, bufs["status"].data, self.right,
@@ -381,7 +381,7 @@ class TileRunner:
         packet = plan.normals_in_march_config
         ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
                                  plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],
-                                 size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))
+                                 bufs["flags2"], size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))
         if self.clip_k is not None:
             ev.append(launch(q, self.clip_k, n, bufs["flags2"].data, bufs["status2"].data, self.right, self.up,
                              self.fwd, *self.clip_n, bufs["normal2"].data))

@@ -226,7 +226,7 @@ def add_counts(total: dict[str, int], more: dict[str, int]) -> dict[str, int]:
 def count_guards(status, depth, guard) -> dict[str, int]:
     """Pixels each numerical guard fired on (nothing clamped without being counted).
     ``guard`` holds the flags (kernels/common/codes.cl) of the march kernel's flags buffer ORed
-    with those the normals kernels write into the normal's w.  Guards are rare: one pass ORs
+    with those the normals kernels OR into it.  Guards are rare: one pass ORs
     every pixel's flags, and only the flags that fired anywhere are counted pixel by pixel."""
     status, guard = (np.asarray(a).ravel() for a in (status, guard))
     guard = guard.astype(np.int32, copy=False)

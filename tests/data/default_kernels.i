@@ -392,7 +392,7 @@ n = ok ? n / l : (real4)(0, 0, 1, 0);
 __kernel void normals_jacobian(const int n_items, __global const real4 *point, __global const int *status,
 const real4 c, const int max_iter, const real bailout,
 const real4 right, const real4 up, const real4 forward,
-__global real4 *normal)
+__global real4 *normal, __global int *flags)
 {
 size_t i0 = get_global_id(0) * 1;
 julia_params jp = { c, bailout * bailout, 0, max_iter };
@@ -400,5 +400,7 @@ do { int hit_ = (i0) < (size_t)(n_items) && (status)[i0] == 1; if (!(hit_)) { if
 int guard = 0;
 real nx, ny, nz;
 to_camera_unit(normal_along(point[i0], jp, right, up, forward, &guard), &guard, &nx, &ny, &nz);
-normal[i0] = (real4)(nx, ny, nz, (real)guard);
+normal[i0] = (real4)(nx, ny, nz, 0);
+if (guard)
+flags[i0] |= guard;
 }
