@@ -5,6 +5,7 @@ The machine is shared and its speed drifts by a third within minutes, so two run
 benchmark an hour apart compare nothing.  Here the earlier commit (--rev, a git worktree made
 for the run and removed after) and the checkout render the same scene in child processes that
 alternate, --repeats pairs; each child renders once to build and warm, then --renders times,
+(keeping every output, or with --png what a PNG keeps)
 and reports the least time of each kernel (its OpenCL events, summed over the tiles) and the
 least CPU-seconds of a whole render (getrusage: the host's work and the kernels' threads).
 Each child starts with empty program caches (pyjulia4d's programs, pyopencl's and PoCL's
@@ -14,7 +15,7 @@ scene costs a user, as in the explorer.
 Reports the medians over the pairs and checkout / earlier; writes
 benchmarks/results/commit_ratio.md (a section per run: both commits, device, date).
 
-    python benchmarks/commit_ratio.py --rev 6bff021 [--repeats 5] [--set KEY=VALUE ...]
+    python benchmarks/commit_ratio.py --rev 6bff021 [--repeats 5] [--set KEY=VALUE ...] [--png]
 """
 from __future__ import annotations
 
@@ -40,8 +41,12 @@ import collections, json, resource, sys, time, warnings
 warnings.simplefilter("ignore")
 from pyjulia4d import Scene, render
 import pyjulia4d.opencl.executor as ex
-renders, over = int(sys.argv[1]), sys.argv[2:]
+renders, png, over = int(sys.argv[1]), sys.argv[2] == "png", sys.argv[3:]
 scene = Scene.default().with_overrides(over)
+outputs = None
+if png:   # what a PNG keeps (colour and alpha), as peers.py's renders do
+    from pyjulia4d.app.cli import CHANNEL_GROUPS
+    outputs = CHANNEL_GROUPS["RGBA"]
 events = []
 home = sys.modules[ex.TileRunner.__module__]   # where the tile runner's launch lives, in either commit
 launch = home.launch
@@ -51,7 +56,7 @@ def timed(queue, kernel, n, *args, **kw):
     return e
 home.launch = timed
 t_first = time.perf_counter()
-render(scene)
+render(scene, outputs=outputs)
 first = time.perf_counter() - t_first
 def cpu():
     r = resource.getrusage(resource.RUSAGE_SELF)
@@ -60,7 +65,7 @@ best, best_cpu, device = {}, float("inf"), "?"
 for _ in range(renders):
     events.clear()
     c0 = cpu()
-    r = render(scene)
+    r = render(scene, outputs=outputs)
     best_cpu = min(best_cpu, cpu() - c0)
     device = r.device_name
     per = collections.Counter()
@@ -73,7 +78,7 @@ print(json.dumps({"kernels": best, "cpu": best_cpu, "first": first, "device": de
 """
 
 
-def child(tree: Path, renders: int, over: list[str]) -> dict:
+def child(tree: Path, renders: int, over: list[str], png: bool = False) -> dict:
     """One child process in ``tree``, its program caches empty (the module docstring)."""
     with tempfile.TemporaryDirectory() as cache:
         for item in cache_dir().iterdir() if cache_dir().is_dir() else ():
@@ -81,7 +86,7 @@ def child(tree: Path, renders: int, over: list[str]) -> dict:
                 (shutil.copytree if item.is_dir() else shutil.copy2)(item, Path(cache) / item.name)
         env = dict(os.environ, PYTHONPATH=str(tree), PYJULIA4D_CACHE=cache, XDG_CACHE_HOME=str(Path(cache) / "xdg"),
                    POCL_CACHE_DIR=str(Path(cache) / "pocl"))
-        p = subprocess.run([sys.executable, "-c", CHILD, str(renders), *over], cwd=tree, env=env,
+        p = subprocess.run([sys.executable, "-c", CHILD, str(renders), "png" if png else "all", *over], cwd=tree, env=env,
                            capture_output=True, text=True, timeout=3600)
     if p.returncode != 0:
         raise SystemExit(f"{tree}: {(p.stderr.strip().splitlines() or ['?'])[-1]}")
@@ -95,6 +100,8 @@ def main(argv=None) -> int:
     ap.add_argument("--renders", type=int, default=8, help="timed renders in each child (the least counts)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--size", default="640x480")
+    ap.add_argument("--png", action="store_true",
+                    help="keep what a PNG keeps (colour and alpha), as peers.py's renders do; default: every output")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")
@@ -113,7 +120,7 @@ def main(argv=None) -> int:
             for k in range(a.repeats):
                 order = [("earlier", tree), ("checkout", ROOT)]
                 for name, path in order if k % 2 == 0 else order[::-1]:
-                    runs[name].append(child(path, a.renders, over))
+                    runs[name].append(child(path, a.renders, over, a.png))
         finally:
             subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, capture_output=True)
     names = sorted({k for r in runs["checkout"] for k in r["kernels"]},
@@ -131,6 +138,7 @@ def main(argv=None) -> int:
     table = "\n".join(rows)
     print(table)
     scene = f", the default scene with {', '.join(a.set)}" if a.set else ", the default scene"
+    scene += ", keeping a PNG's outputs" if a.png else ""
     section = (f"\n## {utc_now()}, {a.size}{scene}, {runs['checkout'][0]['device']}: commit {git_commit()} "
                f"against {rev}, medians of {a.repeats} alternating pairs (each the least of {a.renders} renders)\n\n"
                f"{table}\n")

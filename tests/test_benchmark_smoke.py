@@ -313,9 +313,9 @@ def test_commit_ratio_report_runs(tmp_path):
                                                      capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout")
     assert load("commit_ratio").main(["--rev", "HEAD", "--repeats", "1", "--renders", "1",
-                                            "--size", "64x48", "--out", str(tmp_path)]) == 0
+                                            "--size", "64x48", "--png", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "commit_ratio.md").read_text()
-    assert "| kernel march |" in md and "| CPU-s of a render |" in md
+    assert "| kernel march |" in md and "| CPU-s of a render |" in md and "keeping a PNG's outputs" in md
 
 
 @pytest.mark.parametrize("script,args", [
