@@ -21,6 +21,9 @@ ray's iterations at every step, and replays them through three schedules:
   falls below the block's footprint (B pixels at that distance) on any of its rays; every
   ray of the block starts there, and the steps in front of it are skipped.  The coarse
   pass is counted as one ray's steps to that depth per block.
+* blocks and refill again after 4x4 cone starts (the kernel's march/cone.cl, modelled by the
+  rule above): each ray's steps in front of its block's start left out, so the rays a refilled
+  lane takes begin near the surface, as they do in the kernel.
 
 What is left out, so these are upper bounds of the gain: the refinement of each hit
 (march/refine.cl, the same in every schedule), the per-step work that does not iterate (the
@@ -30,7 +33,7 @@ the image run 2.3-2.8x slower in packets, benchmarks/throughput.py "rays shuffle
 
 Writes benchmarks/results/march_levers.md (appends a section per run).
 
-    python benchmarks/march_levers.py [--size 320x240]
+    python benchmarks/march_levers.py [--size 320x240] [--set KEY=VALUE ...]
 """
 from __future__ import annotations
 
@@ -162,18 +165,38 @@ def coarse_to_fine(its, ts, ds, W: int, H: int, side: int, pixel: float) -> tupl
     return skipped / total, coarse / total
 
 
+def cone_trim(its, ts, ds, W: int, H: int, side: int, pixel: float) -> np.ndarray:
+    """``its`` with each ray's steps in front of its block's start (coarse_to_fine's rule) left
+    out and the rest moved to the front: the march each ray runs after a cone start."""
+    out = np.zeros_like(its)
+    for by in range(0, H - side + 1, side):
+        for bx in range(0, W - side + 1, side):
+            rays = (np.arange(by, by + side)[:, None] * W + np.arange(bx, bx + side)).ravel()
+            t, d = ts[rays], ds[rays]
+            below = d < t * pixel * side * (math.sqrt(2) / 2)
+            first = np.where(below.any(1), below.argmax(1), its.shape[1])
+            tb = min((t[i, k] for i, k in enumerate(first) if k < its.shape[1]), default=math.inf)
+            for r in rays:
+                kept = its[r][(ts[r] >= tb) & (its[r] > 0)]
+                out[r, :len(kept)] = kept
+    return out
+
+
 def main(argv=None) -> int:
     ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="320x240")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="scene overrides (e.g. fractal.max_iter=20 march.epsilon=0.05)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     W, H = size_of(a.size, "--size")
-    scene = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}"])
+    scene = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", *a.set])
     its, ts, ds = record(scene)
     total = int(its.sum())
     order = block_order(W, H)
     base = cost_blocks(its, order)
-    lines = [f"\n## {utc_now()}, commit {git_commit()}, default scene {W}x{H}, {LANES} lanes\n",
+    what = f"the default scene with {', '.join(a.set)}" if a.set else "default scene"
+    lines = [f"\n## {utc_now()}, commit {git_commit()}, {what} {W}x{H}, {LANES} lanes\n",
              f"{total:.4g} iterations in the march ({total / (W * H):.0f} per ray, refinement left out); "
              f"packets of 4x4 blocks use {total / (LANES * base):.1%} of their lanes' iteration slots.\n",
              "| schedule | lanes' use | modelled march time vs blocks |", "|---|---|---|",
@@ -189,6 +212,18 @@ def main(argv=None) -> int:
         skip, coarse = coarse_to_fine(its, ts, ds, W, H, side, pixel)
         lines.append(f"| {side}x{side} | {skip:.1%} | {coarse:.1%} | {skip - coarse:.1%} |")
         print(lines[-1], flush=True)
+    cut = cone_trim(its, ts, ds, W, H, BLOCK, pixel)
+    left = int(cut.sum())
+    cbase = cost_blocks(cut, order)
+    lines += ["", f"After 4x4 cone starts: {left:.4g} iterations ({left / total:.1%} of the above), "
+              f"the blocks' lanes' use {left / (LANES * cbase):.1%}.", "",
+              "| schedule after the cone starts | lanes' use | modelled march time vs blocks |", "|---|---|---|",
+              f"| blocks (as the kernel runs) | {left / (LANES * cbase):.1%} | 1.00 |"]
+    for q in (4, 16, 64):
+        c = cost_refill(cut, order, q)
+        lines.append(f"| refill from a queue of {q} blocks | {left / (LANES * c):.1%} | {c / cbase:.2f} |")
+        print(lines[-1], flush=True)
+    lines.append(f"| every lane always busy | 100 % | {left / (LANES * cbase):.2f} |")
     md = a.out / "march_levers.md"
     append_run(md, "# Compaction and coarse-to-fine, modelled on the default scene's rays\n\nWritten by "
                "`python benchmarks/march_levers.py` (its docstring says what is modelled and what is "
