@@ -165,6 +165,20 @@ def coarse_to_fine(its, ts, ds, W: int, H: int, side: int, pixel: float) -> tupl
     return skipped / total, coarse / total
 
 
+def schedules(its: np.ndarray, order: np.ndarray, title: str) -> list[str]:
+    """The table of the blocks' schedule, refill from queues of 4, 16 and 64 blocks, and every
+    lane busy: lanes' use and modelled time against the blocks'."""
+    total, base = int(its.sum()), cost_blocks(its, order)
+    rows = [f"| {title} | lanes' use | modelled march time vs blocks |", "|---|---|---|",
+            f"| blocks (as the kernel runs) | {total / (LANES * base):.1%} | 1.00 |"]
+    for q in (4, 16, 64):
+        c = cost_refill(its, order, q)
+        rows.append(f"| refill from a queue of {q} blocks | {total / (LANES * c):.1%} | {c / base:.2f} |")
+        print(rows[-1], flush=True)
+    rows.append(f"| every lane always busy (the bound of any compaction) | 100 % | {total / (LANES * base):.2f} |")
+    return rows
+
+
 def cone_trim(its, ts, ds, W: int, H: int, side: int, pixel: float) -> np.ndarray:
     """``its`` with each ray's steps in front of its block's start (coarse_to_fine's rule) left
     out and the rest moved to the front: the march each ray runs after a cone start."""
@@ -198,14 +212,8 @@ def main(argv=None) -> int:
     what = f"the default scene with {', '.join(a.set)}" if a.set else "default scene"
     lines = [f"\n## {utc_now()}, commit {git_commit()}, {what} {W}x{H}, {LANES} lanes\n",
              f"{total:.4g} iterations in the march ({total / (W * H):.0f} per ray, refinement left out); "
-             f"packets of 4x4 blocks use {total / (LANES * base):.1%} of their lanes' iteration slots.\n",
-             "| schedule | lanes' use | modelled march time vs blocks |", "|---|---|---|",
-             f"| blocks (as the kernel runs) | {total / (LANES * base):.1%} | 1.00 |"]
-    for q in (4, 16, 64):
-        c = cost_refill(its, order, q)
-        lines.append(f"| refill from a queue of {q} blocks | {total / (LANES * c):.1%} | {c / base:.2f} |")
-        print(lines[-1], flush=True)
-    lines.append(f"| every lane always busy (the bound of any compaction) | 100 % | {total / (LANES * base):.2f} |")
+             f"packets of 4x4 blocks use {total / (LANES * base):.1%} of their lanes' iteration slots.\n"]
+    lines += schedules(its, order, "schedule")
     pixel = 2 * math.tan(math.radians(scene.camera.fov) / 2) / H
     lines += ["", "| coarse to fine, block | iterations skipped | coarse pass | net |", "|---|---|---|---|"]
     for side in (4, 8, 16):
@@ -214,16 +222,9 @@ def main(argv=None) -> int:
         print(lines[-1], flush=True)
     cut = cone_trim(its, ts, ds, W, H, BLOCK, pixel)
     left = int(cut.sum())
-    cbase = cost_blocks(cut, order)
     lines += ["", f"After 4x4 cone starts: {left:.4g} iterations ({left / total:.1%} of the above), "
-              f"the blocks' lanes' use {left / (LANES * cbase):.1%}.", "",
-              "| schedule after the cone starts | lanes' use | modelled march time vs blocks |", "|---|---|---|",
-              f"| blocks (as the kernel runs) | {left / (LANES * cbase):.1%} | 1.00 |"]
-    for q in (4, 16, 64):
-        c = cost_refill(cut, order, q)
-        lines.append(f"| refill from a queue of {q} blocks | {left / (LANES * c):.1%} | {c / cbase:.2f} |")
-        print(lines[-1], flush=True)
-    lines.append(f"| every lane always busy | 100 % | {left / (LANES * cbase):.2f} |")
+              f"the blocks' lanes' use {left / (LANES * cost_blocks(cut, order)):.1%}.", ""]
+    lines += schedules(cut, order, "schedule after the cone starts")
     md = a.out / "march_levers.md"
     append_run(md, "# Compaction and coarse-to-fine, modelled on the default scene's rays\n\nWritten by "
                "`python benchmarks/march_levers.py` (its docstring says what is modelled and what is "
