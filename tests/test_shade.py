@@ -54,7 +54,7 @@ def test_shade_matches_reference(over, fl):
       np.float32(sh.shininess), R.buf(terms, np.float32), R.buf(np.zeros((2, 4)), np.float32),
       np.int32(2), np.float32(sh.fog), np.float32(1.5), R.buf4(geo), R.buf(rgb, np.float32),
       R.buf(vis, np.float32), R.buf(refl, np.float32), np.float32(sh.reflection), out)
-    got = out.get().view(np.float32).reshape(n, 4)
+    got = out.get().view(np.float32).reshape(4, n).T   # shade.cl's four planes
     want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
                      sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5,
                      terms=terms, sky=sh.sky, lights_geo=geo if sh.lights else None, lights_rgb=rgb,

@@ -12,8 +12,18 @@
  * -D COLORMAP, the colour map's entry for the hit's colour value (terms.z, linear
  * interpolation in a table of n_lut colours); -D FOG fades it toward the background with
  * distance; -D REFLECTION mixes in the mirror bounce (shade/reflect.cl) before it.  All
- * vectors in camera coordinates; linear light; output is float RGBA
- * whatever the precision. */
+ * vectors in camera coordinates; linear light; output is float RGBA whatever the precision,
+ * in four planes of n_items floats (red, green, blue, alpha): the host's images keep their
+ * channels in planes (pipeline/store.py), and files a tile's plane by plane in whole rows. */
+
+/* pixel i's colour v into the four planes */
+inline void put_rgba(__global float *rgba, size_t i, int n_items, float4 v)
+{
+    rgba[i] = v.x;
+    rgba[i + (size_t)n_items] = v.y;
+    rgba[i + 2 * (size_t)n_items] = v.z;
+    rgba[i + 3 * (size_t)n_items] = v.w;
+}
 
 __kernel void shade(const int n_items, __global const int *status, __global const real4 *normal,
                     __global const real4 *point, const real4 eye, const real4 right,
@@ -24,10 +34,10 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
                     const int n_lut, const float fog, const float fog_start,
                     __global const real4 *lights_geo, __global const float4 *lights_rgb,
                     __global const float4 *vis_extra, __global const float4 *refl,
-                    const float reflection, __global float4 *rgba)
+                    const float reflection, __global float *rgba)
 {
     size_t i = get_global_id(0);
-    HITS_ONLY(i, n_items, status, rgba[i] = (float4)(background.xyz, 0.0f));
+    HITS_ONLY(i, n_items, status, put_rgba(rgba, i, n_items, (float4)(background.xyz, 0.0f)));
     real4 pv = point[i] - eye;
     float3 p = (float3)(DOT4(pv, right), DOT4(pv, up), -DOT4(pv, forward));
     /* the hit is the eye itself (camera inside the set, depth 0): no eye-to-point
@@ -92,5 +102,5 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
     float fade = exp(-fog * fmax((float)sqrt(DOT4(pv, pv)) - fog_start, 0.0f));
     rgb = mix(background.xyz, rgb, fade);
 #endif
-    rgba[i] = (float4)(rgb, 1.0f);
+    put_rgba(rgba, i, n_items, (float4)(rgb, 1.0f));
 }

@@ -255,9 +255,10 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
 
 
 def copy_xyz(dst: np.ndarray, src: np.ndarray) -> None:
-    """dst[..., k] = src[..., k] for k < 3: a tile's (h, w, 4) colour or normal into the
-    image's (h, w, 3), one channel at a time (numpy's copy of a [..., :3] slice as one
-    strided block took 4.5x as long: 1.15 against 0.26 ms for 512x480 pixels)."""
+    """dst[..., k] = src[..., k] for k < 3: a tile's (h, w, 4) colour (shade.cl's planes: whole
+    rows) or normal into the image's (h, w, 3), one channel at a time (numpy's copy of a
+    [..., :3] slice of interleaved values as one strided block took 4.5x as long: 1.15
+    against 0.26 ms for 512x480 pixels)."""
     for k in range(3):
         dst[..., k] = src[..., k]
 

@@ -401,8 +401,8 @@ class TileRunner:
             a = maps[k]
             if k in ("point", "normal"):
                 out[k] = a.view(self.pr.scalar).reshape(*shape, 4)
-            elif k == "rgba":
-                out[k] = a.view(np.float32).reshape(*shape, 4)
+            elif k == "rgba":   # shade.cl's four planes, seen as (ah, aw, 4)
+                out[k] = a.view(np.float32).reshape(4, *shape).transpose(1, 2, 0)
             else:
                 out[k] = a.reshape(shape)
         return out
