@@ -297,6 +297,16 @@ def test_explore_latency_report_runs(tmp_path):
     assert "previews per second while dragging" in md and "Scene size 64x48" in md
 
 
+def test_refill_trial_report_runs(tmp_path):
+    """benchmarks/refill_trial.py, tiny: every queue's row, the same results as one block's."""
+    assert load("refill_trial").main(["--size", "64x48", "--queues", "1,4", "--repeats", "1",
+                                      "--out", str(tmp_path)]) == 0
+    if not (tmp_path / "refill_trial.md").exists():
+        pytest.skip("the march here runs no packets of 16 (the trial's only width)")
+    md = (tmp_path / "refill_trial.md").read_text()
+    assert "commit" in md and md.count("| yes |") == 2
+
+
 @pytest.mark.slow   # eight runs of the whole command, each a process of its own
 def test_command_cost_report_runs(tmp_path):
     assert load("command_cost").main(["--repeats", "1", "--no-big", "--out", str(tmp_path)]) == 0
