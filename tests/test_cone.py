@@ -42,14 +42,16 @@ def test_only_the_estimate_march_of_camera_rays_takes_the_cone():
         assert "CONE_START" not in kernel_config.scene_config(s.with_overrides(over)).defines
 
 
-@pytest.mark.parametrize("lanes", [1] + packet_widths((16,)))
+@pytest.mark.parametrize("lanes,pairs", [(1, False)] + [(w, p) for w in packet_widths((16,)) for p in (False, True)])
 @pytest.mark.parametrize("name", SCENES)
-def test_cone_kernel_matches_reference(name, lanes):
+def test_cone_kernel_matches_reference(name, lanes, pairs):
     """float32 against float64: the same blocks held or not, and t_last within the float32
     rounding of the steps that led there (a block whose last ball sits at the threshold
-    dist = 2 k t may take one step more or less in one of them: at most 2 % of blocks)."""
+    dist = 2 k t may take one step more or less in one of them: at most 2 % of blocks).
+    ``pairs``: two packets of blocks per work-item (-D PACKET_PAIRS), as the render runs it."""
     s = Scene.default().with_overrides(SCENES[name] + ["image.width=161", "image.height=121"])
-    cfg = (kernel_config.march_config(s, lanes) if lanes > 1 else kernel_config.scene_config(s))
+    cfg = (kernel_config.march_config(s, lanes, pairs=pairs) if lanes > 1 else kernel_config.scene_config(s))
+    assert ("PACKET_PAIRS" in cfg.defines) == pairs
     R = Runner(cfg)
     fr = camera_frame(s)
     f, m = s.fractal, s.march
@@ -60,7 +62,7 @@ def test_cone_kernel_matches_reference(name, lanes):
     R("cone_starts", (bw * bh,), np.int32(bw), np.int32(bx0), np.int32(by0), R.vec(fr.position), R.vec(fr.forward),
       R.vec(fr.right), R.vec(fr.up), R.scalar(fr.tan_half_fov), np.int32(W), np.int32(H), R.vec(f.c),
       np.int32(f.max_iter), R.scalar(f.bailout), R.scalar(march_radius(s)), R.scalar(-1), R.scalar(-1),
-      np.int32(m.max_steps), out, lanes=lanes)
+      np.int32(m.max_steps), out, lanes=lanes * (2 if pairs else 1))
     k = out.get().astype(np.float64).reshape(-1, 2)
     t_lo, t_last = cone_starts(fr, W, H, f.c, f.max_iter, f.bailout, march_radius(s), -1.0, -1.0, m.max_steps,
                                formula_of(f), region)

@@ -321,7 +321,7 @@ class TileRunner:
         if self.cone_k is not None:
             bx0, by0, bw, bh = tile.cone_blocks()
             kernels.append(launch(q, self.cone_k, bw * bh, np.int32(bw), np.int32(bx0), np.int32(by0), *self.camera,
-                                  *self.cone_const, bufs["cone"].data, lanes=plan.lanes))
+                                  *self.cone_const, bufs["cone"].data, lanes=plan.lanes * plan.march_packets))
             cone = (bufs["cone"].data, np.int32(bw))
         kernels.append(launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
                               np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const,
