@@ -181,6 +181,31 @@ def test_kept_memory_is_bounded() -> None:
     assert keep.held == 8000                   # 11,000 would pass the bound: let go
 
 
+def test_new_memory_maps_large_images_and_keeps_them() -> None:
+    """store.new_memory: below MAPPED_FROM numpy's memory, from it pages mapped for the image
+    alone (not numpy's, which would ask for huge pages); either is writable memory of the
+    size asked, and a mapped image's memory is kept and comes back like any other."""
+    import mmap
+
+    from pyjulia4d.pipeline.store import MAPPED_FROM, Reuse, new_memory
+
+    small, big = new_memory(4096), new_memory(MAPPED_FROM)
+    assert small.nbytes == 4096 and big.nbytes == MAPPED_FROM and new_memory(0).nbytes == 0
+    assert not isinstance(getattr(small.base, "obj", None), mmap.mmap)
+    if hasattr(mmap, "MAP_ANONYMOUS"):
+        assert isinstance(big.base.obj, mmap.mmap)
+    big[::4096] = 3                            # every page writable
+    assert int(big[::4096].sum()) == 3 * (MAPPED_FROM // 4096)
+    keep = Reuse(keep=2 * MAPPED_FROM)
+    a = keep.empty(MAPPED_FROM).view(np.float32)
+    a[...] = 1.5
+    where = a.__array_interface__["data"][0]
+    del a
+    assert keep.held == MAPPED_FROM
+    b = keep.empty(MAPPED_FROM)
+    assert b.__array_interface__["data"][0] == where and keep.held == 0
+
+
 def test_a_later_render_leaves_an_earlier_result_alone() -> None:
     """Two results alive at once never share memory; a result rendered into kept memory is
     the same as one rendered into new memory."""
