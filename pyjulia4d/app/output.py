@@ -93,8 +93,10 @@ PNG_BAND_ROWS = 64   # rows encoded at a time (write_png)
 
 
 def to_u8(x: np.ndarray) -> np.ndarray:
-    x = np.nan_to_num(np.asarray(x, dtype=np.float32), nan=0.0)
-    return np.rint(np.clip(x, 0.0, 1.0) * 255.0).astype(np.uint8)
+    """Values in [0, 1] (clipped; NaN as 0) as 8-bit integers, rounded (colormap.levels_u8)."""
+    from pyjulia4d.pipeline.colormap import levels_u8
+
+    return levels_u8(x, srgb=False)
 
 
 def to_levels(x: np.ndarray, bits: int) -> np.ndarray:
@@ -110,7 +112,7 @@ def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> n
     ``alpha`` (H, W) in [0, 1]: the colour clipped to [0, 1] and sRGB-encoded (the renderer
     shades in linear light; an EXR keeps it linear), alpha linear; both rounded.  Without
     ``alpha`` (None): (H, W, 3), the colour alone."""
-    from pyjulia4d.pipeline.colormap import linear_to_srgb
+    from pyjulia4d.pipeline.colormap import levels_u8, linear_to_srgb
 
     color = np.asarray(color)
     alpha = None if alpha is None else np.asarray(alpha)
@@ -122,10 +124,14 @@ def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> n
     rgba = np.empty(color.shape[:2] + (3 if alpha is None else 4,), np.uint8 if bits == 8 else np.uint16)
     for r0 in range(0, color.shape[0], PNG_BAND_ROWS):
         band = slice(r0, r0 + PNG_BAND_ROWS)
-        rgba[band, :, :3] = to_levels(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)),
-                                      bits)
+        if bits == 8:   # from tables, the same levels as the transfer function's (levels_u8),
+            for k in range(3):   # a channel at a time: the render's colour lies in planes
+                rgba[band, :, k] = levels_u8(color[band, :, k], srgb=True, total=color.size)
+        else:
+            rgba[band, :, :3] = to_levels(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)),
+                                          bits)
         if alpha is not None:
-            rgba[band, :, 3] = to_levels(alpha[band], bits)
+            rgba[band, :, 3] = levels_u8(alpha[band], False, alpha.size) if bits == 8 else to_levels(alpha[band], bits)
     return rgba
 
 

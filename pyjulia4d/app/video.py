@@ -60,8 +60,7 @@ def read_frame(path: str | os.PathLike) -> np.ndarray:
     if p.suffix.lower() == ".exr":
         import OpenEXR
 
-        from pyjulia4d.pipeline.colormap import linear_to_srgb
-        from pyjulia4d.app.output import to_u8
+        from pyjulia4d.pipeline.colormap import levels_u8
 
         ch = OpenEXR.File(str(p), separate_channels=True).channels()
         if all(f"ViewLayer.Combined.{k}" in ch for k in "RGB"):   # image.exr = "compositing": over black
@@ -70,7 +69,7 @@ def read_frame(path: str | os.PathLike) -> np.ndarray:
             raise OutputError(f"{shown_path(str(p))}: no R, G, B channels to make a video of "
                               f"(rendered with --channels without RGBA)")
         rgb = np.stack([np.asarray(ch[k].pixels, np.float32) for k in "RGB"], axis=-1)
-        return to_u8(linear_to_srgb(np.nan_to_num(rgb, nan=0.0)))
+        return levels_u8(rgb, srgb=True)
     if p.suffix.lower() in (".tif", ".tiff"):   # 8 or 16 bits a channel (image.bits)
         import tifffile
 

@@ -67,10 +67,10 @@ class RenderResult:
 
         from PIL import Image
 
-        from pyjulia4d.pipeline.colormap import linear_to_srgb
-        rgb = np.rint(linear_to_srgb(np.nan_to_num(self.color)) * 255).astype(np.uint8)
-        a = np.rint(np.clip(np.nan_to_num(self.alpha if self.alpha is not None else 1.0), 0, 1) * 255)
-        rgba = np.dstack([rgb, np.broadcast_to(a, rgb.shape[:2]).astype(np.uint8)])
+        from pyjulia4d.pipeline.colormap import levels_u8
+        rgb = levels_u8(self.color, srgb=True)   # the levels a written PNG has (app/output.py)
+        a = levels_u8(self.alpha if self.alpha is not None else np.ones(rgb.shape[:2], np.float32), srgb=False)
+        rgba = np.dstack([rgb, a])
         buf = io.BytesIO()
         Image.fromarray(rgba).save(buf, format="PNG")
         return buf.getvalue()
