@@ -22,10 +22,15 @@ default device's runtime loaded and its context made (the device remembered, so 
 runtime alone, as the command loads it).  Writes benchmarks/results/command_cost.md (a
 section per run: device, date, commit).
 
-    python benchmarks/command_cost.py [--repeats 5] [--big 3840x2160] [--no-big]
+With ``--rev REV`` the second of each pair is the same command from commit REV's tree (a git
+worktree made for the run and removed after) instead of every runtime loaded: this
+checkout's command against an earlier one's, side by side, as ratios.
+
+    python benchmarks/command_cost.py [--repeats 5] [--big 3840x2160] [--no-big] [--rev REV]
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import statistics
 import subprocess
@@ -38,7 +43,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from run_log import append_run, git_commit, utc_now  # noqa: E402
+from run_log import append_run, earlier_tree, git_commit, short_commit, utc_now  # noqa: E402
 from bench_args import Parser, size_of  # noqa: E402
 
 
@@ -70,14 +75,39 @@ def run(args: list[str], env: dict[str, str], cwd: str) -> dict:
     return {"cpu": ru.ru_utime + ru.ru_stime, "wall": wall, "mib": ru.ru_maxrss / 1024, "line": out.strip()}
 
 
+def measure(cases, modes, floor_env: dict[str, str], repeats: int) -> tuple[dict, str]:
+    """Each case in each mode (name, environment), alternating, ``repeats`` times after one
+    untimed run of each, and the floor's stages; {(case or stage, mode or "floor"): runs}."""
+    got: dict[tuple[str, str], list[dict]] = {}
+    device = "?"
+    with tempfile.TemporaryDirectory() as tmp:
+        for _, args in cases:                     # fill the caches, remember the device
+            for _, env in modes:
+                run(["render", *args], env, tmp)
+        for k in range(repeats):
+            for name, args in cases:
+                order = modes if k % 2 == 0 else modes[::-1]
+                for mode, env in order:
+                    r = run(["render", *args], env, tmp)
+                    got.setdefault((name, mode), []).append(r)
+                    device = r["line"].split(" on ", 1)[-1].split(" (", 1)[0]
+            for name, code in FLOOR:
+                got.setdefault((name, "floor"), []).append(run(["-c", code], floor_env, tmp))
+    return got, device
+
+
 def main(argv=None) -> int:
     ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--big", default="3840x2160", help="the large size (WxH)")
     ap.add_argument("--no-big", action="store_true", help="leave out the large renders")
+    ap.add_argument("--rev", help="beside an earlier commit's command (its tree) instead of every runtime loaded")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     bw, bh = (str(v) for v in size_of(a.big, "--big"))
+    rev = None if a.rev is None else short_commit(a.rev)
+    if a.rev is not None and rev is None:
+        ap.error(f"--rev: {a.rev!r} is no commit of this repository")
     cases = [("start-up, 8x6 PNG", ["--width", "8", "--height", "6", "-o", "s.png"]),
              ("640x480 PNG", ["--width", "640", "--height", "480", "-o", "m.png"])]
     if not a.no_big:
@@ -90,31 +120,24 @@ def main(argv=None) -> int:
     base["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), base.get("PYTHONPATH")]))
     every = dict(base, OCL_ICD_VENDORS=runtimes.registered["folder"] or runtimes.SYSTEM_VENDORS,
                  OPENBLAS_NUM_THREADS=str(os.cpu_count() or 1))
-    modes = [("as run", base), ("every runtime", every)]
     floor_env = dict(base, OPENBLAS_NUM_THREADS="1")   # as __main__.py sets it for the command
-    got: dict[tuple[str, str], list[dict]] = {}
-    device = "?"
-    with tempfile.TemporaryDirectory() as tmp:
-        for _, args in cases:                     # fill the caches, remember the device
-            for _, env in modes:
-                run(["render", *args], env, tmp)
-        for k in range(a.repeats):
-            for name, args in cases:
-                order = modes if k % 2 == 0 else modes[::-1]
-                for mode, env in order:
-                    r = run(["render", *args], env, tmp)
-                    got.setdefault((name, mode), []).append(r)
-                    device = r["line"].split(" on ", 1)[-1].split(" (", 1)[0]
-            for name, code in FLOOR:
-                got.setdefault((name, "floor"), []).append(run(["-c", code], floor_env, tmp))
-    rows = ["| case | CPU-s | wall s | peak MiB | CPU-s, every runtime | peak MiB, every runtime | CPU ratio | "
-            "memory ratio |", "|---|---|---|---|---|---|---|---|"]
+    with contextlib.ExitStack() as stack:
+        if rev is None:
+            modes = [("as run", base), ("every runtime", every)]
+        else:   # the same command from the earlier commit's tree, in the same environment
+            tree = stack.enter_context(earlier_tree(rev))
+            modes = [("as run", base), (f"at {rev}", dict(base, PYTHONPATH=os.pathsep.join(
+                filter(None, [str(tree), os.environ.get("PYTHONPATH")]))))]
+        got, device = measure(cases, modes, floor_env, a.repeats)
+    other = modes[1][0]
+    rows = [f"| case | CPU-s | wall s | peak MiB | CPU-s, {other} | wall s, {other} | peak MiB, {other} | CPU ratio | "
+            "wall ratio | memory ratio |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name, _ in cases:
         m = {mode: {q: statistics.median(r[q] for r in got[name, mode]) for q in ("cpu", "wall", "mib")}
              for mode, _ in modes}
-        s, e = m["as run"], m["every runtime"]
-        rows.append(f"| {name} | {s['cpu']:.3f} | {s['wall']:.3f} | {s['mib']:.0f} | {e['cpu']:.3f} | "
-                    f"{e['mib']:.0f} | {s['cpu'] / e['cpu']:.2f} | {s['mib'] / e['mib']:.2f} |")
+        s, e = m["as run"], m[other]
+        rows.append(f"| {name} | {s['cpu']:.3f} | {s['wall']:.3f} | {s['mib']:.0f} | {e['cpu']:.3f} | {e['wall']:.3f} | "
+                    f"{e['mib']:.0f} | {s['cpu'] / e['cpu']:.2f} | {s['wall'] / e['wall']:.2f} | {s['mib'] / e['mib']:.2f} |")
     start = statistics.median(r["cpu"] for r in got[cases[0][0], "as run"])
     rows += ["", f"The start-up's floor (cumulative, against the start-up's {start:.3f} CPU-s):", "",
              "| stage | CPU-s | this stage | share of the start-up |", "|---|---|---|---|"]
@@ -127,7 +150,8 @@ def main(argv=None) -> int:
                 f"{start - before:+.3f} | 100% |")
     table = "\n".join(rows)
     print(table)
-    section = (f"\n## {utc_now()}, {device}, commit {git_commit()}, median of {a.repeats} alternating runs\n\n"
+    section = (f"\n## {utc_now()}, {device}, commit {git_commit()}{'' if rev is None else ' beside ' + rev}, "
+               f"median of {a.repeats} alternating runs\n\n"
                f"{table}\n")
     append_run(a.out / "command_cost.md",
                "# What the whole command costs\n\nWritten by `python benchmarks/command_cost.py` (its docstring "

@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT / "benchmarks") not in sys.path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from run_log import append_run, git_commit, utc_now  # noqa: E402
+from run_log import append_run, earlier_tree, git_commit, short_commit, utc_now  # noqa: E402
 from pyjulia4d.resources import cache_dir  # noqa: E402
 from bench_args import Parser, size_of  # noqa: E402
 
@@ -106,23 +106,15 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")
     over = [f"image.width={w}", f"image.height={h}", *a.set]
-    got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{a.rev}^{{commit}}"], cwd=ROOT,
-                         capture_output=True, text=True)
-    if got.returncode != 0:
+    rev = short_commit(a.rev)
+    if rev is None:
         ap.error(f"--rev: {a.rev!r} is no commit of this repository")
-    rev = got.stdout.strip()
     runs: dict[str, list[dict]] = {"earlier": [], "checkout": []}
-    with tempfile.TemporaryDirectory() as td:
-        tree = Path(td) / "earlier"
-        subprocess.run(["git", "worktree", "add", "--detach", str(tree), rev], cwd=ROOT, check=True,
-                       capture_output=True)
-        try:
-            for k in range(a.repeats):
-                order = [("earlier", tree), ("checkout", ROOT)]
-                for name, path in order if k % 2 == 0 else order[::-1]:
-                    runs[name].append(child(path, a.renders, over, a.png))
-        finally:
-            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, capture_output=True)
+    with earlier_tree(rev) as tree:
+        for k in range(a.repeats):
+            order = [("earlier", tree), ("checkout", ROOT)]
+            for name, path in order if k % 2 == 0 else order[::-1]:
+                runs[name].append(child(path, a.renders, over, a.png))
     names = sorted({k for r in runs["checkout"] for k in r["kernels"]},
                    key=lambda k: -statistics.median(r["kernels"].get(k, 0) for r in runs["checkout"]))
 

@@ -3,9 +3,11 @@ files that grow by one section per run, each rewritten atomically (a temp file r
 over it, as pyjulia4d's own outputs are)."""
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import os
 import subprocess
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -31,3 +33,24 @@ def append_run(path: Path, title: str, section: str) -> None:
     tmp = path.with_name(f".{path.name}.{os.getpid()}")
     tmp.write_text(text)
     os.replace(tmp, path)
+
+
+def short_commit(rev: str) -> str | None:
+    """``rev``'s short commit in this repository, None where it names none."""
+    got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{rev}^{{commit}}"], cwd=ROOT,
+                         capture_output=True, text=True)
+    return got.stdout.strip() if got.returncode == 0 else None
+
+
+@contextlib.contextmanager
+def earlier_tree(rev: str):
+    """A git worktree of commit ``rev`` (short_commit's) in a temporary folder, removed after:
+    the earlier side of a side-by-side run."""
+    with tempfile.TemporaryDirectory() as td:
+        tree = Path(td) / "earlier"
+        subprocess.run(["git", "worktree", "add", "--detach", str(tree), rev], cwd=ROOT, check=True,
+                       capture_output=True)
+        try:
+            yield tree
+        finally:
+            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=ROOT, capture_output=True)

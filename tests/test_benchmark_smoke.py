@@ -314,6 +314,19 @@ def test_command_cost_report_runs(tmp_path):
     assert "| start-up, 8x6 PNG |" in md and "| 640x480 PNG |" in md
 
 
+@pytest.mark.slow   # a git worktree and child processes per commit
+def test_command_cost_beside_an_earlier_commit_runs(tmp_path):
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT,
+                                                     capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout")
+    assert load("command_cost").main(["--repeats", "1", "--no-big", "--rev", "HEAD", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "command_cost.md").read_text()
+    assert " beside " in md and "| 640x480 PNG |" in md and "wall s, at " in md
+
+
 @pytest.mark.slow   # a git worktree and a child process per commit
 def test_commit_ratio_report_runs(tmp_path):
     import shutil
@@ -332,6 +345,7 @@ def test_commit_ratio_report_runs(tmp_path):
     ("peers.py", ["--size", "640x"]),
     ("commit_ratio.py", ["--rev", "no-such-commit"]),
     ("command_cost.py", ["--big", "0x480"]),
+    ("command_cost.py", ["--rev", "no-such-commit", "--no-big"]),
     ("scaling.py", ["--repeats", "3"]),
     ("throughput.py", ["--size", "axb"]),
     ("pov_compare.py", ["--repeats", "many"]),
