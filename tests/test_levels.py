@@ -23,9 +23,9 @@ SPECIAL = np.array([np.nan, -np.nan, np.inf, -np.inf, 0.0, -0.0, 1.0, 0.5, 0.003
                    np.float32)
 
 
-@pytest.mark.parametrize("srgb", [True, False])
-def test_levels_match_the_transfer_function_at_every_step(srgb: bool) -> None:
-    level, thr = u8_tables(srgb)
+def test_levels_match_the_transfer_function_at_every_step() -> None:
+    srgb = True
+    level, thr = u8_tables()
     steps = thr[thr != 0xFFFFFFFF].astype(np.int64)
     # the level climbs 0..255 one step at a time from bucket to bucket; each step lies inside
     # a bucket (its threshold in the table) or exactly at the next bucket's start
@@ -66,18 +66,13 @@ def test_levels_keep_shape_and_take_any_layout() -> None:
 
 
 def test_few_values_take_the_reference_until_the_tables_are_built() -> None:
-    """Below TABLES_FROM values in all, levels come from the reference (building a table
+    """Below TABLES_FROM values in all, levels come from the reference (building the tables
     costs more than converting them); the same levels either way."""
     import pyjulia4d.pipeline.colormap as cm
 
     x = np.linspace(-0.1, 1.1, 1001, dtype=np.float32)
-    built = set(cm.BUILT)
-    try:
-        cm.BUILT.clear()
-        np.testing.assert_array_equal(cm.levels_u8(x), levels_u8_reference(x))
-        assert not cm.BUILT
-        np.testing.assert_array_equal(cm.levels_u8(x, total=TABLES_FROM), levels_u8_reference(x))
-        assert cm.BUILT == {True}
-    finally:
-        cm.BUILT.clear()
-        cm.BUILT.update(built)
+    cm.u8_tables.cache_clear()
+    np.testing.assert_array_equal(cm.levels_u8(x), levels_u8_reference(x))
+    assert cm.u8_tables.cache_info().currsize == 0
+    np.testing.assert_array_equal(cm.levels_u8(x, total=TABLES_FROM), levels_u8_reference(x))
+    assert cm.u8_tables.cache_info().currsize == 1

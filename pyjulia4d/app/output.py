@@ -131,7 +131,7 @@ def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> n
             rgba[band, :, :3] = to_levels(linear_to_srgb(np.nan_to_num(np.asarray(color[band], np.float32), nan=0.0)),
                                           bits)
         if alpha is not None:
-            rgba[band, :, 3] = levels_u8(alpha[band], False, alpha.size) if bits == 8 else to_levels(alpha[band], bits)
+            rgba[band, :, 3] = to_levels(alpha[band], bits)
     return rgba
 
 

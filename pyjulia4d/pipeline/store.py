@@ -39,7 +39,7 @@ def new_memory(nbytes: int) -> np.ndarray:
     numpy asks the kernel for transparent huge pages for every array of 4 MiB or more
     (madvise MADV_HUGEPAGE), and where the system's huge-page defrag setting is "madvise"
     (a common default) the first touch of each such page may wait for the kernel to compact
-    memory: on the development machine 1.15-1.29 s for 500 MiB, where plain pages took 0.20 s
+    memory: on a 2-core Intel Xeon VM 1.15-1.29 s for 500 MiB, where plain pages took 0.20 s
     (0.165 s pre-faulted), so a 3840x2160 render keeping every output spent 1.9 s where the
     same render again in the process took 0.66 s.  An image is written once and read once;
     huge pages buy it nothing."""
