@@ -63,6 +63,10 @@ def test_levels_keep_shape_and_take_any_layout() -> None:
     np.testing.assert_array_equal(got, levels_u8_reference(color))
     x64 = rng.random((5, 7)) * 1.2 - 0.1
     np.testing.assert_array_equal(levels_u8(x64, False), levels_u8_reference(x64, False))
+    for x in (np.float32(0.5), 0.25, np.array(0.75), [0.1, 0.7], np.array([[1, 2], [3, 4]]), np.array([True, False])):
+        got, want = levels_u8(x), levels_u8_reference(x)
+        assert got.shape == want.shape and got.dtype == np.uint8
+        np.testing.assert_array_equal(got, want)
 
 
 def test_few_values_take_the_reference_until_the_tables_are_built() -> None:

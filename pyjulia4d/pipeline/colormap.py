@@ -85,7 +85,8 @@ def levels_u8(x: np.ndarray, srgb: bool = True, total: int | None = None) -> np.
     levels (no power to spare: the reference took 2.1 ms, tables 2.8)."""
     if not srgb or ((np.size(x) if total is None else total) < TABLES_FROM and not u8_tables.cache_info().currsize):
         return levels_u8_reference(x, srgb)
-    b = np.ascontiguousarray(x, np.float32).view(np.uint32)
+    a = np.asarray(x, np.float32)
+    b = (a if a.flags.c_contiguous else a.copy()).view(np.uint32)   # any shape, 0-d too
     level, thr = u8_tables()
     c = np.minimum(b, np.uint32(ONE_BITS))
     k = c >> np.uint32(U8_SHIFT)
