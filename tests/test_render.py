@@ -204,6 +204,53 @@ def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
     assert binary.read_bytes() != b"not a program"
 
 
+def test_programs_never_go_through_pyopencls_cache(tmp_path, monkeypatch):
+    # devices.build builds with cache_dir=False: pyopencl's own binary cache, keyed without the
+    # runtime's settings, once handed Intel's runtime a binary it refused (INVALID_BINARY),
+    # and pyopencl's error path then raised a KeyError; pyjulia4d keeps binaries itself
+    import pyopencl.cache
+    from harness import device
+    from pyjulia4d.opencl import build
+    from pyjulia4d.pipeline import kernel_config
+    from pyjulia4d.opencl.runner import queue_for
+
+    built = pyopencl.cache.create_built_program_from_source_cached
+    seen = []
+
+    def no_cache(*args, cache_dir=None, **kwargs):   # pyopencl passes cache_dir by name
+        seen.append(cache_dir)
+        if cache_dir is not False:
+            raise AssertionError("pyopencl's binary cache was used")
+        return built(*args, cache_dir=cache_dir, **kwargs)
+
+    monkeypatch.setattr(pyopencl.cache, "create_built_program_from_source_cached", no_cache)
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    ctx, _ = queue_for(device())
+    cfg = kernel_config.KernelConfig(kernel_config.probe_config(Scene.default()).pieces, ("PYOPENCL_CACHE_TEST",))
+    build._programs.pop((ctx.int_ptr, cfg), None)
+    prg = build.program(ctx, cfg)
+    assert prg.get_info(cl.program_info.KERNEL_NAMES) and seen and not any(seen)
+    build._programs.pop((ctx.int_ptr, cfg))
+
+
+def test_a_failed_build_leaves_no_file(tmp_path, monkeypatch):
+    # pyopencl saves a failed build's source in a temporary file ("(source saved as ...)");
+    # devices.build removes it (a driver that cannot compile fails every build, the compile
+    # probe's included), and the error still carries the build log
+    import tempfile
+    from harness import device
+    from pyjulia4d.opencl.devices import build
+    from pyjulia4d.opencl.runner import queue_for
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.setattr(tempfile, "tempdir", None)   # gettempdir() reads TMPDIR again
+    ctx, _ = queue_for(device())
+    with pytest.raises(cl.Error) as e:
+        build(cl.Program(ctx, "__kernel void k(__global float *a) { a[0] = no_such_name; }"))
+    assert "no_such_name" in str(e.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_kernels_made_once_per_thread():
     # build.kernel: one kernel object per (program, name) and thread - a kernel holds its
     # arguments from set to enqueue, so two threads rendering at once must not share one -

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import json
+import re
+import tempfile
 import warnings
 from pathlib import Path
 from typing import Callable
@@ -58,10 +60,25 @@ def has_fp64(device: cl.Device) -> bool:
 def build(prg: cl.Program, options=()) -> cl.Program:
     """``prg.build(options)`` without pyopencl's CompilerWarning: Intel's CPU runtime returns a
     build log ("Compilation started ... Device build done") on every successful build,
-    which pyopencl would show as a warning; failures still raise with their log."""
+    which pyopencl would show as a warning; failures still raise with their log.  pyopencl's
+    own binary cache is not used (``cache_dir=False``): pyjulia4d keeps the binaries itself
+    (build.py), and pyopencl's cache, keyed without the runtime's settings, handed back a
+    binary the runtime refused (Intel's, built with another CL_CONFIG_CPU_TARGET_ARCH:
+    INVALID_BINARY), whose error path then failed with a KeyError of its own."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cl.CompilerWarning)
-        return prg.build(options=list(options))
+        try:
+            return prg.build(options=list(options), cache_dir=False)
+        except (cl.Error, RuntimeError) as e:   # pyopencl's RuntimeError is a cl.Error
+            # pyopencl saves a failed build's source in a temporary file it never removes
+            # ("(source saved as /tmp/tmpXXXX.cl)"); the error keeps the build log
+            saved = SAVED_SOURCE.search(str(e))
+            if saved and Path(saved.group(1)).parent == Path(tempfile.gettempdir()):
+                Path(saved.group(1)).unlink(missing_ok=True)
+            raise
+
+
+SAVED_SOURCE = re.compile(r"\(source saved as (\S+\.cl)\)")
 
 
 _PROBE_SOURCE = "__kernel void probe(__global float *a) { a[get_global_id(0)] *= 2.0f; }"
