@@ -32,14 +32,21 @@ SCENES = {
 def test_prediction_within_a_factor_of_3(name, monkeypatch):
     """The probe (about 2048 pixels in 8x8 blocks) against the kernel time of the render
     itself: the issue's bar is a factor of 3; measured here 0.5-2 (README, Performance).
-    These renders are short enough to skip the probe: it is asked for here."""
+    These renders are short enough to skip the probe: it is asked for here.  The probe takes
+    a few milliseconds, so a moment's preemption on a busy machine (the test suite's other
+    worker) moves one prediction by more than that factor (once 0.20 where the same scene
+    gives 0.62 quietly and 0.9-1.2 under steady load): the median of three renders' ratios
+    is held to it."""
     monkeypatch.setattr(calibrate, "SKIP_BELOW_SECONDS", 0.0)
     s = Scene.from_dict({}, SCENES[name])
     render(s, device=device())    # programs built, the framing pass cached out of the timing
-    r = render(s, device=device())
-    p = r.prediction
-    assert p is not None and p.probe_pixels >= 1024
-    assert 1 / 3 <= r.kernel_seconds / p.seconds <= 3, (r.kernel_seconds, p.seconds)
+    ratios = []
+    for _ in range(3):
+        r = render(s, device=device())
+        p = r.prediction
+        assert p is not None and p.probe_pixels >= 1024
+        ratios.append(r.kernel_seconds / p.seconds)
+    assert 1 / 3 <= sorted(ratios)[1] <= 3, ratios
 
 
 def test_probe_blocks_lie_in_the_region_and_spread_over_it():
