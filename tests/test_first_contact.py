@@ -145,6 +145,21 @@ def test_cpu_runtime_preference(monkeypatch) -> None:
     assert devices.select_device("0:0") is pocl   # an explicit choice stands
 
 
+def test_device_keys_are_made_once_per_device() -> None:
+    """devices.device_key: the same text from a new wrapper of the same device, made once (a
+    driver answered one of its parts in 90 us, asked for every device at each render)."""
+    import pyopencl as cl
+    from pyjulia4d.opencl import devices
+
+    for _, p, d in devices.indexed_devices():
+        key = devices.device_key(d)
+        assert devices._keys[d.int_ptr] == key
+        again = next(x for x in p.get_devices() if x.int_ptr == d.int_ptr)   # a new wrapper
+        assert devices.device_key(again) == key
+        assert key == " | ".join(x.strip() for x in (p.name, p.version, d.name, d.version, d.driver_version))
+    assert not any(isinstance(x, cl.Device) for x in devices._keys)
+
+
 def test_devices_says_the_default_and_the_registration() -> None:
     from pyjulia4d.opencl.devices import describe_devices
 

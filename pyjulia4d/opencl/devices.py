@@ -155,12 +155,23 @@ def cannot_compile(device: cl.Device) -> DeviceError:
                        f"(a CPU unknown to PyPI's PoCL: install Debian's pocl-opencl-icd)")
 
 
+_keys: dict[int, str] = {}
+
+
 def device_key(device: cl.Device) -> str:
     """Platform, platform version, device, device version and driver version: what a
-    cached answer about a device (a program binary, a probed width) is keyed by."""
-    p = device.platform
-    return " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version,
-                                           device.driver_version))
+    cached answer about a device (a program binary, a probed width) is keyed by.  Made once
+    per device and process: PyPI's PoCL 3.0 answers CL_DEVICE_VERSION in 90 us here, and
+    choosing the default device asks for every device's key at each render."""
+    ptr = device.int_ptr if isinstance(device, cl.Device) else None
+    key = _keys.get(ptr) if ptr is not None else None
+    if key is None:
+        p = device.platform
+        key = " | ".join(x.strip() for x in (p.name, p.version, device.name, device.version,
+                                              device.driver_version))
+        if ptr is not None:
+            _keys[ptr] = key
+    return key
 
 
 def describe_devices() -> str:
