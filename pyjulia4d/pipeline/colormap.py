@@ -45,20 +45,21 @@ TABLES_FROM = 1 << 16    # values converted in all, from which levels_u8 builds 
 
 
 @lru_cache(maxsize=None)
-def u8_tables() -> tuple[np.ndarray, np.ndarray]:
+def u8_tables() -> tuple[np.ndarray, np.ndarray] | None:
     """levels_u8's tables of the sRGB levels: for each bucket of 2^U8_SHIFT float32 values in
     [0, 1], the level of its first value (uint8) and the bit pattern of the first value in it
     whose level is one more (uint32; 0xFFFFFFFF where the level does not change inside it).
     The level is a non-decreasing function of the value, and its 255 steps lie far enough
-    apart that a bucket holds at most one (checked here); each step is found by bisection on
-    the bit patterns against ``levels_u8_reference``."""
+    apart that a bucket holds at most one; each step is found by bisection on the bit
+    patterns against ``levels_u8_reference``.  None where the bucket starts and ends show
+    otherwise (a platform whose power rounds differently): the reference is used then."""
     n = (ONE_BITS >> U8_SHIFT) + 1
     starts = np.arange(n, dtype=np.uint32) << U8_SHIFT
     level = levels_u8_reference(starts.view(np.float32))
     ends = np.minimum(starts + np.uint32((1 << U8_SHIFT) - 1), np.uint32(ONE_BITS))
     last = levels_u8_reference(ends.view(np.float32))
     if np.any(last.astype(int) - level > 1) or np.any(np.diff(level.astype(int)) < 0):
-        raise AssertionError("u8_tables: more than one level step in a bucket, or levels not monotone")
+        return None
     thr = np.full(n, 0xFFFFFFFF, np.uint32)
     steps = np.flatnonzero(last > level)           # buckets with a step inside (after their start)
     lo, hi = starts[steps].astype(np.int64), ends[steps].astype(np.int64)   # level(lo) low, level(hi) high
@@ -85,9 +86,12 @@ def levels_u8(x: np.ndarray, srgb: bool = True, total: int | None = None) -> np.
     levels (no power to spare: the reference took 2.1 ms, tables 2.8)."""
     if not srgb or ((np.size(x) if total is None else total) < TABLES_FROM and not u8_tables.cache_info().currsize):
         return levels_u8_reference(x, srgb)
+    tables = u8_tables()
+    if tables is None:
+        return levels_u8_reference(x, srgb)
+    level, thr = tables
     a = np.asarray(x, np.float32)
     b = (a if a.flags.c_contiguous else a.copy()).view(np.uint32)   # any shape, 0-d too
-    level, thr = u8_tables()
     c = np.minimum(b, np.uint32(ONE_BITS))
     k = c >> np.uint32(U8_SHIFT)
     out = level[k]
