@@ -206,6 +206,20 @@ def test_new_memory_maps_large_images_and_keeps_them() -> None:
     assert b.__array_interface__["data"][0] == where and keep.held == 0
 
 
+def test_new_zeros_are_zeros_of_the_shape_asked() -> None:
+    """store.new_zeros: np.zeros, in pages of its own from MAPPED_FROM bytes on."""
+    from pyjulia4d.pipeline.store import MAPPED_FROM, new_zeros
+
+    for shape in ((0, 3), (7, 5, 3), (MAPPED_FROM // 12 + 1, 3)):
+        for dtype in (np.float32, np.int32):
+            z = new_zeros(shape, dtype)
+            assert z.shape == shape and z.dtype == dtype and z.flags.writeable and z.flags.c_contiguous
+            assert not z.any()
+            if z.size:
+                z.flat[-1] = 1
+                assert z.sum() == 1
+
+
 def test_a_later_render_leaves_an_earlier_result_alone() -> None:
     """Two results alive at once never share memory; a result rendered into kept memory is
     the same as one rendered into new memory."""

@@ -27,7 +27,7 @@ from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.pipeline.plan import TILE, Plan, Tile, check_flag, check_lanes, check_tile, make_plan, make_tiles
 from pyjulia4d.pipeline.progress import Progress, silent
 from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
-from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore
+from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore, new_zeros
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
@@ -181,8 +181,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
         # around it (flags of border pixels look outside the region), as the flags take them
         ex0, ey0 = max(0, rx - 1), max(0, ry - 1)
         ex1, ey1 = min(IW, rx + W + 1), min(IH, ry + H + 1)
-        centre_c = np.zeros((ey1 - ey0, ex1 - ex0, 3), np.float32) if plan.shades else None
-        centre_a = np.zeros((ey1 - ey0, ex1 - ex0), np.float32)
+        centre_c = new_zeros((ey1 - ey0, ex1 - ex0, 3), np.float32) if plan.shades else None
+        centre_a = new_zeros((ey1 - ey0, ex1 - ex0), np.float32)
 
         def note(t: Tile, got: dict[str, np.ndarray]) -> None:
             rows, cols = t.dst()
@@ -220,8 +220,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
                                               max(t.n for t in plan.tiles))
                 bar.set_total(W * H + sum(t.w * t.h for t in ring) + S * sum(t.w * t.h for t in tiles))
             crunner = TileRunner(dataclasses.replace(cplan, tiles=tiles), dev) if tiles else None
-            acc_c = np.zeros((H, W, 3), np.float32) if "color" in keep else None
-            acc_a = np.zeros((H, W), np.float32)
+            acc_c = new_zeros((H, W, 3), np.float32) if "color" in keep else None
+            acc_a = new_zeros((H, W), np.float32)
 
             def add(t: Tile, got: dict[str, np.ndarray]) -> None:
                 own, dst = t.own(), at(t)
@@ -233,16 +233,20 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
                 _run_tiles(crunner, tiles, add, kernel_events, bar, sample=k, samples=S)
             if crunner is not None:
                 crunner.close()
+            # the means in place: no image-sized temporaries, whose first touch is new memory's
+            if acc_c is not None:
+                np.divide(acc_c, S, out=acc_c)
+            np.divide(acc_a, S, out=acc_a)
             if flags is None:
                 if acc_c is not None:
-                    img["color"] = acc_c / S
+                    img["color"] = acc_c
                 if "alpha" in keep:
-                    img["alpha"] = acc_a / S
+                    img["alpha"] = acc_a
             else:
                 if acc_c is not None:
-                    img["color"] = np.where(flags[..., None], acc_c / S, img["color"])
+                    np.copyto(img["color"], acc_c, where=flags[..., None])
                 if "alpha" in keep:
-                    img["alpha"] = np.where(flags, acc_a / S, img["alpha"])
+                    np.copyto(img["alpha"], acc_a, where=flags)
 
     result = RenderResult(
         color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),

@@ -43,13 +43,28 @@ def new_memory(nbytes: int) -> np.ndarray:
     (0.165 s pre-faulted), so a 3840x2160 render keeping every output spent 1.9 s where the
     same render again in the process took 0.66 s.  An image is written once and read once;
     huge pages buy it nothing."""
+    got = _mapped_pages(nbytes)
+    return np.empty(nbytes, np.uint8) if got is None else got
+
+
+def new_zeros(shape: tuple, dtype) -> np.ndarray:
+    """``np.zeros(shape, dtype)`` in new_memory's pages where it is 4 MiB or more (new anonymous
+    pages are zeros already): the antialiasing passes' sums and their centre image."""
+    dtype = np.dtype(dtype)
+    got = _mapped_pages(int(np.prod(shape)) * dtype.itemsize)
+    return np.zeros(shape, dtype) if got is None else got.view(dtype).reshape(shape)
+
+
+def _mapped_pages(nbytes: int) -> np.ndarray | None:
+    """``nbytes`` (uint8) of anonymous private pages, pre-faulted where the system can, zero;
+    None below MAPPED_FROM, or where they cannot be mapped."""
     flags = getattr(mmap, "MAP_PRIVATE", 0) | getattr(mmap, "MAP_ANONYMOUS", 0)
     if nbytes < MAPPED_FROM or not flags:
-        return np.empty(nbytes, np.uint8)
+        return None
     try:
         m = mmap.mmap(-1, nbytes, flags=flags | getattr(mmap, "MAP_POPULATE", 0))
     except OSError:   # no room for it all at once, or a system without those flags
-        return np.empty(nbytes, np.uint8)
+        return None
     return np.frombuffer(m, np.uint8)   # the array holds the map; unmapped when it dies
 
 
