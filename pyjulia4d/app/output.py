@@ -113,7 +113,7 @@ def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> n
     shades in linear light; an EXR keeps it linear), alpha linear; both rounded.  Without
     ``alpha`` (None): (H, W, 3), the colour alone."""
     from pyjulia4d.pipeline.colormap import levels_u8, linear_to_srgb
-    from pyjulia4d.pipeline.store import new_memory
+    from pyjulia4d.pipeline.store import new_empty
 
     color = np.asarray(color)
     alpha = None if alpha is None else np.asarray(alpha)
@@ -122,11 +122,9 @@ def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> n
                          f"{None if alpha is None else alpha.shape}")
     # in bands of rows: the float64 temporaries of the transfer function on a whole 3840x2160
     # image took 800 MB (a PNG render's peak was 1.16 GB); a band's are a few MB
-    shape = color.shape[:2] + (3 if alpha is None else 4,)
-    dtype = np.dtype(np.uint8 if bits == 8 else np.uint16)
-    # pages of its own past 4 MiB (store.new_memory: numpy's huge pages took 70-80 ms to first
+    # pages of its own past 4 MiB (store.new_empty: numpy's huge pages took 70-80 ms to first
     # touch for a 3840x2160 image here, plain pages 12 ms)
-    rgba = new_memory(int(np.prod(shape)) * dtype.itemsize).view(dtype).reshape(shape)
+    rgba = new_empty(color.shape[:2] + (3 if alpha is None else 4,), np.uint8 if bits == 8 else np.uint16)
     for r0 in range(0, color.shape[0], PNG_BAND_ROWS):
         band = slice(r0, r0 + PNG_BAND_ROWS)
         if bits == 8:   # from tables, the same levels as the transfer function's (levels_u8),

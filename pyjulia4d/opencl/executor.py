@@ -236,7 +236,8 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
             # the means in place: no image-sized temporaries, whose first touch is new memory's
             if acc_c is not None:
                 np.divide(acc_c, S, out=acc_c)
-            np.divide(acc_a, S, out=acc_a)
+            if "alpha" in keep:
+                np.divide(acc_a, S, out=acc_a)
             if flags is None:
                 if acc_c is not None:
                     img["color"] = acc_c

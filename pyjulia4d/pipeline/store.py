@@ -47,12 +47,23 @@ def new_memory(nbytes: int) -> np.ndarray:
     return np.empty(nbytes, np.uint8) if got is None else got
 
 
+def new_empty(shape: tuple, dtype) -> np.ndarray:
+    """``np.empty(shape, dtype)`` in new_memory's pages where it is 4 MiB or more: a picture's
+    levels (app/output.py)."""
+    return _new_array(shape, dtype, np.empty)
+
+
 def new_zeros(shape: tuple, dtype) -> np.ndarray:
     """``np.zeros(shape, dtype)`` in new_memory's pages where it is 4 MiB or more (new anonymous
     pages are zeros already): the antialiasing passes' sums and their centre image."""
+    return _new_array(shape, dtype, np.zeros)
+
+
+def _new_array(shape: tuple, dtype, numpys) -> np.ndarray:
+    """An array of ``shape`` in _mapped_pages, else numpy's (``numpys``: np.empty or np.zeros)."""
     dtype = np.dtype(dtype)
     got = _mapped_pages(int(np.prod(shape)) * dtype.itemsize)
-    return np.zeros(shape, dtype) if got is None else got.view(dtype).reshape(shape)
+    return numpys(shape, dtype) if got is None else got.view(dtype).reshape(shape)
 
 
 def _mapped_pages(nbytes: int) -> np.ndarray | None:
