@@ -392,3 +392,19 @@ def test_mandelbulber_depth_reads_to_the_mathematics(tmp_path):
 
     hit = np.isfinite(mb.render_depth(ro, text, mb.peers.MB_CPU, tmp_path))
     assert 0.2 < hit.mean() < 0.6 and not hit[0, 0]   # the set, and not the reference spheres
+
+
+def test_gpu_check_stops_without_a_gpu(tmp_path):
+    # benchmarks/gpu_check.sh on a machine with no OpenCL GPU: the devices listed, one line
+    # saying why nothing ran, status 3 (a GPU machine runs the checks instead)
+    import os
+    import pyopencl as cl
+
+    if any(d.type & cl.device_type.GPU for p in cl.get_platforms() for d in p.get_devices()):
+        pytest.skip("an OpenCL GPU is here: the script would run its checks")
+    env = dict(os.environ, PY=sys.executable, OUT=str(tmp_path))
+    p = subprocess.run(["bash", str(ROOT / "benchmarks" / "gpu_check.sh")], env=env, capture_output=True,
+                       text=True, timeout=120)
+    assert p.returncode == 3, p.stdout + p.stderr
+    assert "gpu_check: no OpenCL GPU found" in p.stdout
+    assert "(default)" in (tmp_path / "devices.txt").read_text()

@@ -229,7 +229,9 @@ def test_programs_never_go_through_pyopencls_cache(tmp_path, monkeypatch):
     cfg = kernel_config.KernelConfig(kernel_config.probe_config(Scene.default()).pieces, ("PYOPENCL_CACHE_TEST",))
     build._programs.pop((ctx.int_ptr, cfg), None)
     prg = build.program(ctx, cfg)
-    assert prg.get_info(cl.program_info.KERNEL_NAMES) and seen and not any(seen)
+    # drivers that cache builds themselves (PoCL, NVIDIA's: pyopencl.characterize.has_src_build_cache)
+    # are built by pyopencl without its cache function at all
+    assert prg.get_info(cl.program_info.KERNEL_NAMES) and all(c is False for c in seen)
     build._programs.pop((ctx.int_ptr, cfg))
 
 
