@@ -10,7 +10,9 @@ each renderer runs at several settings, and each setting's error is measured:
 * The scenes: ``matched`` is ``peers.py``'s POV-Ray scene (pyjulia4d's default scene at 640x480,
   a shadowless light at the eye) and ``max_iter 20``, the same at ``max_iteration 20``;
   ``hypercomplex sqr`` and ``documentation example`` (POV-Ray's own quaternion example, seed
-  003, written at precision 15) are ``pov_compare.py``'s.  pyjulia4d renders what ``import-pov`` makes of
+  003, written at precision 15) are ``pov_compare.py``'s, as are ``hypercomplex cube``, ``exp``,
+  ``sin``, ``ln`` and ``pwr(2, 0.5)`` (settings_for: where a pair has no distance estimate,
+  the scans and the proven march, with coarser scans besides).  pyjulia4d renders what ``import-pov`` makes of
   each, so both render the same truncated set (POV-Ray's escape radius and iteration count).
 * The truth: ``measure.truth.brute_force_depth`` (float64, a chord scan at 2e-4 through the
   bounding ball, a scan at 2e-6 over the chord before the first inside sample, bisection) on
@@ -51,7 +53,7 @@ each renderer runs at several settings, and each setting's error is measured:
 For each peer's row the table names the fastest pyjulia4d row at least as good, and the ratio
 of the two rates.  Writes benchmarks/results/peer_error.md (a section per run) and
 peer_error.png (peer_error_default_look.png with ``--look default``; Mandelbulber2's scenes in
-peer_error_mandelbulber2.png): wrong pixels against CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
+peer_error_mandelbulber2.png, the other hypercomplex functions in peer_error_functions.png): wrong pixels against CPU-seconds, a panel per scene.  POV-Ray is skipped with a message where it is not installed.
 
     python benchmarks/peer_error.py [--scenes all] [--samples 4000] [--repeats 3] [--look default]
     python benchmarks/peer_error.py --scenes Mandelbulber2     # its two scenes alone
@@ -119,6 +121,26 @@ SETTINGS = {
                                   "march.post_steps=8"],
     "draft (proven)": ["march.quality=draft"],
 }
+# where the pair has no distance estimate, coarser scans besides (POV-Ray's step at precision 20
+# is 0.05, a tenth to a twentieth of these scenes' chords)
+FIXED_SETTINGS = {
+    "fixed, z 25, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=25",
+                                 "march.post_steps=8"],
+    "fixed, z 50, 8 bisection steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=50",
+                                       "march.post_steps=8", "march.refine=bisect"],
+    "fixed, z 100, 8 bisection steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=100",
+                                        "march.post_steps=8", "march.refine=bisect"],
+}
+
+
+def settings_for(scene) -> dict[str, list[str]]:
+    """SETTINGS that the scene's pair renders: without a distance estimate, the scans and the
+    proven march, and FIXED_SETTINGS' coarser scans."""
+    from pyjulia4d.fractal.registry import has_distance_estimate
+
+    if has_distance_estimate(scene.fractal):
+        return dict(SETTINGS)
+    return {**{k: v for k, v in SETTINGS.items() if "march.method=de" not in v}, **FIXED_SETTINGS}
 
 
 def pov_matched(w: int, h: int, precision: float) -> str:
@@ -139,6 +161,12 @@ def pov_documentation(w: int, h: int, precision: float) -> str:
 
 SCENES = {"matched": pov_matched, "max_iter 20": pov_max_iter, "hypercomplex sqr": pov_hypercomplex,
           "documentation example": pov_documentation}
+# pov_compare.py's other hypercomplex functions, at its defaults but for precision; most have no
+# distance estimate, so the distance-estimate settings are left out there (settings_for)
+FUNCTIONS = ("hypercomplex cube", "hypercomplex exp", "hypercomplex sin", "hypercomplex ln",
+             "hypercomplex pwr(2, 0.5)")
+for _name in FUNCTIONS:
+    SCENES[_name] = (lambda w, h, precision, n=_name: pov_compare.pov_text(n, precision=precision))
 ALL = list(SCENES) + list(mb_depth.SCENES)
 LIT = ("matched", "max_iter 20")   # the scenes --look default lights (peers.py's point light)
 LOOK: list[str] = []               # --look default: pyjulia4d's soft shadows and occlusion
@@ -310,12 +338,13 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
                                          np.hstack([dirs[idx], np.zeros((n, 1))]))
             rows.update({k: errors(v, idx, mb_truth, footprint(mb_truth, scene, h)) for k, v in depths.items()})
         timers.update({k: (lambda over=over: mb_depth.cpu_seconds(name, w, h, tmp, over)) for k, over in overs.items()})
-    times: dict[str, list[float]] = {k: [] for k in list(rows) + list(SETTINGS)}
+    settings = settings_for(scene)
+    times: dict[str, list[float]] = {k: [] for k in list(rows) + list(settings)}
     device = "?"
     for _ in range(repeats):   # alternate, so the shared machine's load falls on all alike
         for k, timed in timers.items():
             times[k].append(timed())
-        for k, over in SETTINGS.items():
+        for k, over in settings.items():
             r = run_pyjulia4d(toml, LOOK + over, tmp / "depth.npy", renders)
             device = r["device"]
             times[k].append(r["cpu"])
@@ -338,12 +367,12 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
         print(lines[-1], flush=True)
     peer_rows = [k for k in rows if k.startswith(PEERS)]
     if peer_rows:
-        default = next(iter(SETTINGS))
+        default = next(iter(settings))
         lines += ["", "| peer's row | fastest pyjulia4d setting at least as good | rate / the peer's "
                   "| pyjulia4d's default: rate / the peer's | its wrong pixels (0.1 px) / the peer's |",
                   "|---|---|---|---|---|"]
         for k in peer_rows:
-            good = [s for s in SETTINGS if as_good(rows[s], rows[k])]
+            good = [s for s in settings if as_good(rows[s], rows[k])]
             best = max(good, key=lambda s: rows[s]["rate"]) if good else None
             ratio = f"{rows[best]['rate'] / rows[k]['rate']:.2f}" if best else "-"
             wrong = (f"{rows[default]['wrong01'] / rows[k]['wrong01']:.2f}" if rows[k]["wrong01"] > 0 else "-")
@@ -418,7 +447,8 @@ def main(argv=None) -> int:
     print(f"wrote {md}")
     # POV-Ray's scenes and Mandelbulber2's each have their own plot, so a run of one leaves the other's
     stem = "peer_error" if a.look == "matched" else "peer_error_default_look"
-    for suffix, panels in (("", {n: r for n, r in plotted.items() if n not in mb_depth.SCENES}),
+    for suffix, panels in (("", {n: r for n, r in plotted.items() if n not in (*mb_depth.SCENES, *FUNCTIONS)}),
+                           ("_functions", {n: r for n, r in plotted.items() if n in FUNCTIONS}),
                            ("_mandelbulber2", {n: r for n, r in plotted.items() if n in mb_depth.SCENES})):
         if panels:
             png = a.out / f"{stem}{suffix}.png"
@@ -462,10 +492,10 @@ def write_plot(path: Path, scenes: dict[str, dict[str, dict]], title: str) -> No
                             xytext=(3, 3), textcoords="offset points", color="tab:red")
         ax.plot([r["cpu"] for _, r in ours], [100 * r["wrong01"] for _, r in ours], "s", color="tab:blue",
                 ms=4, label="pyjulia4d, its march settings")
-        r0 = ours[0][1]   # SETTINGS' first: the scene's default
+        r0 = ours[0][1]   # settings_for's first: the scene's default
         ax.plot([r0["cpu"]], [100 * r0["wrong01"]], "*", color="tab:blue", ms=12, label="pyjulia4d's default")
         ax.set_xscale("log")
-        ax.xaxis.set_major_locator(FixedLocator([0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10]))
+        ax.xaxis.set_major_locator(FixedLocator([0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10]))
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_title(name, fontsize=8)

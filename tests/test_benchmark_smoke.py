@@ -144,6 +144,27 @@ def test_peer_error_counts_wrong_pixels():
     assert pe.as_good(e, e) and not pe.as_good(e, dict(e, wrong1=0.5))
 
 
+def test_peer_error_settings_follow_the_pair():
+    """Every setting peer_error.py runs on a scene is one the scene's pair renders: no
+    distance-estimate march where the pair has no estimate (the command refuses it), the
+    coarser scans there instead; the scene's default first (the plot stars it)."""
+    from pyjulia4d.scene.model import Scene
+    from pyjulia4d.scene.checks import SceneError
+
+    pe = load("peer_error")
+    quat = pe.settings_for(Scene.default())
+    assert quat == pe.SETTINGS
+    for fn in ("exp", "sin", "ln", "pwr"):
+        scene = Scene.default().with_overrides(["fractal.algebra=hypercomplex", f"fractal.function={fn}"])
+        got = pe.settings_for(scene)
+        assert next(iter(got)) == next(iter(pe.SETTINGS))
+        assert set(pe.FIXED_SETTINGS) <= set(got) and "draft (proven)" in got
+        for over in got.values():
+            scene.with_overrides(over)   # a SceneError where the pair cannot
+        with pytest.raises(SceneError):
+            scene.with_overrides(pe.SETTINGS["de, epsilon 1e-2"])
+
+
 def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
     """POV-Ray's depth as benchmarks/peer_error.py reads it (a distance pigment in two 16-bit
     channels) against the float64 brute force of the same set: at precision 1000 POV-Ray
