@@ -384,13 +384,14 @@ def test_double_refused_before_any_build(monkeypatch) -> None:
 
 def test_cluster_tiles_record_the_fitted_camera() -> None:
     """render --workers: the result's scene (the header's) is the camera the tiles used."""
+    from harness import device
     from pyjulia4d import render
     from pyjulia4d.app.cluster import render_tiled
 
     scene = Scene.from_dict({"image": {"width": 48, "height": 36}})
-    result, used = render_tiled(None, scene, tile=16)
+    result, used = render_tiled(None, scene, tile=16)   # the tiles' device: PYJULIA4D_DEVICE's, else the default
     assert result.scene == used and not used.camera.fit
-    whole = render(scene)
+    whole = render(scene, device=device())              # the same device: its fit is the same to the bit
     assert whole.scene == used
     assert np.array_equal(whole.color, result.color)
 
