@@ -87,49 +87,43 @@ PRECISIONS = (10, 20, 40, 100)   # POV-Ray's default is 20
 
 PEERS = ("POV-Ray", "Mandelbulber2")
 
+def custom(method: str, epsilon: float | None = None, z: int | None = None, steps: int | None = None,
+           refine: str | None = None) -> list[str]:
+    """A setting's overrides: the march keys given, the quality custom."""
+    over = ["march.quality=custom", f"march.method={method}"]
+    over += [f"march.epsilon={epsilon}"] * (epsilon is not None) + [f"march.z_resolution={z}"] * (z is not None)
+    return over + [f"march.post_steps={steps}"] * (steps is not None) + [f"march.refine={refine}"] * bool(refine)
+
+
 # pyjulia4d's settings: name -> overrides of the imported scene
 SETTINGS = {
     "default (march.quality auto)": [],   # the scene's own: see the section's title
-    "de, epsilon 3e-3": ["march.quality=custom", "march.method=de", "march.epsilon=0.003"],
-    "de, epsilon 1e-2": ["march.quality=custom", "march.method=de", "march.epsilon=0.01"],
-    "de, epsilon 1e-2, 6 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.01",
-                                      "march.post_steps=6"],
-    "de, epsilon 1e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.01",
-                                      "march.post_steps=8"],
-    "de, epsilon 3e-2": ["march.quality=custom", "march.method=de", "march.epsilon=0.03"],
-    "de, epsilon 3e-2, 6 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.03",
-                                      "march.post_steps=6"],
-    "de, epsilon 3e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.03",
-                                      "march.post_steps=8"],
-    "de, epsilon 5e-2, 8 ITP steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
-                                      "march.post_steps=8"],
+    "de, epsilon 3e-3": custom("de", 0.003),
+    "de, epsilon 1e-2": custom("de", 0.01),
+    "de, epsilon 1e-2, 6 ITP steps": custom("de", 0.01, steps=6),
+    "de, epsilon 1e-2, 8 ITP steps": custom("de", 0.01, steps=8),
+    "de, epsilon 3e-2": custom("de", 0.03),
+    "de, epsilon 3e-2, 6 ITP steps": custom("de", 0.03, steps=6),
+    "de, epsilon 3e-2, 8 ITP steps": custom("de", 0.03, steps=8),
+    "de, epsilon 5e-2, 8 ITP steps": custom("de", 0.05, steps=8),
     # bisection: at these epsilons the march's brackets are all about epsilon wide, where
     # ITP converges no faster than bisection and costs two level evaluations more a ray
-    "de, epsilon 3e-2, 8 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.03",
-                                            "march.post_steps=8", "march.refine=bisect"],
+    "de, epsilon 3e-2, 8 bisection steps": custom("de", 0.03, steps=8, refine="bisect"),
     # 7: the fewest steps that bring an epsilon-wide bracket near a tenth of a pixel's footprint
     # (5e-2 / 2^7 = 3.9e-4, against 3.8e-4 to 5.3e-4 at depths 2.5 to 3.5 here)
-    "de, epsilon 5e-2, 7 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
-                                            "march.post_steps=7", "march.refine=bisect"],
-    "de, epsilon 5e-2, 8 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
-                                            "march.post_steps=8", "march.refine=bisect"],
-    "de, epsilon 5e-2, 10 bisection steps": ["march.quality=custom", "march.method=de", "march.epsilon=0.05",
-                                             "march.post_steps=10", "march.refine=bisect"],
-    "fixed, z 50, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=50",
-                                 "march.post_steps=8"],
-    "fixed, z 100, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=100",
-                                  "march.post_steps=8"],
+    "de, epsilon 5e-2, 7 bisection steps": custom("de", 0.05, steps=7, refine="bisect"),
+    "de, epsilon 5e-2, 8 bisection steps": custom("de", 0.05, steps=8, refine="bisect"),
+    "de, epsilon 5e-2, 10 bisection steps": custom("de", 0.05, steps=10, refine="bisect"),
+    "fixed, z 50, 8 ITP steps": custom("fixed", z=50, steps=8),
+    "fixed, z 100, 8 ITP steps": custom("fixed", z=100, steps=8),
     "draft (proven)": ["march.quality=draft"],
 }
 # where the pair has no distance estimate, coarser scans besides (POV-Ray's step at precision 20
 # is 0.05, a tenth to a twentieth of these scenes' chords)
 FIXED_SETTINGS = {
-    "fixed, z 25, 8 ITP steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=25",
-                                 "march.post_steps=8"],
-    "fixed, z 50, 8 bisection steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=50",
-                                       "march.post_steps=8", "march.refine=bisect"],
-    "fixed, z 100, 8 bisection steps": ["march.quality=custom", "march.method=fixed", "march.z_resolution=100",
-                                        "march.post_steps=8", "march.refine=bisect"],
+    "fixed, z 25, 8 ITP steps": custom("fixed", z=25, steps=8),
+    "fixed, z 50, 8 bisection steps": custom("fixed", z=50, steps=8, refine="bisect"),
+    "fixed, z 100, 8 bisection steps": custom("fixed", z=100, steps=8, refine="bisect"),
 }
 
 
