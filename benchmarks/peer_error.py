@@ -87,12 +87,15 @@ PRECISIONS = (10, 20, 40, 100)   # POV-Ray's default is 20
 
 PEERS = ("POV-Ray", "Mandelbulber2")
 
+
 def custom(method: str, epsilon: float | None = None, z: int | None = None, steps: int | None = None,
            refine: str | None = None) -> list[str]:
     """A setting's overrides: the march keys given, the quality custom."""
     over = ["march.quality=custom", f"march.method={method}"]
-    over += [f"march.epsilon={epsilon}"] * (epsilon is not None) + [f"march.z_resolution={z}"] * (z is not None)
-    return over + [f"march.post_steps={steps}"] * (steps is not None) + [f"march.refine={refine}"] * bool(refine)
+    for key, v in (("epsilon", epsilon), ("z_resolution", z), ("post_steps", steps), ("refine", refine)):
+        if v is not None:
+            over.append(f"march.{key}={v}")
+    return over
 
 
 # pyjulia4d's settings: name -> overrides of the imported scene
