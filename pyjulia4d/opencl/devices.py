@@ -292,14 +292,14 @@ def select_device(spec: str | None = None) -> cl.Device:
         for _, _, d in rows:
             if device_type(d) == s.upper():
                 return d
-        raise DeviceError(f"--device {spec!r}: no {s.upper()} device found {hint}")
+        raise DeviceError(f"device {spec!r}: no {s.upper()} device found {hint}")
     for idx, _, d in rows:
         if s == idx:
             return d
     if ":" in s and all(part.strip().isdigit() for part in s.split(":")):
-        raise DeviceError(f"--device {spec!r}: no device with that index {hint}")
+        raise DeviceError(f"device {spec!r}: no device with that index {hint}")
     needle = s.lower()
     for _, p, d in rows:
         if needle and any(needle in n.lower() for n in (p.name, p.vendor, d.name)):
             return d
-    raise DeviceError(f"--device {spec!r}: no matching OpenCL device {hint}")
+    raise DeviceError(f"device {spec!r}: no matching OpenCL device {hint}")
