@@ -1,6 +1,7 @@
 """camera.fit (pyjulia4d/framing.py): a quick first pass frames the set, keeping the view
 direction."""
 import numpy as np
+import pytest
 
 from pyjulia4d.geometry.camera import camera_frame
 from pyjulia4d.pipeline.framing import fit_camera, to_scene
@@ -48,3 +49,35 @@ def test_fit_keeps_the_slice():
         w = r.position[..., 3][r.status == 1]
         assert w.size > 100 and np.allclose(w, d, atol=1e-6)
         assert abs(r.scene.camera.position[3]) < 1e-9 and abs(r.scene.camera.target[3]) < 1e-9
+
+
+
+def test_a_pass_with_one_hit_frames_it_at_a_pixel_of_the_pass():
+    """A set the pass sees in one pixel: the camera goes no nearer than where half that
+    pixel fills the view (it had gone to 1e-6 from its target, a camera with no direction,
+    which the scene's checks refused), and the framed scene renders."""
+    import dataclasses
+    from pyjulia4d.pipeline.framing import MARGIN, PROBE
+
+    s = Scene.default().with_overrides(["camera.fit=true", "image.width=64", "image.height=48"])
+    point = np.array([0.1, -0.2, 0.3, 0.0])
+    seen = {}
+
+    def one_hit(probe, outputs):
+        seen["eye"] = to_world(probe, probe.camera.position)
+        real = render(probe, outputs=outputs)
+        pos = np.full_like(real.position, np.nan)
+        pos[20, 30] = point
+        return dataclasses.replace(real, position=pos)
+
+    fitted, rec = fit_camera(s, one_hit)
+    assert rec["probe_hits"] == 1
+    fr = camera_frame(fitted)
+    eye, target = to_world(fitted, fitted.camera.position), to_world(fitted, fitted.camera.target)
+    np.testing.assert_allclose(target, point, atol=1e-6)
+    tan_v = fr.tan_half_fov
+    z = float((point - seen["eye"]) @ fr.forward)           # the hit's depth in the pass
+    want = z * tan_v / PROBE[1] / (MARGIN * min(tan_v, tan_v * 64 / 48))
+    assert np.linalg.norm(eye - target) == pytest.approx(want, rel=1e-6)
+    r = render(fitted)
+    assert r.scene.camera == fitted.camera

@@ -4,8 +4,9 @@
 The pass looks along the scene's view direction at the whole bounding ball (96 x 72 rays,
 depth and position only); the new target is the centroid of the 4D points it hit and the
 new distance the smallest at which every one of them lies within 90 % of the field of
-view, both turned back into the scene's (slice) coordinates.  A pass that hits nothing
-leaves the camera alone.
+view, but no nearer than where half a pixel of the pass fills it (what the pass cannot
+resolve; a set seen as a single hit is framed at that distance), both turned back into the
+scene's (slice) coordinates.  A pass that hits nothing leaves the camera alone.
 """
 from __future__ import annotations
 
@@ -74,8 +75,13 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     c = centre + sum(((c - centre) @ v) * v for v in (fr.right, fr.up, fr.forward))
     rel = pts - c
     x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
+    # the pass sees the set to within one of its pixels: no nearer than where half a probe
+    # pixel at the hits' depth fills the view (one hit or a few together would otherwise
+    # put the camera on its target, a camera with no direction)
+    half_pixel = float(np.max((pts - eye) @ fr.forward)) * tan_v / PROBE[1]
     dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),
-               float(np.max(np.abs(y) / (MARGIN * tan_v) - z)), 1e-6)
+               float(np.max(np.abs(y) / (MARGIN * tan_v) - z)),
+               half_pixel / (MARGIN * min(tan_v, tan_h)), 1e-6)
     pos = c - dist * fr.forward
     _within_reach(scene, pos, radius, "the framed camera")
     record.update(distance=dist, target=[float(v) for v in c])
