@@ -1,8 +1,8 @@
 """Is every algebra x function pair as accurate as it reports?  Each pair rendered at its
 defaults (camera.fit, the pair's own march) and every pixel's first crossing compared with
 a float64 brute force of the set (measure/truth.brute_force_depth: a chord scan at 2e-4,
-a 2e-6 scan before each first inside sample, bisection).  The render's own inside ends are
-more samples for it (refine_truth): where the float64 set test finds one inside in front of
+a 2e-6 scan before each first inside sample, bisection).  The render's own inside ends, and
+points within four float32 spacings of them, are more samples for it (refine_truth): where the float64 set test finds one inside in front of
 the brute force's crossing, the chord scan stepped over a part there (the cubic locus's
 spikes are thinner than 2e-4), and the crossing is searched again before it; "truth
 refined" counts those pixels.
@@ -73,19 +73,29 @@ def truth_of(s: Scene) -> np.ndarray:
     return brute_force_depth(s, o, d).reshape(h, w)
 
 
+# a render's depth comes back in float32, so its inside end is known to a spacing of t: the
+# truth samples that far either side of it, at an eighth of a spacing (islands of the set
+# thinner than one spacing - dust at max_iter 20 - had been lost between the samples)
+END_SPACINGS = np.arange(-32, 33) / 8
+
+
 def refine_truth(s: Scene, truth: np.ndarray, results) -> tuple[np.ndarray, int]:
-    """The truth with the renders' inside ends (depth + bracket of each hit) as more samples
-    (measure/truth.refine_depth: where the float64 set test finds one inside in front of the
-    truth, the chord scan stepped over a part, and the crossing is searched again before it).
-    Returns (the truth, the pixels it moved)."""
+    """The truth with the renders' inside ends (depth + bracket of each hit, and points
+    within END_SPACINGS float32 spacings of it) as more samples (measure/truth.refine_depth:
+    where the float64 set test finds one inside in front of the truth, the chord scan
+    stepped over a part, and the crossing is searched again before it).  Returns (the truth,
+    the pixels it moved)."""
     w, h = s.image.width, s.image.height
     o, d = ref.generate_rays(camera_frame(s), w, h)
-    out, moved = truth.ravel(), 0
+    out = truth.ravel()
+    before = out.copy()
     for r in results:
-        ends = np.where(r.status == 1, r.depth.astype(np.float64) + r.bracket.astype(np.float64), np.inf).ravel()
-        out, n = refine_depth(s, o, d, out, ends)
-        moved += n
-    return out.reshape(h, w), moved
+        hit = (r.status == 1).ravel()
+        end = (r.depth.astype(np.float64) + r.bracket.astype(np.float64)).ravel()
+        ulp = np.spacing(np.abs(r.depth.astype(np.float32))).astype(np.float64).ravel()
+        for k in (0.0, *END_SPACINGS):
+            out, _ = refine_depth(s, o, d, out, np.where(hit, end + k * ulp, np.inf))
+    return out.reshape(h, w), int(np.count_nonzero(out != before))
 
 
 def measure(scene: Scene, dev) -> dict:
