@@ -93,7 +93,7 @@ def refine_truth(s: Scene, truth: np.ndarray, results) -> tuple[np.ndarray, int]
         hit = (r.status == 1).ravel()
         end = (r.depth.astype(np.float64) + r.bracket.astype(np.float64)).ravel()
         ulp = np.spacing(np.abs(r.depth.astype(np.float32))).astype(np.float64).ravel()
-        for k in (0.0, *END_SPACINGS):
+        for k in END_SPACINGS:   # 0 among them: the inside end itself
             out, _ = refine_depth(s, o, d, out, np.where(hit, end + k * ulp, np.inf))
     return out.reshape(h, w), int(np.count_nonzero(out != before))
 
