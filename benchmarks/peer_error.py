@@ -112,6 +112,10 @@ SETTINGS = {
     # bisection: at these epsilons the march's brackets are all about epsilon wide, where
     # ITP converges no faster than bisection and costs two level evaluations more a ray
     "de, epsilon 3e-2, 8 bisection steps": custom("de", 0.03, steps=8, refine="bisect"),
+    # 5 and 6 leave the bracket at 1.6e-3 and 7.8e-4, 0.3-0.4 and 0.15-0.2 of a pixel's
+    # footprint: the same hits and misses as 7 (the march decides those), coarser depths
+    "de, epsilon 5e-2, 5 bisection steps": custom("de", 0.05, steps=5, refine="bisect"),
+    "de, epsilon 5e-2, 6 bisection steps": custom("de", 0.05, steps=6, refine="bisect"),
     # 7: the fewest steps that bring an epsilon-wide bracket near a tenth of a pixel's footprint
     # (5e-2 / 2^7 = 3.9e-4, against 3.8e-4 to 5.3e-4 at depths 2.5 to 3.5 here)
     "de, epsilon 5e-2, 7 bisection steps": custom("de", 0.05, steps=7, refine="bisect"),
