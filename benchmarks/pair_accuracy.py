@@ -17,7 +17,8 @@ to 0.4 towards z, camera.fit framing what is there.
 
 Per pair: the render's stated p99 error (its bracket behind the depth plus the width in front
 it did not prove empty, result.error_stats)
-and the measured p99 depth error |depth - truth| on the pixels both hit; the silhouette
+and the measured p99 depth error |depth - truth| on the pixels both hit ("-" where no pixel
+is hit by both, a scene that shows nothing: its silhouette alone judges it); the silhouette
 error (pixels hit by one and not the other); the pixels that stepped over the set (the
 truth's crossing in front of the render's depth by more than it states and float32's
 rounding of t).  "As accurate as it reports": p99 error within 2x the stated p99 bracket,
@@ -98,6 +99,11 @@ def refine_truth(s: Scene, truth: np.ndarray, results) -> tuple[np.ndarray, int]
     return out.reshape(h, w), int(np.count_nonzero(out != before))
 
 
+def figure(x: float) -> str:
+    """A table's error figure: two significant digits, "-" for none (no pixel hit)."""
+    return f"{x:.2g}" if np.isfinite(x) else "-"
+
+
 def measure(scene: Scene, dev) -> dict:
     """One scene: render it, brute-force its truth on the render's own rays, compare."""
     t0 = time.perf_counter()
@@ -170,7 +176,7 @@ def main(argv=None) -> int:
             honest += m["honest"]
             runs += 1
             name = f"{algebra} {function}" + (f" (own scene {k}: {' '.join(extra)})" if k else "")
-            row = (f"| {name} | {m['method']} | {m['stated_p99']:.2g} | {m['p99_err']:.2g} | "
+            row = (f"| {name} | {m['method']} | {figure(m['stated_p99'])} | {figure(m['p99_err'])} | "
                    f"{100 * m['silhouette']:.2f} % | {100 * m['stepped']:.2f} % | {'yes' if m['honest'] else 'no'} | "
                    f"{m['render_s']:.2f} | {m['truth_s']:.1f} | {m['truth_moved']} |")
             rows.append(row)

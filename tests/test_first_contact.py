@@ -427,6 +427,48 @@ def test_render_arguments_are_checked(kw, message) -> None:
     assert str(e.value).startswith(message)
 
 
+class Hostile:
+    """An object whose every protocol method fails: a bad argument must still be named in
+    one line, never let the object's own exception through."""
+    def __iter__(self):
+        raise RuntimeError("boom")
+
+    def __eq__(self, other):
+        raise RuntimeError("boom")
+
+    def __hash__(self):
+        return 1
+
+    def __repr__(self):
+        raise RuntimeError("boom")
+
+    def __len__(self):
+        return 4
+
+
+@pytest.mark.parametrize("kw,message", [
+    (dict(region=Hostile()), "region: expected (x0, y0, width, height), whole numbers, got <a Hostile>"),
+    (dict(outputs=Hostile()), "outputs: expected a list of output names"),
+    (dict(outputs=[Hostile(), Hostile()]), "outputs: expected a list of output names"),
+    (dict(tile=Hostile()), "tile: expected a tile side in [1, 8192] pixels, got <a Hostile>"),
+    (dict(lanes=Hostile()), "lanes: expected one of 1, 4, 8, 16 rays per work-item, got <a Hostile>"),
+    (dict(force=Hostile()), "force: expected True or False, got <a Hostile>"),
+])
+def test_hostile_objects_are_named_in_one_line(kw, message) -> None:
+    from pyjulia4d import render
+
+    with pytest.raises(SceneError) as e:
+        render(Scene.default().with_overrides(["image.width=16", "image.height=12"]), **kw)
+    assert str(e.value).startswith(message) and "\n" not in str(e.value)
+
+
+def test_mesh_executor_is_checked_before_it_is_compared() -> None:
+    from pyjulia4d.app.mesh import build_mesh
+
+    with pytest.raises(SceneError, match=r"^executor: expected 'opencl' or 'reference', got <a Hostile>"):
+        build_mesh(Scene.default(), resolution=8, executor=Hostile())
+
+
 def test_one_output_name_is_one_output() -> None:
     from pyjulia4d import render
 

@@ -6,9 +6,9 @@
 #define STATUS_HIT 1
 #define STATUS_CAPPED 2   /* the step cap ended the march before a hit or the far plane */
 
-/* Guard flags (nothing clamped without being counted).  The normals kernels write them
- * into the w component of the normal buffer, otherwise 0; the march kernel writes its own
- * flags buffer; the host counts the pixels each fired on (RenderResult.guards). */
+/* Guard flags (nothing clamped without being counted).  The march kernel writes them into
+ * its flags buffer and the normals kernels OR theirs into the same buffer; the host counts
+ * the pixels each fired on (RenderResult.guards). */
 #define GUARD_NORMAL_FALLBACK 1   /* degenerate or non-finite normal replaced by the view axis */
 #define GUARD_JACOBIAN_TINY 2     /* Jacobian iteration stopped: q_n about to underflow (c ~ 0) */
 #define GUARD_ULP_STEP 4          /* de: a step below the spacing of t was raised to one ulp */

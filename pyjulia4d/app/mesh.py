@@ -27,7 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pyjulia4d.pipeline.mesh_plan import MeshPlan, make_mesh_plan
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.model import Scene
 
 FORMATS = {".stl": "stl", ".ply": "ply", ".obj": "obj", ".glb": "glb"}
@@ -97,13 +97,13 @@ def check_walls(walls: bool, resolution: int) -> None:
 def check_smooth(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_SMOOTH:
         raise SceneError("--smooth", f"expected a whole number of smoothing passes in [0, {MAX_SMOOTH}], "
-                                     f"got {value!r}"[:120])
+                                     f"got {show(value, 80)}")
     return value
 
 
 def check_decimate(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= 1.0:
-        raise SceneError("--decimate", f"expected the share of triangles to keep, in (0, 1], got {value!r}"[:120])
+        raise SceneError("--decimate", f"expected the share of triangles to keep, in (0, 1], got {show(value, 80)}")
     return float(value)
 
 
@@ -236,12 +236,12 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
 
 def _executor(plan: MeshPlan, device: Any, executor: str):
     """(sample(k0, nk), vertices(a, b)) of the OpenCL kernels or of their float64 twins."""
+    if not isinstance(executor, str) or executor not in ("opencl", "reference"):
+        raise SceneError("executor", f"expected 'opencl' or 'reference', got {show(executor, 80)}")
     if executor == "reference":
         from pyjulia4d.reference import mesh as twin
 
         return (lambda k0, nk: twin.mesh_sample(plan, k0, nk)), (lambda a, b: twin.mesh_vertices(plan, a, b))
-    if executor != "opencl":
-        raise SceneError("executor", f"expected 'opencl' or 'reference', got {executor!r}"[:100])
     from pyjulia4d.opencl.devices import device_of
     from pyjulia4d.opencl.mesh import MeshRunner
 

@@ -17,7 +17,7 @@ import numpy as np
 from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.fractal.registry import has_distance_estimate, march_method
 
@@ -256,10 +256,10 @@ def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
         return None
     try:
         vals = list(region)
-    except TypeError:
+    except Exception:   # not iterable, or an object whose own iteration fails: not a region either way
         vals = []
     if len(vals) != 4 or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in vals):
-        raise SceneError("region", f"expected (x0, y0, width, height), whole numbers, got {region!r}"[:200])
+        raise SceneError("region", f"expected (x0, y0, width, height), whole numbers, got {show(region, 120)}")
     x0, y0, w, h = (int(v) for v in vals)
     W, H = scene.image.width, scene.image.height
     if not (0 <= x0 and 0 <= y0 and w >= 1 and h >= 1 and x0 + w <= W and y0 + h <= H):
@@ -275,21 +275,21 @@ def check_lanes(lanes) -> int:
     """``lanes``: one of LANE_COUNTS (an int, not a bool)."""
     if isinstance(lanes, bool) or not isinstance(lanes, int) or lanes not in LANE_COUNTS:
         raise SceneError("lanes", f"expected one of {', '.join(map(str, LANE_COUNTS))} rays per work-item, "
-                                  f"got {lanes!r}"[:200])
+                                  f"got {show(lanes, 120)}")
     return lanes
 
 
 def check_tile(tile) -> int:
     """``tile``: a whole number of pixels in [1, MAX_TILE]."""
     if isinstance(tile, bool) or not isinstance(tile, int) or not 1 <= tile <= MAX_TILE:
-        raise SceneError("tile", f"expected a tile side in [1, {MAX_TILE}] pixels, got {tile!r}"[:200])
+        raise SceneError("tile", f"expected a tile side in [1, {MAX_TILE}] pixels, got {show(tile, 120)}")
     return tile
 
 
 def check_flag(name: str, value) -> bool:
     """A yes/no argument of render(): True or False only (a string "no" would be true)."""
     if not isinstance(value, bool):
-        raise SceneError(name, f"expected True or False, got {value!r}"[:200])
+        raise SceneError(name, f"expected True or False, got {show(value, 120)}")
     return value
 
 

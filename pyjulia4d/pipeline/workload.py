@@ -171,7 +171,7 @@ def resolve_outputs(outputs) -> frozenset[str]:
         outputs = [outputs]
     try:
         names = set(outputs)
-    except TypeError:   # not iterable, or unhashable items
+    except Exception:   # not iterable, unhashable items, or an object whose own iteration fails
         raise SceneError("outputs", f"expected a list of output names ({', '.join(OUTPUTS)}), got "
                                     f"{type(outputs).__name__}") from None
     if not all(isinstance(n, str) for n in names):

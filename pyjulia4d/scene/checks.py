@@ -69,6 +69,8 @@ def show(v: Any, limit: int = 60) -> str:
         s = f"<an integer of ~{int(v.bit_length() * math.log10(2)) + 1} digits>"
     except RecursionError:  # a deeply nested list
         s = f"<a deeply nested {type(v).__name__}>"
+    except Exception:  # an object whose own __repr__ fails: its type is all there is to show
+        s = f"<a {type(v).__name__}>"
     return s if len(s) <= limit else s[: limit - 3] + "..."
 
 
