@@ -24,6 +24,19 @@ NAME_MAX, PATH_MAX = 255, 4096
 _HELD = tuple(getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s))
 
 
+def path_text(path: object) -> str | None:
+    """A path given from Python as its text: a str, or an os.PathLike whose ``__fspath__``
+    gives one; None for anything else (bytes, an int - which open() would take as a file
+    descriptor -, None, an object whose ``__fspath__`` fails), which the caller refuses."""
+    if not isinstance(path, (str, os.PathLike)):
+        return None
+    try:
+        raw = os.fspath(path)
+    except Exception:   # the object's own __fspath__ failed: not a path either way
+        return None
+    return raw if isinstance(raw, str) else None
+
+
 def shown_path(path: str) -> str:
     """The path as a message shows it: itself when printable, else its repr."""
     return path if path and path.isprintable() else repr(path)

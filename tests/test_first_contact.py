@@ -462,6 +462,42 @@ def test_hostile_objects_are_named_in_one_line(kw, message) -> None:
     assert str(e.value).startswith(message) and "\n" not in str(e.value)
 
 
+def test_hostile_objects_in_the_scene_and_output_interfaces(tmp_path) -> None:
+    from pyjulia4d.app.mesh import build_mesh
+    from pyjulia4d.app.output import OutputError, write_image
+
+    with pytest.raises(SceneError, match=r"^overrides: expected a list of SECTION.KEY=VALUE texts, got <a Hostile>$"):
+        Scene.default().with_overrides(Hostile())
+    with pytest.raises(SceneError, match=r"^--resolution: expected a whole number .* got <a Hostile>$"):
+        build_mesh(Scene.default(), resolution=Hostile())
+    with pytest.raises(OutputError, match=r"^output path: expected a str or an os.PathLike, got Hostile$"):
+        write_image(Hostile(), None)
+
+
+@pytest.mark.parametrize("path", [0, 5, None, b"scene.toml", 2.5])
+def test_a_scene_path_must_be_a_path(path) -> None:
+    """An int would be opened as a file descriptor - and closed after the read: refused
+    before anything is opened; so are bytes, None and other types."""
+    import os
+
+    r, w = os.pipe()
+    try:
+        with pytest.raises(SceneError, match=r"^scene: expected the path of a scene file"):
+            Scene.from_toml(path if path != 5 else r)
+        os.fstat(r)   # still open
+    finally:
+        os.close(r)
+        os.close(w)
+
+
+@pytest.mark.parametrize("path", [5, None, b"/tmp/x.png", ["a.png"]])
+def test_an_output_path_must_be_a_path(path, tmp_path) -> None:
+    from pyjulia4d.app.output import OutputError, write_image
+
+    with pytest.raises(OutputError, match=r"^output path: expected a str or an os.PathLike"):
+        write_image(path, None)
+
+
 def test_mesh_executor_is_checked_before_it_is_compared() -> None:
     from pyjulia4d.app.mesh import build_mesh
 

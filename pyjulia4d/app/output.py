@@ -10,8 +10,8 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from pyjulia4d.files import NAME_MAX, PATH_MAX, RANDOM_CHARS, atomic_write, path_limit, quoted_path, shown_path, \
-    signals_held, temp_affixes
+from pyjulia4d.files import NAME_MAX, PATH_MAX, RANDOM_CHARS, atomic_write, path_limit, path_text, quoted_path, \
+    shown_path, signals_held, temp_affixes
 
 FORMATS = (".png", ".exr", ".tif", ".tiff")
 TIFF = (".tif", ".tiff")
@@ -42,7 +42,9 @@ def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS, what
     """Fail before rendering if ``path`` cannot take the image: its format (one of
     ``formats``: an unsupported ``what`` format), its directory, the length of its name and path
     (the temp file's too), and a temp file really created (and removed) beside it."""
-    raw = os.fspath(path)
+    raw = path_text(path)
+    if raw is None:
+        raise OutputError(f"{what} path: expected a str or an os.PathLike, got {type(path).__name__}")
     shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")

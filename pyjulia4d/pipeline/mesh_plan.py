@@ -17,7 +17,7 @@ import numpy as np
 from pyjulia4d.geometry.camera import set_radius, slice_rotation
 from pyjulia4d.geometry.vec4 import unit
 from pyjulia4d.pipeline.kernel_config import KernelConfig, mesh_config
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.model import Scene
 
 MIN_RESOLUTION, MAX_RESOLUTION = 8, 2048   # grid points a side (--resolution)
@@ -61,7 +61,7 @@ class MeshPlan:
 def check_resolution(value) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or not MIN_RESOLUTION <= value <= MAX_RESOLUTION:
         raise SceneError("--resolution", f"expected a whole number of grid points a side in "
-                                         f"[{MIN_RESOLUTION}, {MAX_RESOLUTION}], got {value!r}"[:160])
+                                         f"[{MIN_RESOLUTION}, {MAX_RESOLUTION}], got {show(value, 80)}")
     return value
 
 

@@ -449,6 +449,10 @@ class Scene:
         fill_preset(raw["march"], keep=set(raw["march"]))
         if isinstance(overrides, str):  # a lone string would be iterated per character
             overrides = [overrides]
+        try:
+            overrides = list(overrides)
+        except Exception:   # not iterable, or an object whose own iteration fails
+            raise SceneError("overrides", f"expected a list of SECTION.KEY=VALUE texts, got {show(overrides)}") from None
         for text in overrides:
             section, key, value = parse_override(text, CHECKS)
             raw[section][key] = value

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any, Mapping
 
+from pyjulia4d.files import path_text
 from pyjulia4d.scene.checks import SceneError, scalar, show, show_key
 
 if sys.version_info >= (3, 11):
@@ -72,9 +73,13 @@ def read_scene_table(path: str | Path) -> dict[str, Any]:
     """The TOML table of a scene file: a bounded read (/dev/zero or a stray multi-gigabyte
     file is refused, not loaded), UTF-8, every failure one SceneError naming the path
     (Scene.from_toml, keyframes.load)."""
-    where = show_key(str(path))
+    raw = path_text(path)
+    if raw is None:   # an int would be opened as a file descriptor, and closed
+        raise SceneError("scene", f"expected the path of a scene file (a str or an os.PathLike), got "
+                                  f"{type(path).__name__}")
+    where = show_key(raw)
     try:
-        with open(path, "rb") as f:
+        with open(raw, "rb") as f:
             data = f.read(MAX_SCENE_BYTES + 1)
     except (OSError, ValueError) as e:  # ValueError: a NUL in the path
         raise SceneError(where, f"cannot read: {getattr(e, 'strerror', None) or e}") from None
