@@ -13,7 +13,7 @@ import signal
 import tempfile
 import threading
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator
 
 # Room left for tempfile's random part of a name (8 characters in CPython today).
 RANDOM_CHARS = 16
@@ -24,17 +24,20 @@ NAME_MAX, PATH_MAX = 255, 4096
 _HELD = tuple(getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, s))
 
 
-def path_text(path: object) -> str | None:
+def path_text(path: object, error: Callable[[str], Exception]) -> str:
     """A path given from Python as its text: a str, or an os.PathLike whose ``__fspath__``
-    gives one; None for anything else (bytes, an int - which open() would take as a file
-    descriptor -, None, an object whose ``__fspath__`` fails), which the caller refuses."""
-    if not isinstance(path, (str, os.PathLike)):
-        return None
-    try:
-        raw = os.fspath(path)
-    except Exception:   # the object's own __fspath__ failed: not a path either way
-        return None
-    return raw if isinstance(raw, str) else None
+    gives one.  Anything else - bytes, an int (which open() would take as a file descriptor,
+    and close), None, an object whose ``__fspath__`` fails - raises ``error(what)``, the
+    caller's own one-line error, told what was given: "a str or an os.PathLike, got int"."""
+    raw = None
+    if isinstance(path, (str, os.PathLike)):
+        try:
+            raw = os.fspath(path)
+        except Exception:   # the object's own __fspath__ failed: not a path either way
+            raw = None
+    if not isinstance(raw, str):
+        raise error(f"a str or an os.PathLike, got {type(path).__name__}")
+    return raw
 
 
 def shown_path(path: str) -> str:

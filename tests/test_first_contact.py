@@ -498,6 +498,56 @@ def test_an_output_path_must_be_a_path(path, tmp_path) -> None:
         write_image(path, None)
 
 
+def _path_calls():
+    from pyjulia4d.app import animation, video
+    from pyjulia4d.app.output import check_output_path
+    from pyjulia4d.interop.povray import writer
+
+    return [(check_output_path, "output path: expected"), (animation.check_pattern, "frame pattern: expected"),
+            (lambda p: animation.strip([p], "sheet.png"), "frame path: expected"),
+            (lambda p: animation.strip([], p), "contact sheet path: expected"),
+            (video.check_video_path, "video path: expected"), (video.read_frame, "frame path: expected"),
+            (writer.import_pov, "POV-Ray scene path: expected"),
+            (lambda p: writer.check_toml_path(p, "a.pov"), "scene file path: expected")]
+
+
+@pytest.mark.parametrize("bad", [3, None, b"a.png", Hostile()], ids=["int", "None", "bytes", "hostile"])
+def test_every_path_argument_takes_a_path(bad) -> None:
+    """Each function of the package that takes a path refuses anything but a str or an
+    os.PathLike in one line of its own error (a ValueError), before it opens anything."""
+    for call, message in _path_calls():
+        with pytest.raises(ValueError) as e:
+            call(bad)
+        assert str(e.value).startswith(message) and "a str or an os.PathLike" in str(e.value), call
+
+
+def test_a_file_that_is_no_frame_is_named(tmp_path) -> None:
+    from pyjulia4d.app.output import OutputError
+    from pyjulia4d.app.video import read_frame
+
+    fake = tmp_path / "frame.png"
+    fake.write_text("not a picture")
+    with pytest.raises(OutputError, match=r"frame.png: cannot read it as a frame \(UnidentifiedImageError"):
+        read_frame(fake)
+    with pytest.raises(OutputError, match=r"missing.png: cannot read it as a frame \(FileNotFoundError"):
+        read_frame(tmp_path / "missing.png")
+
+
+def test_device_and_workers_of_the_wrong_type() -> None:
+    from pyjulia4d.app.cluster import check_workers, worker_device
+    from pyjulia4d.opencl.devices import DeviceError, select_device
+
+    for bad in (3, Hostile(), b"cpu"):
+        with pytest.raises(DeviceError, match=r"^device: expected None or a text"):
+            select_device(bad)
+        with pytest.raises(DeviceError, match=r"^device: expected None or a text"):
+            worker_device(bad)
+    for bad in (Hostile(), 2.5, True, None):
+        with pytest.raises(SceneError, match=r"^--workers: expected a whole number of workers"):
+            check_workers(bad)
+    assert check_workers(3) == 3 and check_workers(" 2 ") == 2
+
+
 def test_mesh_executor_is_checked_before_it_is_compared() -> None:
     from pyjulia4d.app.mesh import build_mesh
 

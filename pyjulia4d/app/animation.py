@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 from pyjulia4d.app.output import OutputError, check_output_path, read_header
-from pyjulia4d.files import NAME_MAX, atomic_write, path_limit, shown_path, temp_affixes
+from pyjulia4d.files import NAME_MAX, atomic_write, path_limit, path_text, shown_path, temp_affixes
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import add_counts
 from pyjulia4d.scene.checks import SceneError
@@ -38,7 +38,7 @@ _HASHES = re.compile(r"#+")
 def check_pattern(pattern: str | os.PathLike) -> str:
     """``-o``: a frame file name with one run of '#', replaced by the zero-padded frame
     number (julia_####.png -> julia_0007.png; wider numbers keep all their digits)."""
-    raw = os.fspath(pattern)
+    raw = path_text(pattern, lambda got: OutputError(f"frame pattern: expected {got}"))
     name = Path(raw).name
     runs = _HASHES.findall(name)
     if len(runs) != 1:
@@ -291,10 +291,12 @@ def strip(files: Sequence[str | os.PathLike], out: str | os.PathLike, columns: i
     import numpy as np
     from PIL import Image
 
-    from pyjulia4d.files import atomic_write
     from pyjulia4d.app.video import read_frame
 
+    out = path_text(out, lambda got: OutputError(f"contact sheet path: expected {got}"))
     imgs = [read_frame(f) for f in files]
+    if not imgs:
+        raise OutputError(f"{shown_path(out)}: no frames for a contact sheet")
     cols = columns or len(imgs)
     rows = math.ceil(len(imgs) / cols)
     h, w = imgs[0].shape[:2]

@@ -30,7 +30,7 @@ import numpy as np
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
 from pyjulia4d.scene.model import Scene
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.resources import module_installed
 
 
@@ -77,6 +77,8 @@ def worker_device(spec: str | None) -> Any:
     <worker name> (one worker per GPU), else the default choice (devices.select_device)."""
     from pyjulia4d.opencl.devices import device_type, list_devices, select_device
 
+    if spec is not None and not isinstance(spec, str):
+        return select_device(spec)   # refuses it in one line
     spec = spec or os.environ.get("PYJULIA4D_DEVICE") or None
     if spec is None:
         name = _worker_name()
@@ -178,11 +180,14 @@ def check_device(device: str | None, scheduler: str | None) -> Any:
 
 
 def check_workers(text: Any) -> int:
-    """--workers N: an integer 0 <= N <= 1024 (0: in this process, no cluster)."""
+    """--workers N: an integer 0 <= N <= 1024 (0: in this process, no cluster); the text of
+    one, or the int."""
+    if isinstance(text, bool) or not isinstance(text, (int, str)):
+        raise SceneError("--workers", f"expected a whole number of workers, got {type(text).__name__}")
     try:
         n = int(str(text).strip())
     except ValueError:
-        raise SceneError("--workers", f"expected a whole number of workers, got {text!r}") from None
+        raise SceneError("--workers", f"expected a whole number of workers, got {show(text)}") from None
     if not 0 <= n <= 1024:
         raise SceneError("--workers", f"must be in [0, 1024], got {n}")
     return n

@@ -42,9 +42,7 @@ def check_output_path(path: str | Path, formats: tuple[str, ...] = FORMATS, what
     """Fail before rendering if ``path`` cannot take the image: its format (one of
     ``formats``: an unsupported ``what`` format), its directory, the length of its name and path
     (the temp file's too), and a temp file really created (and removed) beside it."""
-    raw = path_text(path)
-    if raw is None:
-        raise OutputError(f"{what} path: expected a str or an os.PathLike, got {type(path).__name__}")
+    raw = path_text(path, lambda got: OutputError(f"{what} path: expected {got}"))
     shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")

@@ -16,7 +16,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from pyjulia4d.app.output import OutputError, check_directory
-from pyjulia4d.files import atomic_write, quoted_path, shown_path
+from pyjulia4d.files import atomic_write, path_text, quoted_path, shown_path
 from pyjulia4d.resources import module_installed
 
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
@@ -33,7 +33,7 @@ def have_ffmpeg() -> bool:
 def check_video_path(path: str | os.PathLike) -> Path:
     """Fail before rendering if ``path`` cannot take the video: .mp4 or .webm, in an
     existing, writable directory."""
-    raw = os.fspath(path)
+    raw = path_text(path, lambda got: OutputError(f"video path: expected {got}"))
     shown = shown_path(raw)
     p = Path(raw)
     if not raw or raw.endswith(("/", os.sep)):
@@ -55,8 +55,18 @@ def check_video_path(path: str | os.PathLike) -> Path:
 
 def read_frame(path: str | os.PathLike) -> np.ndarray:
     """A frame file as (H, W, 3) uint8 sRGB: a PNG's or TIFF's RGB, an EXR's R, G, B encoded as
-    output.write_png encodes them."""
-    p = Path(path)
+    output.write_png encodes them.  A file that cannot be read as one is an OutputError naming it."""
+    p = Path(path_text(path, lambda got: OutputError(f"frame path: expected {got}")))
+    try:
+        return _read_rgb(p)
+    except OutputError:
+        raise
+    except Exception as e:   # missing, unreadable, or not an image of that format: the file's fault
+        raise OutputError(f"{shown_path(str(p))}: cannot read it as a frame ({type(e).__name__}: "
+                          f"{' '.join(str(e).split())[:120]})") from None
+
+
+def _read_rgb(p: Path) -> np.ndarray:
     if p.suffix.lower() == ".exr":
         import OpenEXR
 
@@ -91,7 +101,7 @@ def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: floa
     .webm), atomically; returns the number of frames written."""
     import imageio_ffmpeg
 
-    p = Path(path)
+    p = check_video_path(path)
     ext = p.suffix.lower()
     it: Iterator[np.ndarray] = iter(frames)
     first = next(it, None)

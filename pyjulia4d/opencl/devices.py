@@ -271,6 +271,8 @@ def select_device(spec: str | None = None) -> cl.Device:
     Anything else: the first device whose platform name, platform vendor or
     device name contains it (case-insensitive).
     """
+    if spec is not None and not isinstance(spec, str):
+        raise DeviceError(f"device: expected None or a text such as 'cpu', '0:1' or a name, got {type(spec).__name__}")
     rows = indexed_devices()
     if not rows:
         raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")

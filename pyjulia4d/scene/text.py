@@ -73,10 +73,7 @@ def read_scene_table(path: str | Path) -> dict[str, Any]:
     """The TOML table of a scene file: a bounded read (/dev/zero or a stray multi-gigabyte
     file is refused, not loaded), UTF-8, every failure one SceneError naming the path
     (Scene.from_toml, keyframes.load)."""
-    raw = path_text(path)
-    if raw is None:   # an int would be opened as a file descriptor, and closed
-        raise SceneError("scene", f"expected the path of a scene file (a str or an os.PathLike), got "
-                                  f"{type(path).__name__}")
+    raw = path_text(path, lambda got: SceneError("scene", f"expected the path of a scene file, {got}"))
     where = show_key(raw)
     try:
         with open(raw, "rb") as f:

@@ -41,11 +41,12 @@ def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
 
 
 def read_pov(path: str | Path) -> str:
-    from pyjulia4d.files import shown_path
+    from pyjulia4d.files import path_text, shown_path
 
-    where = shown_path(os.fspath(path))
+    raw_path = path_text(path, lambda got: PovError(f"POV-Ray scene path: expected {got}"))
+    where = shown_path(raw_path)
     try:
-        with open(path, "rb") as f:
+        with open(raw_path, "rb") as f:
             raw = f.read(MAX_POV_BYTES + 1)
     except (OSError, ValueError) as e:
         raise PovError(f"{where}: cannot read: {getattr(e, 'strerror', None) or e}") from None
@@ -60,8 +61,12 @@ def read_pov(path: str | Path) -> str:
 
 def import_pov(path: str | Path, width: int | None = None, height: int | None = None) -> Imported:
     """Read ``path`` and map its julia_fractal, camera and light to a pyjulia4d scene."""
-    from pyjulia4d.files import shown_path
+    from pyjulia4d.files import path_text, shown_path
 
+    for key, v in (("width", width), ("height", height)):   # checked before any arithmetic on them
+        if v is not None:
+            Scene.from_dict({"image": {key: v}})
+    path = path_text(path, lambda got: PovError(f"POV-Ray scene path: expected {got}"))
     w, h = DEFAULT_SIZE if width is None and height is None else (width, height)
     if w is None or h is None:  # one given: the other keeps pyjulia4d's aspect ratio
         w = w if w is not None else max(1, round(h * DEFAULT_SIZE[0] / DEFAULT_SIZE[1]))
@@ -86,9 +91,9 @@ def check_toml_path(path: str | Path, source: str | Path) -> Path:
     """Fail before writing if ``path`` cannot take the scene file (output.check_output_path's
     checks, for .toml)."""
     from pyjulia4d.app.output import OutputError, check_directory
-    from pyjulia4d.files import NAME_MAX, path_limit, quoted_path, shown_path
+    from pyjulia4d.files import NAME_MAX, path_limit, path_text, quoted_path, shown_path
 
-    raw = os.fspath(path)
+    raw = path_text(path, lambda got: OutputError(f"scene file path: expected {got}"))
     shown = shown_path(raw)
     if not raw:
         raise OutputError(f"{shown}: empty output path")
