@@ -500,6 +500,7 @@ def test_an_output_path_must_be_a_path(path, tmp_path) -> None:
 
 def _path_calls():
     from pyjulia4d.app import animation, video
+    from pyjulia4d.app.explore.notebook import Explorer
     from pyjulia4d.app.output import check_output_path
     from pyjulia4d.interop.povray import writer
 
@@ -508,7 +509,8 @@ def _path_calls():
             (lambda p: animation.strip([], p), "contact sheet path: expected"),
             (video.check_video_path, "video path: expected"), (video.read_frame, "frame path: expected"),
             (writer.import_pov, "POV-Ray scene path: expected"),
-            (lambda p: writer.check_toml_path(p, "a.pov"), "scene file path: expected")]
+            (lambda p: writer.check_toml_path(p, "a.pov"), "scene file path: expected"),
+            (lambda p: Explorer(folder=p), "--folder: expected")]
 
 
 @pytest.mark.parametrize("bad", [3, None, b"a.png", Hostile()], ids=["int", "None", "bytes", "hostile"])

@@ -11,6 +11,7 @@ keyframes, as the page's do.  Needs ipywidgets (``pip install ipywidgets``).
 """
 from __future__ import annotations
 
+import os
 import threading
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,7 @@ def _scene(scene: Scene | str | Path | None) -> Scene:
         return Scene.from_dict({})
     if isinstance(scene, Scene):
         return scene
-    if not isinstance(scene, (str, Path)):
+    if not isinstance(scene, (str, os.PathLike)):
         raise SceneError("scene", f"expected None, a pyjulia4d.Scene or a scene file's path, got "
                                   f"{type(scene).__name__}")
     return Scene.from_toml(scene)
@@ -41,12 +42,14 @@ class Explorer:
     --device; files are written in ``folder``."""
 
     def __init__(self, scene: Scene | str | Path | None = None, device: Any = None, folder: str | Path = ".") -> None:
+        from pyjulia4d.app.explore.run import check_folder, device_renderer, warm
+
+        folder = check_folder(folder)   # the arguments before ipywidgets, whose import is slow
+        start = _scene(scene)
         import ipywidgets as w
 
-        from pyjulia4d.app.explore.run import device_renderer, warm
-
         render = device_renderer(device)
-        scene = warm(_scene(scene), render)
+        scene = warm(start, render)
         self.image = w.Image(format="png", layout=w.Layout(width="640px"))
         self.facts = w.HTML()
         self.message = w.HTML()

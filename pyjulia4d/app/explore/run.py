@@ -13,6 +13,7 @@ from typing import Any, Callable
 
 from pyjulia4d.app.explore.loop import stages
 from pyjulia4d.app.explore.session import Render
+from pyjulia4d.files import path_text, shown_path
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
@@ -53,10 +54,11 @@ def warm(scene: Scene, render: Render) -> Scene:
     return scene
 
 
-def check_folder(folder: str) -> Path:
-    """--folder: an existing, writable directory."""
+def check_folder(folder: str | os.PathLike) -> Path:
+    """--folder (and the notebook Explorer's folder): an existing, writable directory."""
+    folder = path_text(folder, lambda got: SceneError("--folder", f"expected {got}"))
     p = Path(folder)
-    shown = folder if folder.isprintable() else repr(folder)
+    shown = shown_path(folder)
     if not p.is_dir():
         raise SceneError("--folder", f"{shown}: no such directory")
     try:   # the only exact test of "can a file be made here" is to make one
