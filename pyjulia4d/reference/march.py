@@ -179,18 +179,21 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
     b2 = bailout * bailout
-    e, p = K.enc_start(o, d, t0, t1, c, formula)
-    proven = E.enc_outside(e, b2)
-    live = ~proven
-    best = E.enc_margin(e, bailout)
-    for _ in range(K.enc_steps(max_iter)):
-        if not live.any():
-            break
-        e = K.enc_next(e, p, formula)
-        out = live & E.enc_outside(e, b2)
-        best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
-        proven |= out
-        live &= ~out & E.enc_hopeful(e, bailout)
+    # every ray's form is stepped, the decided ones too: their growth past the float64 range
+    # is an infinite radius, no proof (as in the kernel), not a warning
+    with np.errstate(all="ignore"):
+        e, p = K.enc_start(o, d, t0, t1, c, formula)
+        proven = E.enc_outside(e, b2)
+        live = ~proven
+        best = E.enc_margin(e, bailout)
+        for _ in range(K.enc_steps(max_iter)):
+            if not live.any():
+                break
+            e = K.enc_next(e, p, formula)
+            out = live & E.enc_outside(e, b2)
+            best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
+            proven |= out
+            live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best
 
 
