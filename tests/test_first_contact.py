@@ -550,6 +550,44 @@ def test_device_and_workers_of_the_wrong_type() -> None:
     assert check_workers(3) == 3 and check_workers(" 2 ") == 2
 
 
+@pytest.mark.parametrize("header,message", [
+    (5, "header: expected None or a dict of text entries, got int"),
+    (Hostile(), "header: expected None or a dict of text entries, got Hostile"),
+    ({"k" * 80: "v"}, "header: key 'kkk"),
+    ({"": "v"}, "header: key '': expected 1 to 79 printable Latin-1 characters"),
+    ({"ключ": "v"}, "header: key 'ключ': expected 1 to 79 printable Latin-1"),
+    ({" a": "v"}, "header: key ' a'"),
+    ({"a\x00b": "v"}, "header: key 'a\\x00b'"),
+    ({"a": 1}, "header: a: expected text without NUL"),
+    ({"a": "x\x00"}, "header: a: expected text without NUL"),
+    ({"pyjulia4d.scene": "junk"}, "header: key 'pyjulia4d.scene': the pyjulia4d.* entries are the render's own"),
+])
+@pytest.mark.parametrize("ext", ["png", "exr", "tif"])
+def test_a_saved_images_header_is_checked_before_anything_is_written(header, message, ext, tmp_path) -> None:
+    from pyjulia4d import render
+    from pyjulia4d.app.output import OutputError
+
+    r = render(Scene.default().with_overrides(["image.width=8", "image.height=6"]))
+    with pytest.raises(OutputError) as e:
+        r.save(tmp_path / f"x.{ext}", header=header)
+    assert str(e.value).startswith(message) and "\n" not in str(e.value)
+    assert list(tmp_path.iterdir()) == []
+    r.save(tmp_path / f"x.{ext}", header={"artist": "A. Person", "note": "ünïcode välue"})
+    from pyjulia4d.app.output import read_header
+
+    got = read_header(tmp_path / f"x.{ext}")
+    assert got["artist"] == "A. Person" and got["note"] == "ünïcode välue" and "pyjulia4d.scene" in got
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf"), True, "1e-3", Hostile()])
+def test_a_reports_stated_bound_is_checked(bad) -> None:
+    from pyjulia4d import render
+
+    r = render(Scene.default().with_overrides(["image.width=8", "image.height=6"]))
+    with pytest.raises(SceneError, match=r"^stated_p99: expected None or a positive finite number"):
+        r.report(bad)
+
+
 def test_mesh_executor_is_checked_before_it_is_compared() -> None:
     from pyjulia4d.app.mesh import build_mesh
 

@@ -3,6 +3,7 @@ writers (atomic: pyjulia4d/files.py) and the reader of their headers."""
 from __future__ import annotations
 
 import os
+import re
 import stat
 import tempfile
 from pathlib import Path
@@ -12,6 +13,7 @@ import numpy as np
 
 from pyjulia4d.files import NAME_MAX, PATH_MAX, RANDOM_CHARS, atomic_write, path_limit, path_text, quoted_path, \
     shown_path, signals_held, temp_affixes
+from pyjulia4d.scene.checks import show
 
 FORMATS = (".png", ".exr", ".tif", ".tiff")
 TIFF = (".tif", ".tiff")
@@ -258,12 +260,47 @@ def write_exr(
                 raise OSError(f"OpenImageIO cannot finish the EXR: {out.geterror()}")
 
 
+# a header key as every format can hold it: PNG's keyword rules (1-79 Latin-1 characters,
+# printable, no leading, trailing or double spaces), the strictest of the three
+_HEADER_KEY = re.compile(r"[\x20-\x7e\xa1-\xff]{1,79}")
+MAX_HEADER_VALUE = 1 << 20   # characters
+
+
+def check_header(header: Any, reserved: str = "") -> dict[str, str]:
+    """A header given from Python: None or a mapping of text keys (PNG's keyword rules, which
+    EXR and TIFF also take) to text values (no NUL, at most 1 Mi characters); keys starting
+    with ``reserved`` are the render's own entries and refused.  OutputError, one line, else."""
+    if header is None:
+        return {}
+    if not isinstance(header, Mapping):
+        raise OutputError(f"header: expected None or a dict of text entries, got {type(header).__name__}")
+    try:
+        items = list(header.items())
+    except Exception:   # a mapping whose own items() fails
+        raise OutputError(f"header: its entries cannot be read ({type(header).__name__})") from None
+    out = {}
+    for k, v in items:
+        if not isinstance(k, str) or not _HEADER_KEY.fullmatch(k) or k != k.strip() or "  " in k:
+            raise OutputError(f"header: key {show(k)}: expected 1 to 79 printable Latin-1 characters, no space "
+                              f"at either end or twice")
+        if reserved and k.startswith(reserved):
+            raise OutputError(f"header: key {show(k)}: the {reserved}* entries are the render's own")
+        if not isinstance(v, str) or "\0" in v or len(v) > MAX_HEADER_VALUE:
+            raise OutputError(f"header: {k}: expected text without NUL, at most {MAX_HEADER_VALUE} characters, "
+                              f"got {show(v)}")
+        out[k] = v
+    return out
+
+
 def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None = None,
                 release: Callable[[slice], None] | None = None) -> None:
     """Write a RenderResult as .png or .tif/.tiff (colour + alpha, 8 or 16 bits a channel by
     the scene's image.bits) or .exr (the channels of the scene's image.exr layout:
     exr_layout.py); ``release(rows)`` after each band of an EXR is written (write_exr)."""
     p = check_output_path(path)
+    if not hasattr(result, "color") or not hasattr(result, "alpha"):
+        raise OutputError(f"{shown_path(str(p))}: expected a RenderResult to write, got {type(result).__name__}")
+    header = check_header(header)
     scene = getattr(result, "scene", None)
     bits = scene.image.bits if scene is not None else 8
     try:

@@ -53,11 +53,17 @@ class RenderResult:
                 f"{self.device_name or '?'}, {self.lanes} rays per work-item, outputs {', '.join(kept)})")
 
     def save(self, path, header: dict | None = None) -> None:
-        """Write the image: .png (colour and alpha) or .exr (every output kept), atomically;
-        the header gets this render's report (output.write_image)."""
-        from pyjulia4d.app.output import write_image
-        report, _ = self.report()
-        write_image(path, self, {**report, **(header or {})})
+        """Write the image: .png or .tif (colour and alpha) or .exr (the scene's EXR layout),
+        atomically; the header gets the scene as rendered and this render's report, as the
+        command line writes them (so ``pyjulia4d render`` of the file renders it again), and
+        ``header``'s own text entries (output.check_header; not the pyjulia4d.* ones)."""
+        from pyjulia4d.app.output import check_header, render_header, write_image
+        own = check_header(header, reserved="pyjulia4d.")   # the render's own entries stay its own
+        if self.scene is None:   # a result assembled without its scene: the report alone
+            entries = self.report()[0]
+        else:
+            entries = render_header(self.scene, self)[0]
+        write_image(path, self, {**entries, **own})
 
     def _repr_png_(self) -> bytes | None:
         """The picture, for notebooks (sRGB-encoded 8-bit RGBA)."""
@@ -123,6 +129,11 @@ class RenderResult:
         kernels/march/proven.cl; p50/p99/max) and the pixels left unresolved are never
         hidden; with ``stated_p99`` (the bound a quality preset states) the line says whether
         this render's stated p99 error is within it."""
+        if stated_p99 is not None and (isinstance(stated_p99, bool) or not isinstance(stated_p99, (int, float))
+                                       or not 0 < stated_p99 < math.inf):
+            from pyjulia4d.scene.checks import SceneError, show
+
+            raise SceneError("stated_p99", f"expected None or a positive finite number, got {show(stated_p99)}")
         b = self.bracket_stats()
         e = self.error_stats()
         un = self.unresolved_counts()
