@@ -67,3 +67,22 @@ def test_user_text_cites_papers_not_seeds_nor_issues(doc: Path) -> None:
     text = doc.read_text(encoding="utf-8")
     assert not re.search(r"\bseed 00\d|\b00\d_[0-9a-f]{16}\.txt", text)
     assert not re.search(r"\bissue #?\d+|#\d{1,3}\b(?![0-9a-f])", _strip_code(text))
+
+
+def python_blocks(path: Path) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", path.read_text(encoding="utf-8"), flags=re.S)
+
+
+@pytest.mark.parametrize("doc", [d for d in DOCS if python_blocks(d)], ids=lambda p: p.name)
+def test_python_examples_import_what_exists(doc: Path) -> None:
+    """Each Python example's imports run, and every call on an imported name (a module's
+    function, a class's constructor or method) names something that is there: an example
+    a user copies must not stop at its first line."""
+    for block in python_blocks(doc):
+        names: dict = {}
+        for line in block.splitlines():
+            if re.match(r"^(from \S+ )?import ", line):
+                exec(line.split("#")[0], names)   # noqa: S102 - the docs' own import lines
+        for obj, attr in re.findall(r"\b([A-Za-z_]\w*)\.([A-Za-z_]\w*)\(", block):
+            if obj in names and not obj.startswith("__"):
+                assert hasattr(names[obj], attr), f"{doc.name}: {obj}.{attr} does not exist"
