@@ -40,9 +40,15 @@ def path_text(path: object, error: Callable[[str], Exception]) -> str:
     return raw
 
 
+SHOWN_PATH_MOST = 240   # characters of a path a message shows; the middle of a longer one is cut
+
+
 def shown_path(path: str) -> str:
-    """The path as a message shows it: itself when printable, else its repr."""
-    return path if path and path.isprintable() else repr(path)
+    """The path as a message shows it: itself when printable, else its repr; past
+    SHOWN_PATH_MOST characters its start and end around "...", so the message stays a line
+    one can read."""
+    s = path if path and path.isprintable() else repr(path)
+    return s if len(s) <= SHOWN_PATH_MOST else f"{s[:120]}...{s[-(SHOWN_PATH_MOST - 123):]}"
 
 
 def quoted_path(path: str | Path) -> str:

@@ -588,6 +588,43 @@ def test_a_reports_stated_bound_is_checked(bad) -> None:
         r.report(bad)
 
 
+def test_the_animation_interface_names_bad_arguments(tmp_path) -> None:
+    """docs/animation.md's Python interface: keyframes.load, Animation.scene and with_camera."""
+    from pyjulia4d.scene import keyframes
+
+    src = tmp_path / "a.toml"
+    src.write_text("[animation]\nframes = 3\n[[keyframe]]\nframe = 0\nfractal.c = [0, 0.5, 0, 0]\n"
+                   "[[keyframe]]\nframe = 2\nfractal.c = [0, 0.7, 0, 0]\n")
+    anim = keyframes.load(src)
+    cases = [(lambda: keyframes.load(src, Hostile()), "overrides: expected a list of SECTION.KEY=VALUE texts"),
+             (lambda: keyframes.load(src, 5), "overrides: expected a list of SECTION.KEY=VALUE texts, got 5"),
+             (lambda: keyframes.from_table(5), "scene: expected a table, got 5"),
+             (lambda: anim.scene("1"), "frame: expected a whole frame number, got '1'"),
+             (lambda: anim.scene(Hostile()), "frame: expected a whole frame number, got <a Hostile>"),
+             (lambda: anim.scene(3), "--frames: frame 3 is outside 0..2"),
+             (lambda: anim.with_camera(Hostile(), [0, 0, 0]), "camera.position: expected a list of 3 or 4 numbers"),
+             (lambda: anim.with_camera([1, 2, 3], None), "camera.target: expected a list of 3 or 4 numbers"),
+             (lambda: keyframes.parse_frames(5, 3), "--frames: expected A:B")]
+    for call, message in cases:
+        with pytest.raises(SceneError) as e:
+            call()
+        assert str(e.value).startswith(message), str(e.value)
+    assert anim.scene(1).fractal.c[1] == pytest.approx(0.6)
+
+
+def test_a_mesh_and_a_header_path_are_checked(tmp_path) -> None:
+    from pyjulia4d.app.mesh import write_mesh
+    from pyjulia4d.app.output import OutputError, read_header
+
+    with pytest.raises(OutputError, match=r"^mesh path: expected a str or an os.PathLike, got int"):
+        write_mesh(5, None)
+    with pytest.raises(OutputError, match=r"m.stl: expected a MeshResult to write, got NoneType"):
+        write_mesh(tmp_path / "m.stl", None)
+    with pytest.raises(OutputError, match=r"^image path: expected a str or an os.PathLike, got Hostile"):
+        read_header(Hostile())
+    assert read_header(tmp_path / "missing.png") is None and list(tmp_path.iterdir()) == []
+
+
 def test_mesh_executor_is_checked_before_it_is_compared() -> None:
     from pyjulia4d.app.mesh import build_mesh
 

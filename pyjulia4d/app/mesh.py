@@ -284,10 +284,14 @@ def vertex_colours(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.nda
 
 
 def write_mesh(path: str | Path, result: MeshResult) -> None:
-    """The mesh in the format of ``path``'s suffix, atomically (files.atomic_write)."""
-    from pyjulia4d.app.output import write_file
+    """The mesh in the format of ``path``'s suffix, atomically (files.atomic_write); the path
+    checked first (check_mesh_path)."""
+    from pyjulia4d.app.output import OutputError, write_file
 
-    kind = FORMATS[Path(path).suffix.lower()]
+    path = check_mesh_path(path)
+    if not isinstance(result, MeshResult):
+        raise OutputError(f"{path}: expected a MeshResult to write, got {type(result).__name__}")
+    kind = FORMATS[path.suffix.lower()]
     # vertex normals where the format has them (trimesh writes them only when asked)
     extra = {"ply": {"vertex_normal": True}, "obj": {"include_normals": True},
              "glb": {"include_normals": True}}.get(kind, {})

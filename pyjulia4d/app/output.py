@@ -346,8 +346,8 @@ def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:
 
 def read_header(path: str | Path) -> dict[str, str] | None:
     """An image's header entries (PNG text chunks, EXR string attributes), as write_image
-    wrote them; None if it cannot be read."""
-    path = Path(path)
+    wrote them; None if it cannot be read (OutputError if ``path`` is no path at all)."""
+    path = Path(path_text(path, lambda got: OutputError(f"image path: expected {got}")))
     try:
         if path.suffix.lower() == ".exr":
             import OpenEXR

@@ -184,7 +184,7 @@ def stack_radius(scene: Scene) -> float:
     julia_stack.cl) in the hyperplane w = w0 the view keeps to (scene/rules.check_stack): there
     |z| <= bounding_radius(max |c(u)|) (|c(u)| <= the larger end point's: the segment is
     convex), |u| <= 1 and w = w0, widened by 2^-20 so that a scan starts outside."""
-    f, cam, sl = scene.fractal, scene.camera, scene.slice
+    f, cam = scene.fractal, scene.camera
     cmax = max(math.hypot(*f.c_from), math.hypot(*f.c_to))
     rz = bounding_radius((cmax, 0.0, 0.0, 0.0), f.bailout, f.max_iter, 2)
     w0 = float(to_world(scene, tuple(cam.position[:3]) + ((cam.position[3],) if len(cam.position) == 4

@@ -38,7 +38,7 @@ import numpy as np
 from pyjulia4d.geometry.vec4 import Degenerate, orthonormalise, unit_or_none
 from pyjulia4d.scene.model import CHECKS, Scene
 from pyjulia4d.scene.checks import SceneError, Integer, OrWord, Real, Vector, show, show_key
-from pyjulia4d.scene.text import override_key, read_scene_table
+from pyjulia4d.scene.text import override_key, override_list, read_scene_table
 
 
 INTERPOLATIONS = ("linear", "smooth", "catmull-rom")
@@ -138,6 +138,8 @@ class Animation:
 
     def scene(self, n: int) -> Scene:
         """Frame ``n``'s scene (0 <= n < frames), validated; errors name ``frame[n].<key>``."""
+        if isinstance(n, bool) or not isinstance(n, int):
+            raise SceneError("frame", f"expected a whole frame number, got {show(n)}")
         if n in self._cache:
             return self._cache[n]
         if not 0 <= n < self.frames:
@@ -167,9 +169,14 @@ class Animation:
 
     def with_camera(self, position, target) -> "Animation":
         """The animation with camera.fit resolved: every frame keeps this position and target
-        (camera.fit then false); see :func:`load` for why the set is framed once."""
-        base = self.base.replace(**{"camera.position": list(position), "camera.target": list(target),
-                                    "camera.fit": False})
+        (camera.fit then false); see :func:`load` for why the set is framed once.  Each is a
+        list of 3 or 4 numbers, checked as the scene's keys are."""
+        vectors = {}
+        for key, v in (("camera.position", position), ("camera.target", target)):
+            if not isinstance(v, (list, tuple, np.ndarray)):
+                raise SceneError(key, f"expected a list of 3 or 4 numbers, got {show(v)}")
+            vectors[key] = list(v)
+        base = self.base.replace(**vectors, **{"camera.fit": False})
         return Animation(base, self.tracks, self.frames, self.fps, self.interpolation)
 
 
@@ -275,6 +282,9 @@ def load(path: str | Path, overrides: Iterable[str] = ()) -> Animation:
 
 def from_table(table: Mapping[str, Any], overrides: Iterable[str] = ()) -> Animation:
     """:func:`load` on a table already read (``{section: {key: value}}``)."""
+    if not isinstance(table, Mapping):
+        raise SceneError("scene", f"expected a table, got {show(table)}")
+    overrides = override_list(overrides)
     table = dict(table)
     keyframes = table.pop("keyframe", None)
     anim_table = table.pop("animation", None)
@@ -283,8 +293,6 @@ def from_table(table: Mapping[str, Any], overrides: Iterable[str] = ()) -> Anima
     if moved and (cam is None or isinstance(cam, Mapping)) and "fit" not in (cam or {}):
         # keyframes place the camera: Scene.from_dict's "no position: fit" does not apply
         table["camera"] = {**(cam or {}), "fit": False}
-    if isinstance(overrides, str):
-        overrides = [overrides]
     anim_over, scene_over = [], []
     for text in overrides:
         key = override_key(text) if isinstance(text, str) else ""
@@ -320,6 +328,8 @@ def parse_frames(text: str | None, total: int) -> range:
     """``--frames``: "A:B" (A to B inclusive), "A:" , ":B" or "N"; None: every frame."""
     if text is None:
         return range(total)
+    if not isinstance(text, str):
+        raise SceneError("--frames", f"expected A:B (first and last frame), got {show(text)}")
     s = text.strip()
     try:
         if ":" in s:

@@ -21,7 +21,7 @@ from pyjulia4d.scene import rules
 from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, Integer, Lights, OrWord, Planes,  # noqa: F401
                                     Real, SceneError, Vector, Whole, show, show_key)
 from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, QUALITIES, auto_values, preset_values
-from pyjulia4d.scene.text import parse_override, read_scene_table, toml_value
+from pyjulia4d.scene.text import override_list, parse_override, read_scene_table, toml_value
 
 Vec3 = tuple[float, float, float]
 Vec4 = tuple[float, float, float, float]
@@ -447,13 +447,7 @@ class Scene:
         # A quality preset fills the march keys the same source does not set itself;
         # a later source (an override) wins over an earlier one.
         fill_preset(raw["march"], keep=set(raw["march"]))
-        if isinstance(overrides, str):  # a lone string would be iterated per character
-            overrides = [overrides]
-        try:
-            overrides = list(overrides)
-        except Exception:   # not iterable, or an object whose own iteration fails
-            raise SceneError("overrides", f"expected a list of SECTION.KEY=VALUE texts, got {show(overrides)}") from None
-        for text in overrides:
+        for text in override_list(overrides):
             section, key, value = parse_override(text, CHECKS)
             raw[section][key] = value
             if (section, key) == ("march", "quality"):

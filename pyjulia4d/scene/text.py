@@ -24,6 +24,17 @@ def override_key(text: str) -> str:
     return text.partition("=")[0].strip()
 
 
+def override_list(overrides: Any) -> list:
+    """Overrides given from Python as a list (one string is one override, not its letters);
+    SceneError where they cannot be iterated (each is checked by parse_override)."""
+    if isinstance(overrides, str):
+        return [overrides]
+    try:
+        return list(overrides)
+    except Exception:   # not iterable, or an object whose own iteration fails
+        raise SceneError("overrides", f"expected a list of SECTION.KEY=VALUE texts, got {show(overrides)}") from None
+
+
 def parse_override(text: str, checks: Mapping[str, Mapping[str, Any]]) -> tuple[str, str, Any]:
     """``"section.key=VALUE"`` -> (section, key, value typed for that key), the keys and their
     checkers from ``checks`` (scene.model.checks)."""
