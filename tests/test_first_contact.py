@@ -612,6 +612,29 @@ def test_the_animation_interface_names_bad_arguments(tmp_path) -> None:
     assert anim.scene(1).fractal.c[1] == pytest.approx(0.6)
 
 
+def test_animate_checks_its_arguments_before_any_frame(tmp_path) -> None:
+    from pyjulia4d.app import animation
+    from pyjulia4d.scene import keyframes
+
+    src = tmp_path / "a.toml"
+    src.write_text("[image]\nwidth = 8\nheight = 6\n[animation]\nframes = 2\n")
+    anim = keyframes.load(src)
+    pattern = str(tmp_path / "f" / "m_##.png")
+    for kw, message in [(dict(frames=5), "frames: expected a list of frame numbers, got 5"),
+                        (dict(frames=Hostile()), "frames: expected a list of frame numbers"),
+                        (dict(frames=[0, "1"]), "frames: expected whole frame numbers, got '1'"),
+                        (dict(frames=[0, 0]), "frames: a frame is named twice"),
+                        (dict(force=Hostile()), "force: expected True or False"),
+                        (dict(progress="yes"), "progress: expected True or False"),
+                        (dict(on_written=5), "on_written: expected None or a callable")]:
+        with pytest.raises(SceneError) as e:
+            animation.animate(anim, pattern, workers=0, **kw)
+        assert str(e.value).startswith(message), str(e.value)
+    with pytest.raises(SceneError, match=r"^anim: expected an Animation"):
+        animation.animate(Scene.default(), pattern, workers=0)
+    assert list(tmp_path.iterdir()) == [src]
+
+
 def test_a_mesh_and_a_header_path_are_checked(tmp_path) -> None:
     from pyjulia4d.app.mesh import write_mesh
     from pyjulia4d.app.output import OutputError, read_header

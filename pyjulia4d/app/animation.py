@@ -26,7 +26,7 @@ from pyjulia4d.app.output import OutputError, check_output_path, read_header
 from pyjulia4d.files import NAME_MAX, atomic_write, path_limit, path_text, shown_path, temp_affixes
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import add_counts
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.keyframes import Animation
 
 HEADER_SCENE = "pyjulia4d.scene"
@@ -114,6 +114,21 @@ class Summary:
     stale_removed: int = 0
 
 
+def check_frames(frames: Any) -> list[int]:
+    """animate's ``frames`` from Python: whole frame numbers (range or list), each once; the
+    animation's own range is checked with its scenes (Animation.scene)."""
+    try:
+        got = list(frames)
+    except Exception:   # not iterable, or an object whose own iteration fails
+        raise SceneError("frames", f"expected a list of frame numbers, got {show(frames)}") from None
+    for n in got:
+        if isinstance(n, bool) or not isinstance(n, int):
+            raise SceneError("frames", f"expected whole frame numbers, got {show(n)}")
+    if len(set(got)) != len(got):
+        raise SceneError("frames", "a frame is named twice")
+    return got
+
+
 def _check_scenes(anim: Animation, frames: range, device: Any, force: bool, outputs) -> None:
     """Every frame's scene valid, and the work of each within workload.check's limits, before
     any renders; warnings said once each (with the number of frames that raise them)."""
@@ -151,9 +166,17 @@ def animate(anim: Animation, pattern: str, frames: Sequence[int] | None = None, 
     from pyjulia4d.app import cluster as distributed
     from pyjulia4d.app.video import check_video_path
 
+    from pyjulia4d.pipeline.plan import check_flag
+
     t0 = time.perf_counter()
+    if not isinstance(anim, Animation):
+        raise SceneError("anim", f"expected an Animation (keyframes.load), got {type(anim).__name__}")
+    for name, value in (("force", force), ("progress", progress)):
+        check_flag(name, value)
+    if on_written is not None and not callable(on_written):
+        raise SceneError("on_written", f"expected None or a callable, got {type(on_written).__name__}")
     pattern = check_pattern(pattern)
-    frames = range(anim.frames) if frames is None else frames
+    frames = range(anim.frames) if frames is None else check_frames(frames)
     summary = Summary(frames=frames)
     if workers is not None:
         workers = distributed.check_workers(workers)
