@@ -635,6 +635,14 @@ def test_animate_checks_its_arguments_before_any_frame(tmp_path) -> None:
     assert list(tmp_path.iterdir()) == [src]
 
 
+@pytest.mark.parametrize("bad", [5, b"/tmp", Hostile()], ids=["int", "bytes", "hostile"])
+def test_an_image_stores_folder_is_a_path(bad) -> None:
+    from pyjulia4d.pipeline.store import ImageStore
+
+    with pytest.raises(SceneError, match=r"^store: expected None or a folder, a str or an os.PathLike"):
+        ImageStore(bad)
+
+
 def test_a_mesh_and_a_header_path_are_checked(tmp_path) -> None:
     from pyjulia4d.app.mesh import write_mesh
     from pyjulia4d.app.output import OutputError, read_header

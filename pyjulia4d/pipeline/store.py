@@ -135,6 +135,11 @@ class ImageStore:
     """Allocates a render's host images (``empty``) and lets go of finished rows (``release``)."""
 
     def __init__(self, folder: str | Path | None = None):
+        if folder is not None:
+            from pyjulia4d.files import path_text
+            from pyjulia4d.scene.checks import SceneError
+
+            folder = path_text(folder, lambda got: SceneError("store", f"expected None or a folder, {got}"))
         self.folder = None if folder is None else Path(folder)
         self._maps: list[tuple[mmap.mmap, int, int, int]] = []   # (map, planes, height, bytes per row)
 
