@@ -27,6 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pyjulia4d.files import path_text
+from pyjulia4d.scene.checks import SceneError
+
 PAGE = mmap.PAGESIZE
 # At and above this size an image's memory is mapped anonymous pages (``new_memory``), as numpy
 # would madvise it for transparent huge pages from 4 MiB on
@@ -136,9 +139,6 @@ class ImageStore:
 
     def __init__(self, folder: str | Path | None = None):
         if folder is not None:
-            from pyjulia4d.files import path_text
-            from pyjulia4d.scene.checks import SceneError
-
             folder = path_text(folder, lambda got: SceneError("store", f"expected None or a folder, {got}"))
         self.folder = None if folder is None else Path(folder)
         self._maps: list[tuple[mmap.mmap, int, int, int]] = []   # (map, planes, height, bytes per row)

@@ -170,12 +170,9 @@ class Animation:
     def with_camera(self, position, target) -> "Animation":
         """The animation with camera.fit resolved: every frame keeps this position and target
         (camera.fit then false); see :func:`load` for why the set is framed once.  Each is a
-        list of 3 or 4 numbers, checked as the scene's keys are."""
-        vectors = {}
-        for key, v in (("camera.position", position), ("camera.target", target)):
-            if not isinstance(v, (list, tuple, np.ndarray)):
-                raise SceneError(key, f"expected a list of 3 or 4 numbers, got {show(v)}")
-            vectors[key] = list(v)
+        list of 3 or 4 numbers (or an array), checked by the scene's own keys."""
+        vectors = {key: v.tolist() if isinstance(v, np.ndarray) else v
+                   for key, v in (("camera.position", position), ("camera.target", target))}
         base = self.base.replace(**vectors, **{"camera.fit": False})
         return Animation(base, self.tracks, self.frames, self.fps, self.interpolation)
 
