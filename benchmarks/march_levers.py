@@ -11,12 +11,17 @@ and the work done is the sum of the iterations alone; their ratio is the lanes' 
 script marches the default scene's rays with the float64 twin's estimate
 (pyjulia4d/reference/iterate.py julia_distance_formula, the over-relaxed steps of
 reference/march.py march_de without its ulp guard, which never fires here), records every
-ray's iterations at every step, and replays them through three schedules:
+ray's iterations at every step, and replays them through these schedules:
 
 * blocks: the packets as the kernel runs them (one 4x4 block per work-item);
 * refill: compaction - a work-item keeps LANES lanes busy from a queue of Q blocks' rays, a
   lane taking the next ray as soon as its own ends (one step of every busy lane per round,
   a round costing its slowest lane's iterations);
+* own pace: each lane marches its own ray without waiting for the packet's other lanes at each
+  step (the orbit loop and the march's steps fused: a lane whose orbit has ended takes its
+  estimate, its step and its next point's orbit at once).  Its cost is its slowest lane's
+  iterations summed over that ray's steps, and the estimate (log, sqrt, the step) is then
+  taken in every round where any lane's orbit ends, where the blocks take it once a step;
 * coarse to fine: a cone march per B x B block finds the depth where the estimate first
   falls below the block's footprint (B pixels at that distance) on any of its rays; every
   ray of the block starts there, and the steps in front of it are skipped.  The coarse
@@ -146,6 +151,19 @@ def cost_refill(its: np.ndarray, order: np.ndarray, queue_blocks: int) -> int:
     return cost
 
 
+def cost_own_pace(its: np.ndarray, order: np.ndarray) -> tuple[int, int]:
+    """(rounds, estimate rounds) of the own-pace schedule: a packet's rounds are its slowest
+    lane's iterations over all its ray's steps; its estimate rounds, the rounds in which some
+    lane's orbit ends (a step's end, where the lane takes its estimate)."""
+    packets = its[order].reshape(-1, LANES, its.shape[1])
+    rounds = int(packets.sum(2).max(1).sum())
+    ends = 0
+    for p in packets:
+        done = np.cumsum(p, 1)[p > 0]   # the round at which each of the lanes' steps ends
+        ends += len(np.unique(done))
+    return rounds, ends
+
+
 def coarse_to_fine(its, ts, ds, W: int, H: int, side: int, pixel: float) -> tuple[float, float]:
     """(share of iterations skipped, share the coarse pass costs) with side x side blocks."""
     total = its.sum()
@@ -166,8 +184,8 @@ def coarse_to_fine(its, ts, ds, W: int, H: int, side: int, pixel: float) -> tupl
 
 
 def schedules(its: np.ndarray, order: np.ndarray, title: str) -> list[str]:
-    """The table of the blocks' schedule, refill from queues of 4, 16 and 64 blocks, and every
-    lane busy: lanes' use and modelled time against the blocks'."""
+    """The table of the blocks' schedule, refill from queues of 4, 16 and 64 blocks, each lane at
+    its own pace, and every lane busy: lanes' use and modelled time against the blocks'."""
     total, base = int(its.sum()), cost_blocks(its, order)
     rows = [f"| {title} | lanes' use | modelled march time vs blocks |", "|---|---|---|",
             f"| blocks (as the kernel runs) | {total / (LANES * base):.1%} | 1.00 |"]
@@ -175,6 +193,11 @@ def schedules(its: np.ndarray, order: np.ndarray, title: str) -> list[str]:
         c = cost_refill(its, order, q)
         rows.append(f"| refill from a queue of {q} blocks | {total / (LANES * c):.1%} | {c / base:.2f} |")
         print(rows[-1], flush=True)
+    rounds, ends = cost_own_pace(its, order)
+    steps = int((its[order].reshape(-1, LANES, its.shape[1]).max(1) > 0).sum())
+    rows.append(f"| each lane at its own pace (estimates in {ends / steps:.1f}x the blocks' rounds) | "
+                f"{total / (LANES * rounds):.1%} | {rounds / base:.2f} |")
+    print(rows[-1], flush=True)
     rows.append(f"| every lane always busy (the bound of any compaction) | 100 % | {total / (LANES * base):.2f} |")
     return rows
 

@@ -4,6 +4,7 @@ import importlib.util
 import subprocess
 import sys
 from pathlib import Path
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -326,6 +327,30 @@ def test_refill_trial_report_runs(tmp_path):
         pytest.skip("the march here runs no packets of 16 (the trial's only width)")
     md = (tmp_path / "refill_trial.md").read_text()
     assert "commit" in md and md.count("| yes |") == 2
+
+
+def test_march_levers_schedules_count_rounds_exactly():
+    """benchmarks/march_levers.py's schedules on one packet worked by hand: lane 0 takes 3 then
+    1 iterations, lane 1 1 then 3, the other lanes 1 and 1.  The blocks wait for each step's
+    slowest lane (3 + 3 rounds); at its own pace every lane is done after 4 rounds, and an
+    orbit ends at rounds 1, 2, 3 and 4; every lane busy would take (4 + 4 + 14 x 2) / 16."""
+    lev = load("march_levers")
+    its = np.ones((lev.LANES, 2), np.int64)
+    its[0], its[1] = (3, 1), (1, 3)
+    order = np.arange(lev.LANES)
+    assert lev.cost_blocks(its, order) == 6
+    assert lev.cost_own_pace(its, order) == (4, 4)
+    assert lev.cost_refill(its, order, 1) == 6     # no queue to refill from: the blocks' cost
+    lines = lev.schedules(its, order, "hand")
+    assert "| each lane at its own pace (estimates in 2.0x the blocks' rounds) | 56.2% | 0.67 |" in lines
+
+
+def test_march_levers_report_runs(tmp_path):
+    """benchmarks/march_levers.py, tiny (the float64 twin, no OpenCL): every schedule's row."""
+    assert load("march_levers").main(["--size", "32x24", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "march_levers.md").read_text()
+    assert "commit" in md and md.count("| each lane at its own pace") == 2
+    assert md.count("| refill from a queue of 16 blocks |") == 2
 
 
 @pytest.mark.slow   # eight runs of the whole command, each a process of its own
