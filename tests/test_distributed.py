@@ -154,3 +154,71 @@ def test_render_cluster_options_bad_input(tmp_path, capsys, args, expected):
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and expected in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("address,expected", [
+    ("tcp://127.0.0.1:99999", "the port must be in [1, 65535], got '99999'"),
+    ("tcp://127.0.0.1:0", "the port must be in [1, 65535], got '0'"),
+    ("tcp://h:" + "9" * 5000, "the port must be in [1, 65535], got '999"),
+    ("http://example.com", "cannot connect to 'http://example.com': unknown address scheme 'http'"),
+    ("tcp://[::1", "cannot connect to 'tcp://[::1': invalid address"),
+])
+def test_a_bad_scheduler_address_is_one_line_with_no_traceback_at_exit(tmp_path, address, expected):
+    """In a process of its own: a Client whose start failed was left half-made, and its
+    finalizer printed a traceback when the interpreter exited (after waiting 20 s)."""
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6",
+                        "-o", str(tmp_path / "x.png"), "--scheduler", address],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and expected in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def _serve_once(answer: bytes | None):
+    """A TCP server on a free local port that answers its first connection with ``answer``
+    (None: says nothing and holds the connection); its address, and a stop function."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(4)
+    held = []
+
+    def run():
+        try:
+            conn, _ = srv.accept()
+        except OSError:
+            return
+        held.append(conn)
+        if answer is not None:
+            conn.sendall(answer)
+
+    threading.Thread(target=run, daemon=True).start()
+
+    def stop():
+        for c in held:
+            c.close()
+        srv.close()
+    return f"tcp://127.0.0.1:{srv.getsockname()[1]}", stop
+
+
+@pytest.mark.parametrize("answer,expected", [
+    # Dask's reader takes "HTTP/1.1" for the length of a 3 EiB frame
+    (b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n", "what answers there is not a Dask scheduler"),
+    (None, "no Dask scheduler answered within 1 s"),
+])
+def test_a_server_that_is_no_scheduler_is_one_line(answer, expected):
+    from pyjulia4d.app.cluster import reach_scheduler
+    from pyjulia4d.scene.checks import SceneError
+
+    address, stop = _serve_once(answer)
+    try:
+        with pytest.raises(SceneError) as e:
+            reach_scheduler(address, timeout=0.5)
+    finally:
+        stop()
+    assert str(e.value).startswith(f"--scheduler: cannot connect to '{address}': ") and expected in str(e.value)
+    assert "\n" not in str(e.value)

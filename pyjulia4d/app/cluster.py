@@ -16,9 +16,11 @@ programs they built: ``UnitInfo.programs_built``).
 """
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import os
+import threading
 import time
 import uuid
 import warnings
@@ -198,8 +200,56 @@ def check_where(workers: int | None, scheduler: str | None) -> None:
     if scheduler is not None and workers is not None:
         raise SceneError("--workers", "give --workers (a local cluster) or --scheduler (an existing "
                                       "one), not both")
-    if scheduler is not None and not (isinstance(scheduler, str) and "://" in scheduler):
-        raise SceneError("--scheduler", f"expected an address such as tcp://HOST:8786, got {scheduler!r}")
+    if scheduler is None:
+        return
+    if not (isinstance(scheduler, str) and "://" in scheduler):
+        raise SceneError("--scheduler", f"expected an address such as tcp://HOST:8786, got {show(scheduler)}")
+    port = scheduler.rpartition(":")[2]
+    if port.isascii() and port.isdigit() and (len(port) > 5 or not 0 < int(port) < 65536):
+        # Dask would try such a port for SCHEDULER_TIMEOUT seconds
+        raise SceneError("--scheduler", f"{show(scheduler)}: the port must be in [1, 65535], got {show(port, 20)}")
+
+
+SCHEDULER_TIMEOUT = 10.0   # seconds to reach --scheduler, and as long again for its handshake
+
+
+def reach_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
+    """Connect once to the Dask scheduler at ``address`` and read its handshake, before any
+    Client is made; SceneError (one line) when the address is malformed, nothing answers,
+    or what answers is no Dask scheduler.  A Client whose start fails leaves a half-made
+    object behind, whose finalizer waited 20 s at exit and printed a traceback; and a server
+    that is no scheduler (an HTTP server) answered with bytes that Dask's reader took for
+    the length of a 3 EiB frame (MemoryError).  The probe runs in a thread of its own, with
+    its own event loop, so that it works where a loop already runs (a notebook)."""
+    from distributed.comm import connect
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), 2 * timeout)
+        await comm.close()
+
+    failed: list[Exception] = []
+
+    def run() -> None:
+        try:
+            asyncio.run(probe())
+        except Exception as e:   # whatever a foreign peer's bytes make of Dask's reader
+            failed.append(e)
+
+    thread = threading.Thread(target=run, name="pyjulia4d-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(3 * timeout)
+    if thread.is_alive():
+        failed.append(TimeoutError())
+    if not failed:
+        return
+    e = failed[0]
+    if isinstance(e, TimeoutError):
+        why = f"no Dask scheduler answered within {2 * timeout:g} s"
+    elif isinstance(e, (OSError, ValueError, TypeError)):
+        why = " ".join(str(e).split())[:200] or type(e).__name__
+    else:
+        why = f"what answers there is not a Dask scheduler ({type(e).__name__})"
+    raise SceneError("--scheduler", f"cannot connect to {show(address)}: {why}")
 
 
 @contextlib.contextmanager
@@ -218,8 +268,9 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        reach_scheduler(scheduler)
         try:
-            client = Client(scheduler, timeout="10s", set_as_default=False)
+            client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT:g}s", set_as_default=False)
         except (OSError, TimeoutError, ValueError, TypeError) as e:
             raise SceneError("--scheduler", f"cannot connect to {scheduler!r}: "
                                             f"{' '.join(str(e).split()) or type(e).__name__}") from None
