@@ -540,6 +540,12 @@ def test_the_notebook_view_renders_as_its_sliders_move(tmp_path):
     (["missing.toml"], "missing.toml: cannot read"),
     (["--host", "no-such-host.invalid", "--port", "0"], "--host: cannot listen on no-such-host.invalid"),
     (["--bogus"], "unrecognized arguments: --bogus"),
+    # an empty host would listen on every interface, where the default is this machine only
+    # (each host is checked before the port: with a bad port, a regression stops, never serves)
+    (["--host", "", "--port", "x"], "--host: expected a host name or an IP address such as 127.0.0.1"),
+    (["--host", "[::1", "--port", "x"], "every interface), got '[::1'"),
+    (["--host", "a\x01b", "--port", "x"], "got 'a\\x01b'"),
+    (["--host", "a" * 300, "--port", "x"], "got 'aaaa"),
 ])
 def test_bad_explore_arguments_are_one_line_and_status_2(tmp_path, capsys, monkeypatch, args, says):
     from pyjulia4d.app.cli import main

@@ -313,12 +313,13 @@ def _mesh(args: argparse.Namespace) -> int:
 
 def _explore(args: argparse.Namespace) -> int:
     """explore: the local page (app/explore/); every argument checked before the device."""
-    from pyjulia4d.app.explore.run import check_folder, check_port, explore
+    from pyjulia4d.app.explore.run import check_folder, check_host, check_port, explore
 
+    host = check_host(args.host)
     port = check_port(args.port)
     folder = check_folder(args.folder)
     scene = _scene_of(args.scene, args.overrides)
-    return explore(scene, select_device(args.device), args.host, port, folder, not args.no_browser)
+    return explore(scene, select_device(args.device), host, port, folder, not args.no_browser)
 
 
 def _animate(args: argparse.Namespace) -> int:

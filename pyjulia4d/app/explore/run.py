@@ -14,7 +14,7 @@ from typing import Any, Callable
 from pyjulia4d.app.explore.loop import stages
 from pyjulia4d.app.explore.session import Render
 from pyjulia4d.files import path_text, shown_path
-from pyjulia4d.scene.checks import SceneError
+from pyjulia4d.scene.checks import SceneError, show, show_key
 from pyjulia4d.scene.model import Scene
 
 # The explorer's tiles: a stale stage is abandoned at the end of a tile (loop.py), so they
@@ -76,6 +76,16 @@ def check_port(text: str) -> int:
     return int(s)
 
 
+def check_host(text: str) -> str:
+    """--host: a host name or an IP address (an IPv6 one bare or in brackets).  An empty one is
+    refused: the socket would listen on every interface, where the default is this machine."""
+    inner = text[1:-1] if text.startswith("[") and text.endswith("]") else text
+    if (not inner or len(text) > 255 or not text.isprintable() or any(c.isspace() or c in "[]/" for c in inner)):
+        raise SceneError("--host", f"expected a host name or an IP address such as 127.0.0.1 (0.0.0.0: every "
+                                   f"interface), got {show(text)}")
+    return text
+
+
 def explore(scene: Scene, device: Any, host: str, port: int, folder: Path, open_browser: bool) -> int:
     """Frame and build, bind, say where it listens, open the browser, serve until Ctrl-C."""
     from pyjulia4d.app.explore.server import LOCAL_HOSTS, bind, make_app, serve, url_of
@@ -86,9 +96,9 @@ def explore(scene: Scene, device: Any, host: str, port: int, folder: Path, open_
         sock = bind(host, port)
     except OSError as e:
         if e.errno in (errno.EADDRINUSE, errno.EACCES):
-            raise SceneError("--port", f"cannot listen on {host} port {port}: {e.strerror or e}"
+            raise SceneError("--port", f"cannot listen on {show_key(host)} port {port}: {e.strerror or e}"
                              + ("; --port 0 picks a free one" if port else "")) from None
-        raise SceneError("--host", f"cannot listen on {host}: {e.strerror or e}") from None
+        raise SceneError("--host", f"cannot listen on {show_key(host)}: {e.strerror or e}") from None
     url = url_of(sock)
     hosts = tuple(dict.fromkeys(LOCAL_HOSTS + (host.strip("[]"), host)))
     app = make_app(scene, render, folder, hosts if host not in ("0.0.0.0", "::") else ("*",))
