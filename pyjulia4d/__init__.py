@@ -14,6 +14,7 @@ import, measure/ ground truth and the catalogue of hard cases.
 from pyjulia4d.opencl import runtimes
 
 runtimes.register()  # before any OpenCL call: Intel's CPU runtime from PyPI (opencl/runtimes.py)
+runtimes.pyopencl_cache()  # before pyopencl is imported: its caches off where they cannot be made
 
 __version__ = "0.1.0"
 __all__ = ["Scene", "SceneError", "RenderResult", "render", "__version__"]

@@ -85,6 +85,29 @@ def test_registration_leaves_a_users_choice_alone(tmp_path: Path, env, why) -> N
     assert not (tmp_path / "icd").exists()
 
 
+def test_a_cache_folder_that_cannot_be_made_costs_only_time(tmp_path: Path) -> None:
+    """XDG_CACHE_HOME under a file: pyopencl's cache of argument setters cannot be made there
+    (it stopped the first render with a traceback); pyopencl's caches are turned off and the
+    render goes on, whatever PYOPENCL_NO_CACHE said; where the folder can be made, a user's
+    own PYOPENCL_NO_CACHE stands."""
+    code = ("import os, pyjulia4d; from pyjulia4d import Scene, render; "
+            "r = render(Scene.default().with_overrides(['image.width=16', 'image.height=12'])); "
+            "print(os.environ.get('PYOPENCL_NO_CACHE'), r.hit_fraction > 0.1)")
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    p = _python(code, XDG_CACHE_HOME=str(blocker / "cache"), PYJULIA4D_CACHE=str(tmp_path / "c"))
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr
+    assert p.stdout.split() == ["1", "True"]
+    p = _python(code, XDG_CACHE_HOME=str(tmp_path / "xdg"), PYJULIA4D_CACHE=str(tmp_path / "c"))
+    assert p.returncode == 0 and p.stdout.split() == ["None", "True"], p.stderr
+    p = _python(code, XDG_CACHE_HOME=str(blocker / "cache"), PYOPENCL_NO_CACHE="0",
+                PYJULIA4D_CACHE=str(tmp_path / "c"))
+    assert p.returncode == 0 and p.stdout.split() == ["1", "True"], p.stderr
+    p = _python(code, XDG_CACHE_HOME=str(tmp_path / "xdg"), PYOPENCL_NO_CACHE="1",
+                PYJULIA4D_CACHE=str(tmp_path / "c"))
+    assert p.returncode == 0 and p.stdout.split() == ["1", "True"], p.stderr
+
+
 @needs_intel
 def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
     """No system .icd file at all (an empty vendors folder): the default device comes from

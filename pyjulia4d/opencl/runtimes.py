@@ -135,3 +135,25 @@ def register() -> None:
         return
     os.environ["OCL_ICD_VENDORS"] = str(folder)
     registered.update(library=str(lib), folder=str(folder), why_not="")
+
+
+def pyopencl_cache() -> None:
+    """Turn pyopencl's on-disk caches off (``PYOPENCL_NO_CACHE``) where their folder cannot be
+    made.  pyopencl keeps each kernel's argument setter in a pytools PersistentDict under the
+    user's cache folder (``$XDG_CACHE_HOME/pytools``) and, where that folder cannot be made
+    (an ``XDG_CACHE_HOME`` under /proc, a read-only home), stopped the first render with a
+    traceback; without the cache it only generates the setters again, as pyjulia4d's own
+    program cache costs only time where it cannot be written.  Called before pyopencl is
+    imported (which reads the setting); a user's own ``PYOPENCL_NO_CACHE`` stands where the
+    folder can be made."""
+    try:
+        import platformdirs   # pytools' own way to the folder (a dependency of pytools)
+    except ImportError:
+        return
+    try:
+        folder = platformdirs.user_cache_dir("pytools", "pytools")
+        os.makedirs(folder, exist_ok=True)
+        if not os.access(folder, os.W_OK):
+            raise PermissionError(folder)
+    except (OSError, ValueError):
+        os.environ["PYOPENCL_NO_CACHE"] = "1"
