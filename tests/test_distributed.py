@@ -222,3 +222,26 @@ def test_a_server_that_is_no_scheduler_is_one_line(answer, expected):
         stop()
     assert str(e.value).startswith(f"--scheduler: cannot connect to '{address}': ") and expected in str(e.value)
     assert "\n" not in str(e.value)
+
+
+def test_a_unit_that_fails_on_its_worker_is_one_line(tmp_path):
+    """A worker whose device cannot be had (PYJULIA4D_DEVICE names none): the command's one
+    line, without the worker's own log of the failed task and its traceback, and without
+    Dask's warning that port 8787 (its HTTP server's default) is taken, as it is here."""
+    import socket
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYJULIA4D_DEVICE="no-such-device")
+    with socket.socket() as held:
+        try:
+            held.bind(("127.0.0.1", 8787))
+            held.listen()
+        except OSError:
+            pass   # already taken: the same for the test
+        p = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6",
+                            "-o", str(tmp_path / "x.png"), "--workers", "1"],
+                           capture_output=True, text=True, timeout=300, env=env)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
+    assert "device 'no-such-device': no matching OpenCL device" in p.stderr
+    assert list(tmp_path.iterdir()) == []

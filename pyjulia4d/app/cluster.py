@@ -279,8 +279,12 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
         finally:
             client.close()
         return
+    # The scheduler's HTTP server (its health and metrics routes) runs even without a
+    # dashboard, on port 8787 unless told: where another cluster held it, Dask warned.  The
+    # workers' own log of a failed unit (with its traceback) is left out: the unit's error
+    # comes back to the client, which says it in one line.
     lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR)
+                      dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
     try:
         client = Client(lc, set_as_default=False)
         try:
