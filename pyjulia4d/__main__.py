@@ -1,5 +1,6 @@
 """``python -m pyjulia4d`` and the ``pyjulia4d`` command."""
 import os
+import sys
 
 
 def run() -> int:
@@ -8,8 +9,13 @@ def run() -> int:
     OpenBLAS starts a thread per core when numpy is imported, which cost 0.1 of the 0.5 CPU-s
     of a tiny render here; the renderer uses no BLAS worth threads (the kernels run in OpenCL),
     so one thread, unless the user set it.  The default device's runtime may be loaded alone
-    (opencl/default_device.py)."""
+    (opencl/default_device.py).  What the command prints escapes what the terminal's encoding
+    cannot show (PYTHONIOENCODING=ascii and a file named "é.png": the render was written,
+    then its closing line failed as an error)."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    for stream in (sys.stdout, sys.stderr):
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     from pyjulia4d.app.cli import main
     from pyjulia4d.opencl import default_device
 

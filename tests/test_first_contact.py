@@ -108,6 +108,17 @@ def test_a_cache_folder_that_cannot_be_made_costs_only_time(tmp_path: Path) -> N
     assert p.returncode == 0 and p.stdout.split() == ["1", "True"], p.stderr
 
 
+def test_a_terminal_that_cannot_show_a_name_gets_it_escaped(tmp_path: Path) -> None:
+    """PYTHONIOENCODING=ascii and an output named é.png: the render was written, then its
+    closing line failed (UnicodeEncodeError, a ValueError) and the command said "error"."""
+    p = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6",
+                        "-o", "\u00e9.png"], cwd=tmp_path, env=_env(PYTHONIOENCODING="ascii"),
+                       capture_output=True, text=True, encoding="ascii", timeout=300)
+    assert p.returncode == 0 and p.stderr == "", p.stderr
+    assert p.stdout.startswith("rendered \\xe9.png (8x6)")
+    assert [f.name for f in tmp_path.iterdir()] == ["\u00e9.png"]
+
+
 @needs_intel
 def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
     """No system .icd file at all (an empty vendors folder): the default device comes from
