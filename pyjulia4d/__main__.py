@@ -20,7 +20,22 @@ def run() -> int:
     from pyjulia4d.opencl import default_device
 
     default_device.allow()
-    return main()
+    try:
+        status = main()
+        sys.stdout.flush()
+        return status
+    except OSError as e:
+        if e.filename is not None:   # a file's error the command did not expect: its traceback
+            raise
+        # standard output failed: its reader went away (`| head`), or it is full (/dev/full);
+        # what is still buffered goes nowhere, so that the exit's own flush cannot fail again
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
+        if isinstance(e, BrokenPipeError):
+            return 128 + 13   # as the shell's own tools end on SIGPIPE
+        print(f"pyjulia4d: error: cannot write to standard output: {e.strerror or e}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -119,6 +119,24 @@ def test_a_terminal_that_cannot_show_a_name_gets_it_escaped(tmp_path: Path) -> N
     assert [f.name for f in tmp_path.iterdir()] == ["\u00e9.png"]
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full here")
+def test_standard_output_that_fails_is_one_line_and_no_traceback(tmp_path: Path) -> None:
+    """Standard output full (/dev/full): one line and status 1, where a traceback came; its
+    reader gone (`| head`): no word, and 141 as the shell's own tools (SIGPIPE).  Each had
+    left a traceback, and the render's file was written before its closing line failed."""
+    cmd = [sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6", "-o", "x.png"]
+    with open("/dev/full", "w") as full:
+        p = subprocess.run(cmd, cwd=tmp_path, env=_env(), stdout=full, stderr=subprocess.PIPE, text=True,
+                           timeout=300)
+    assert p.returncode == 1 and p.stderr == ("pyjulia4d: error: cannot write to standard output: No space "
+                                              "left on device\n"), p.stderr
+    q = subprocess.Popen(cmd[:3] + ["keys"], cwd=tmp_path, env=_env(), stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    q.stdout.close()   # the reader goes away before the command writes
+    err = q.stderr.read()
+    assert q.wait(timeout=300) == 141 and err == "", err
+
+
 @needs_intel
 def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
     """No system .icd file at all (an empty vendors folder): the default device comes from
