@@ -303,6 +303,7 @@ def test_render_an_image_default_output_and_overrides(tmp_path: Path, monkeypatc
     (lambda p: p.write_bytes(b"not a png"), "not a readable PNG file"),
     (lambda p: p.mkdir(), "is a directory, not an image"),
     (lambda p: Image.new("RGB", (4, 4)).save(p), "holds no pyjulia4d scene"),
+    (lambda p: os.mkfifo(p), "not a regular file"),   # was "no such file"
 ])
 def test_render_an_image_bad(tmp_path: Path, capsys, make, why) -> None:
     src = tmp_path / "src.png"

@@ -192,8 +192,10 @@ def scene_from_image(path: str, overrides: Sequence[str] = ()) -> Scene:
     shown = path if path.isprintable() else repr(path)
     if Path(path).is_dir():
         raise SceneError(shown, "is a directory, not an image")
-    if not Path(path).is_file():
+    if not Path(path).exists():
         raise SceneError(shown, "cannot read: no such file")
+    if not Path(path).is_file():   # a pipe or a device: an image's header is read by seeking
+        raise SceneError(shown, "not a regular file; an image is read from a file")
     header = read_header(Path(path))
     if header is None:
         raise SceneError(shown, f"not a readable {Path(path).suffix.lower()[1:].upper()} file (damaged, truncated "
