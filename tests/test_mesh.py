@@ -261,6 +261,11 @@ def test_decimation_keeps_the_share_asked_and_says_whether_it_is_closed():
     for bad in (0, 0.0, -0.5, 1.5, float("nan"), True, "0.5"):
         with pytest.raises(SceneError, match="--decimate"):
             mesh_mod.check_decimate(bad)
+    # a share that keeps fewer triangles than a closed surface has (1e-300 kept none, and an
+    # empty file was written)
+    for tiny in (1e-300, 3.0 / len(full.mesh.faces)):
+        with pytest.raises(SceneError, match=r"--decimate: .* triangles keeps [0-3], fewer than the 4"):
+            mesh_mod.build_mesh(SCENES["default"], 40, harness.device(), decimate=tiny)
 
 
 def _first_hits(origin, dirs, tri):

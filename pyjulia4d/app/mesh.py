@@ -220,6 +220,10 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     if smooth:
         trimesh.smoothing.filter_taubin(mesh, iterations=smooth)
     if decimate < 1.0:   # new vertices: coloured at themselves (within h of the surface)
+        keep = round(len(mesh.faces) * decimate)
+        if keep < 4:   # a tetrahedron's: fewer closes nothing (1e-300 wrote an empty file)
+            raise SceneError("--decimate", f"{decimate:g} of the mesh's {len(mesh.faces)} triangles keeps {keep}, "
+                                           f"fewer than the 4 of the least closed surface; keep a larger share")
         mesh = mesh.simplify_quadric_decimation(percent=1.0 - decimate)
         world = inner = np.asarray(mesh.vertices) @ plan.axes + plan.offset
     mesh.visual.vertex_colors = vertex_colours(scene, world, inner)
