@@ -152,7 +152,9 @@ def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
 
 
 def test_an_unwritable_cache_costs_the_runtime_only(tmp_path: Path) -> None:
-    """A cache folder that cannot be written: no exception at import, a reason recorded."""
+    """A cache folder that cannot be written: no exception at import, a reason recorded, and
+    said in the closing line where another CPU runtime takes over (it was said by `devices`
+    alone, while a render went on on PoCL)."""
     blocker = tmp_path / "file"
     blocker.write_text("")
     p = _python("import pyjulia4d; from pyjulia4d import runtimes; print(repr(runtimes.registered['why_not']))",
@@ -160,6 +162,10 @@ def test_an_unwritable_cache_costs_the_runtime_only(tmp_path: Path) -> None:
     assert p.returncode == 0, p.stderr
     if INTEL is not None:
         assert "cannot write the vendors folder" in p.stdout
+        q = _cli(["render", "--width", "8", "--height", "6", "-o", "x.png"], tmp_path,
+                 PYJULIA4D_CACHE=str(blocker / "cache"))
+        if q.returncode == 0 and "no GPU" in q.stdout:   # a CPU took it: another runtime than Intel's
+            assert "Intel's CPU runtime from PyPI is not registered: cannot write the vendors folder" in q.stdout
 
 
 # ------------------------------------------------------------------ which CPU runtime
