@@ -210,7 +210,7 @@ def check_where(workers: int | None, scheduler: str | None) -> None:
         raise SceneError("--scheduler", f"{show(scheduler)}: the port must be in [1, 65535], got {show(port, 20)}")
 
 
-SCHEDULER_TIMEOUT = 10.0   # seconds to reach --scheduler, and as long again for its handshake
+SCHEDULER_TIMEOUT = 10.0   # seconds to reach --scheduler (Dask retries until then); twice that for its greeting
 
 
 def reach_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
@@ -272,7 +272,7 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
         try:
             client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT:g}s", set_as_default=False)
         except (OSError, TimeoutError, ValueError, TypeError) as e:
-            raise SceneError("--scheduler", f"cannot connect to {scheduler!r}: "
+            raise SceneError("--scheduler", f"cannot connect to {show(scheduler)}: "
                                             f"{' '.join(str(e).split()) or type(e).__name__}") from None
         try:
             yield client

@@ -150,7 +150,7 @@ def pyopencl_cache() -> None:
         import platformdirs   # pytools' own way to the folder (a dependency of pytools)
     except ImportError:
         return
-    try:
+    try:   # made as pyopencl makes it at its first kernel: the one exact test (root passes access())
         folder = platformdirs.user_cache_dir("pytools", "pytools")
         os.makedirs(folder, exist_ok=True)
         if not os.access(folder, os.W_OK):
