@@ -336,3 +336,16 @@ def test_video_plays_back_with_the_frames(tmp_path, capsys, ext):
     # consecutive frames differ (the set morphs) more than the codec's error
     assert np.abs(got[0].astype(float) - got[5].astype(float)).mean() > 10.0
     assert not any(p.name.startswith(".") for p in tmp_path.iterdir())
+
+
+def test_the_closing_line_says_where_the_frames_were_rendered():
+    """Frames rendered in this process (workers=0) are said so; they were "1 worker"."""
+    from pyjulia4d.app.animation import Summary, closing_line
+    from pyjulia4d.app.cluster import LOCAL_WORKER
+
+    here = Summary(range(2), rendered=[0, 1], seconds=1.0, workers={(LOCAL_WORKER, 7)}, devices={"CPU X"})
+    assert closing_line(here, "f_#.png", None, 24.0).startswith(
+        "rendered 2 frames to f_#.png in 1.00 s, 0.50 s per frame on CPU X (in this process)")
+    two = Summary(range(2), rendered=[0, 1], seconds=1.0, workers={("tcp://a:1", 7), ("tcp://b:1", 8)},
+                  devices={"CPU X"})
+    assert "on CPU X (2 workers)" in closing_line(two, "f_#.png", None, 24.0)

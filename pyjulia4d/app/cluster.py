@@ -65,12 +65,15 @@ class EncodedImage:
 # ---------------------------------------------------------------- on the worker
 
 
+LOCAL_WORKER = "local"   # the worker name of units rendered in this process (workers=0)
+
+
 def _worker_name() -> Any:
     try:
         from distributed import get_worker
         return get_worker().name
     except (ImportError, ValueError):
-        return "local"
+        return LOCAL_WORKER
 
 
 def worker_device(spec: str | None) -> Any:
