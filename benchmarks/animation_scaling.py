@@ -98,7 +98,7 @@ def main(argv=None) -> int:
         overhead = None
         for n in (1, 2):
             t = time.perf_counter()
-            lc = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+            lc = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0",
                               silence_logs=logging.ERROR)
             client = Client(lc, set_as_default=False)
             client.wait_for_workers(n)

@@ -348,4 +348,4 @@ def test_the_closing_line_says_where_the_frames_were_rendered():
         "rendered 2 frames to f_#.png in 1.00 s, 0.50 s per frame on CPU X (in this process)")
     two = Summary(range(2), rendered=[0, 1], seconds=1.0, workers={("tcp://a:1", 7), ("tcp://b:1", 8)},
                   devices={"CPU X"})
-    assert "on CPU X (2 workers)" in closing_line(two, "f_#.png", None, 24.0)
+    assert "on CPU X (on 2 workers)" in closing_line(two, "f_#.png", None, 24.0)

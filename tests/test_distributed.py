@@ -31,7 +31,7 @@ OUTPUTS = ("color", "alpha", "depth", "normal", "position", "status", "samples",
 def cluster():
     """A local cluster of 2 worker processes, one thread each (as --workers 2 starts)."""
     lc = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, silence_logs=logging.ERROR)
+                                  dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
     client = distributed.Client(lc, set_as_default=False)
     try:
         yield lc, client

@@ -294,12 +294,9 @@ def closing_line(summary: Summary, pattern: str, video: str | None, fps: float) 
     kept = len(summary.current)
     where = ""
     if summary.devices:
-        from pyjulia4d.app.cluster import LOCAL_WORKER
+        from pyjulia4d.app.cluster import rendered_where
 
-        w = len(summary.workers)
-        local = {name for name, _ in summary.workers} == {LOCAL_WORKER}
-        where = f" on {', '.join(sorted(summary.devices))} " + \
-            ("(in this process)" if local else f"({w} worker{'s' if w != 1 else ''})")
+        where = f" on {', '.join(sorted(summary.devices))} ({rendered_where(summary.workers)})"
     per = f", {summary.seconds / n:.2f} s per frame" if n else ""
     line = (f"rendered {n} frame{'s' if n != 1 else ''} to {pattern} in {summary.seconds:.2f} s{per}{where}"
             f"{f'; {kept} already up to date' if kept else ''}")

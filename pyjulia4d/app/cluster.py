@@ -68,6 +68,14 @@ class EncodedImage:
 LOCAL_WORKER = "local"   # the worker name of units rendered in this process (workers=0)
 
 
+def rendered_where(workers: set) -> str:
+    """Where units ran, for a closing line: "in this process" (workers=0), else "on N
+    workers"; ``workers`` holds their (worker name, pid) pairs."""
+    if {name for name, _ in workers} == {LOCAL_WORKER}:
+        return "in this process"
+    return f"on {len(workers)} worker{'s' if len(workers) != 1 else ''}"
+
+
 def _worker_name() -> Any:
     try:
         from distributed import get_worker
@@ -396,9 +404,8 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
         add_counts(counts, r.counts)
         add_counts(guards, r.guards)
     names = sorted({r.device_name for r in parts.values()})
-    nworkers = len({(i.worker, i.pid) for i in infos})
-    where = (f" ({len(regions)} tile{'s' if len(regions) != 1 else ''} on {nworkers} "
-             f"worker{'s' if nworkers != 1 else ''})")
+    where = (f" ({len(regions)} tile{'s' if len(regions) != 1 else ''} "
+             f"{rendered_where({(i.worker, i.pid) for i in infos})})")
     # scene: the camera every tile used (camera.fit resolved once), which the header records
     result = RenderResult(**arrays, counts=counts, guards=guards, lanes=first.lanes,
                           device_name=", ".join(names) + where,
