@@ -321,6 +321,19 @@ def test_render_an_image_bad(tmp_path: Path, capsys, make, why) -> None:
     assert set(tmp_path.iterdir()) == before
 
 
+@pytest.mark.parametrize("description", ["{", "[" * 100000 + "]" * 100000, '"a string"', "made by a scanner"])
+def test_a_tiff_described_by_another_program_holds_no_scene(tmp_path: Path, capsys, description) -> None:
+    """A readable TIFF whose description is not pyjulia4d's JSON object: it holds no scene (it was
+    called damaged, "not a readable TIF file")."""
+    import tifffile
+
+    src = tmp_path / "src.tif"
+    tifffile.imwrite(src, np.zeros((4, 4, 4), np.uint8), description=description)
+    assert cli.main(["render", str(src), "-o", str(tmp_path / "out.png")]) == 2
+    assert capsys.readouterr().err == f"pyjulia4d: error: {src}: holds no pyjulia4d scene (not rendered by " \
+                                      f"pyjulia4d, or its metadata was stripped)\n"
+
+
 def test_render_an_image_with_a_bad_embedded_scene(tmp_path: Path, capsys) -> None:
     from PIL import PngImagePlugin
 

@@ -358,7 +358,13 @@ def read_header(path: str | Path) -> dict[str, str] | None:
 
             import tifffile
             with tifffile.TiffFile(path) as t:
-                text = json.loads(t.pages[0].description or "{}")
+                description = t.pages[0].description or "{}"
+            try:   # another program's description (not our JSON object) is no damage: no entries
+                text = json.loads(description)
+            except (ValueError, RecursionError):
+                return {}
+            if not isinstance(text, dict):
+                return {}
             return {k: v for k, v in text.items() if isinstance(k, str) and isinstance(v, str)}
         from PIL import Image
         with Image.open(path) as im:
