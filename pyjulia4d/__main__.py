@@ -1,6 +1,10 @@
 """``python -m pyjulia4d`` and the ``pyjulia4d`` command."""
+import errno
 import os
 import sys
+
+
+_OUTPUT_ERRNOS = (errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EFBIG, errno.EDQUOT)
 
 
 def run() -> int:
@@ -25,7 +29,9 @@ def run() -> int:
         sys.stdout.flush()
         return status
     except OSError as e:
-        if e.filename is not None:   # a file's error the command did not expect: its traceback
+        # what a failing standard output raises (a file's own error names the file); any
+        # other OSError the command did not expect keeps its traceback
+        if e.filename is not None or e.errno not in _OUTPUT_ERRNOS:
             raise
         # standard output failed: its reader went away (`| head`), or it is full (/dev/full);
         # what is still buffered goes nowhere, so that the exit's own flush cannot fail again

@@ -68,14 +68,6 @@ class EncodedImage:
 LOCAL_WORKER = "local"   # the worker name of units rendered in this process (workers=0)
 
 
-def rendered_where(workers: set) -> str:
-    """Where units ran, for a closing line: "in this process" (workers=0), else "on N
-    workers"; ``workers`` holds their (worker name, pid) pairs."""
-    if {name for name, _ in workers} == {LOCAL_WORKER}:
-        return "in this process"
-    return f"on {len(workers)} worker{'s' if len(workers) != 1 else ''}"
-
-
 def _worker_name() -> Any:
     try:
         from distributed import get_worker
@@ -307,6 +299,14 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
 
 
 # ---------------------------------------------------------------- frames and tiles
+
+
+def rendered_where(workers: set) -> str:
+    """Where units ran, for a closing line: "in this process" (workers=0), else "on N
+    workers"; ``workers`` holds their (worker name, pid) pairs."""
+    if {name for name, _ in workers} == {LOCAL_WORKER}:
+        return "in this process"
+    return f"on {len(workers)} worker{'s' if len(workers) != 1 else ''}"
 
 
 def render_many(client: Any, units: Sequence[tuple[Any, Scene, dict]],

@@ -242,10 +242,10 @@ def default_reason(dev: cl.Device) -> str:
             why += ", no GPU"
     if skipped:
         why += f"; {', '.join(skipped)} cannot compile"
-    if kind == "CPU" and runtimes.registered["why_not"].startswith("cannot write"):
-        # a failure, not a choice: said where it changes the device (a cache folder that cannot
-        # be written, PYJULIA4D_CACHE=/dev/null, left Intel's runtime out and PoCL took over)
-        why += f"; Intel's CPU runtime from PyPI is not registered: {runtimes.registered['why_not']}"
+    if kind == "CPU" and runtimes.registered["failed"]:
+        # said where it changes the device (a cache folder that cannot be written,
+        # PYJULIA4D_CACHE=/dev/null, left Intel's runtime out and PoCL took over)
+        why += f"; Intel's CPU runtime from PyPI is not registered: {runtimes.registered['failed']}"
     return why
 
 

@@ -32,8 +32,9 @@ SYSTEM_VENDORS = "/etc/OpenCL/vendors"   # ocl-icd's compiled-in default
 _INTEL_LIB = "libintelocl.so"
 
 # What register() did, for `devices` and the closing line: the library it registered
-# ("" if none) and why not, when it did not.
-registered: dict[str, str] = {"library": "", "folder": "", "why_not": "not yet run"}
+# ("" if none) and why not, when it did not; ``failed``: the why_not of a failure (not a
+# choice, such as a user's OCL_ICD_VENDORS), "" if none.
+registered: dict[str, str] = {"library": "", "folder": "", "why_not": "not yet run", "failed": ""}
 
 # The remembered default device this process's loader was narrowed to (default_device.py):
 # its record, empty where every runtime is loaded.
@@ -131,7 +132,7 @@ def register() -> None:
     try:
         folder = _write_vendors(icds)
     except OSError as e:
-        registered["why_not"] = f"cannot write the vendors folder ({e.strerror or e})"
+        registered["why_not"] = registered["failed"] = f"cannot write the vendors folder ({e.strerror or e})"
         return
     os.environ["OCL_ICD_VENDORS"] = str(folder)
     registered.update(library=str(lib), folder=str(folder), why_not="")
