@@ -71,8 +71,12 @@ from pyjulia4d.measure import truth
 from pyjulia4d import reference as ref  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
-from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
-from pyjulia4d.opencl.runner import Precision, launch_normals, queue_for  # noqa: E402
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT  # noqa: E402
+from pyjulia4d.opencl.records import Packed, Precision  # noqa: E402
+from pyjulia4d.opencl.runner import launch, queue_for  # noqa: E402
+from pyjulia4d.pipeline import signatures  # noqa: E402
+from pyjulia4d.pipeline.plan import make_plan  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 
 # name -> (overrides, description).  The first nine: seed 000's figures, POV-Ray's example
@@ -236,14 +240,18 @@ class NormalKernels:
         q = self.queue
         w, h = scene.image.width, scene.image.height
         n = w * h
-        fr = camera_frame(scene)
         pos = np.nan_to_num(res.position.reshape(n, 4)).astype(pr.scalar)
         point = cla.to_device(q, np.ascontiguousarray(pos).view(pr.vec_dtype).ravel())
         status = cla.to_device(q, np.ascontiguousarray(res.status.reshape(n), np.int32))
         depth = cla.to_device(q, np.ascontiguousarray(res.depth.reshape(n).astype(pr.scalar)))
         normal = cla.empty(q, n, pr.vec_dtype)
         flags = cla.zeros(q, n, np.int32)
-        launch_normals(q, prg, scene, method, fr, pr, point, depth, status, normal, flags)
+        given = dict(point=point, status=status, normal=normal, flags=flags)
+        if method == "zbuffer":
+            given.update(depth=depth, width=w, height=h)
+        sig = signatures.NORMALS[method]
+        records = make_plan(scene, "CPU", 1, force=True).records()
+        launch(q, build.kernel(prg, sig.kernel), n, *Packed(sig, records, pr)(**given))
         q.finish()
         return normal.get().view(pr.scalar).reshape(h, w, 4)[..., :3].astype(np.float64)
 

@@ -36,7 +36,8 @@ for _p in (ROOT, ROOT / "benchmarks"):
 
 from bench_args import Parser  # noqa: E402
 from pyjulia4d.measure import catalogue as cat  # noqa: E402
-from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
+from pyjulia4d.opencl.executor import render  # noqa: E402
+from pyjulia4d.pipeline.codes import STATUS_HIT  # noqa: E402
 
 from error_vs_time import git_head  # noqa: E402  (same folder: benchmarks/)
 

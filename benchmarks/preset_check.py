@@ -61,7 +61,8 @@ from pyjulia4d.scene.quality import PRESETS, apply_quality, stated_p99  # noqa: 
 
 # the tables' split: scenes up to max_iter 20 and the deeper ones, reported apart
 BOUND_MAX_ITER = 20
-from pyjulia4d.opencl.executor import STATUS_HIT, render  # noqa: E402
+from pyjulia4d.opencl.executor import render  # noqa: E402
+from pyjulia4d.pipeline.codes import STATUS_HIT  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 
 SEEDS = (2027, 2028)

@@ -84,8 +84,9 @@ def main(argv=None) -> int:
     prg = build(cl.Program(runner.ctx, src), [f"-D{d}" for d in cfg.defines])
     cone = runner.slots[0][0]["cone"]
     bx0, by0, bw, bh = tile.cone_blocks()
-    launch(q, runner.cone_k, bw * bh, np.int32(bw), np.int32(bx0), np.int32(by0), *runner.camera,
-           *runner.cone_const, cone.data, lanes=lanes).wait()
+    launch(q, runner.cone_k, bw * bh, *runner.cone_args(blocks_w=bw, bx0=bx0, by0=by0, cone=cone), lanes=lanes).wait()
+    fr, pr = plan.frame, runner.pr
+    camera = tuple(pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up)) + (pr.scalar(fr.tan_half_fov),)
     n = tile.n
     n_blocks = -(-tile.aw // CONE_BLOCK) * -(-tile.ah // (lanes // CONE_BLOCK))
     outs = [cla.empty(q, n, np.float32), cla.empty(q, n, np.int32), cla.empty(q, n, np.int32)]
@@ -95,8 +96,8 @@ def main(argv=None) -> int:
         runs = []
         for _ in range(a.repeats):
             items = -(-n_blocks // qb)
-            kernel.set_args(np.int32(n_blocks), np.int32(n), np.int32(tile.aw), *runner.camera[:5],
-                            np.int32(w), np.int32(h), np.int32(tile.ax0), np.int32(tile.ay0), runner.march_const[0],
+            kernel.set_args(np.int32(n_blocks), np.int32(n), np.int32(tile.aw), *camera,
+                            np.int32(w), np.int32(h), np.int32(tile.ax0), np.int32(tile.ay0), pr.v4(ma.c),
                             np.int32(ma.max_iter), np.float32(ma.bailout), np.float32(ma.epsilon), np.float32(ma.radius),
                             np.float32(ma.near), np.float32(ma.far), np.int32(ma.max_steps), cone.data, np.int32(bw),
                             np.int32(qb), *(o.data for o in outs))

@@ -46,7 +46,8 @@ from pyjulia4d.pipeline import kernel_config  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.opencl.lanes import lanes_for, packet_pairs  # noqa: E402
-from pyjulia4d.opencl.runner import Precision, launch, march_items, queue_for  # noqa: E402
+from pyjulia4d.opencl.records import Precision  # noqa: E402
+from pyjulia4d.opencl.runner import launch, march_items, queue_for  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 from run_log import append_run, git_commit, utc_now  # noqa: E402
 from bench_args import Parser, size_of  # noqa: E402

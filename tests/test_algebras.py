@@ -10,7 +10,8 @@ from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
 from pyjulia4d.reference.algebra import commutative as cm, cquat as cq, hypercomplex as hc, quaternion as qa
 from pyjulia4d.reference.formula import Formula, complex_value
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError

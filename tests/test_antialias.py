@@ -171,7 +171,7 @@ def test_adaptive_colour_matches_reference(over):
 def test_progress_total_is_the_adaptive_work(monkeypatch):
     import sys
 
-    rmod = sys.modules["pyjulia4d.opencl.executor"]   # the package's render is the function
+    from pyjulia4d.opencl import passes as rmod   # where the passes drive their progress
 
     bars = []
 

@@ -10,7 +10,8 @@ import pytest
 
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame, march_radius
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.pipeline.result import percentiles
 from pyjulia4d.scene.model import Scene
 

@@ -21,7 +21,8 @@ from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.measure import catalogue as cat
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame
-from pyjulia4d.opencl.executor import STATUS_CAPPED, STATUS_HIT, STATUS_MISS, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method

@@ -11,7 +11,8 @@ from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import mandelbrot_radius
 from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.kind import rotate
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 

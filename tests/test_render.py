@@ -119,14 +119,14 @@ def test_tiles_give_the_same_image(normals):
 
 @pytest.mark.parametrize("ahead", [False, True])
 def test_tiles_queued_ahead_or_not_give_the_same_image(monkeypatch, ahead):
-    # executor._run_tiles: a CPU device has the next tile queued once the last one is done,
+    # passes.run_tiles: a CPU device has the next tile queued once the last one is done,
     # a GPU before the host waits for it; either order gives the same pixels, filed from
     # buffers mapped while the next tile's kernels write the other slot's
-    from pyjulia4d.opencl import executor
+    from pyjulia4d.opencl import passes
 
     s = Scene.default().with_overrides(["image.width=53", "image.height=41", "image.samples=2"])
     want = render(s, tile=512)
-    monkeypatch.setattr(executor, "queue_ahead", lambda dev: ahead)
+    monkeypatch.setattr(passes, "queue_ahead", lambda dev: ahead)
     got = render(s, tile=16)
     for k in ("depth", "bracket", "status", "samples", "normal", "position", "color", "alpha"):
         np.testing.assert_array_equal(getattr(got, k), getattr(want, k), err_msg=k)

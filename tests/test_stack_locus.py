@@ -12,7 +12,8 @@ from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import march_radius
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method

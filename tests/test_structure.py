@@ -186,3 +186,55 @@ def test_packet_kernels_say_so() -> None:
         packet = any(s in body for s in ("block_lanes(get_global_id(0)", "packet_lanes(get_global_id(0)",
                                          "get_global_id(0) * LANES"))
         assert qualifier == ("PACKET_KERNEL" if packet else "__kernel"), name
+
+
+# The executors: after planning they read the plan alone (pipeline/plan.py).  Each entry is a
+# module and the functions of it that execute ("*": all of it); ``plan.scene`` may only ride
+# on to the result (RenderResult's scene=), as metadata.
+EXECUTORS = {
+    "pyjulia4d.opencl.passes": "*",
+    "pyjulia4d.opencl.runner": "*",
+    "pyjulia4d.pipeline.calibrate": "*",
+    "pyjulia4d.reference.executor": {"execute"},
+    "pyjulia4d.reference.shade": {"light_terms_of_plan", "extra_visibility_of_plan"},
+}
+
+
+def _scene_reads(tree: ast.AST) -> list[int]:
+    """Lines where ``tree`` reads a scene: the name ``scene`` or an attribute ``.scene``, except
+    as the value of a ``scene=`` keyword (the result's metadata)."""
+    passed = {id(k.value) for k in ast.walk(tree) if isinstance(k, ast.keyword) and k.arg == "scene"}
+    return [n.lineno for n in ast.walk(tree)
+            if id(n) not in passed and ((isinstance(n, ast.Attribute) and n.attr == "scene")
+                                        or (isinstance(n, ast.Name) and n.id == "scene"))]
+
+
+def test_executors_read_no_scene() -> None:
+    """The OpenCL executor's passes and runner, calibration and the float64 executor take every
+    number from the plan's records; a scene read there would be a second source."""
+    bad = {}
+    for mod, funcs in EXECUTORS.items():
+        tree = ast.parse(MODULES[mod].read_text())
+        nodes = [tree] if funcs == "*" else [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name in funcs]
+        assert funcs == "*" or len(nodes) == len(funcs), mod
+        lines = [ln for node in nodes for ln in _scene_reads(node)]
+        if lines:
+            bad[mod] = lines
+    assert bad == {}
+
+
+def test_executors_see_a_scene_read() -> None:
+    """The check above finds what it looks for."""
+    assert _scene_reads(ast.parse("w = plan.scene.image.width\nr = RenderResult(scene=plan.scene)")) == [1]
+
+
+# Where the march is resolved from a scene: planning (the registry, the plan and what it
+# calls: kernel configurations, the work bound, the bounding ball) and the render's entry,
+# which picks the packet width before the plan.  Everything after reads plan.march.method.
+PLANNING = {"pyjulia4d.fractal.registry", "pyjulia4d.pipeline.plan", "pyjulia4d.pipeline.kernel_config",
+            "pyjulia4d.pipeline.workload", "pyjulia4d.geometry.camera", "pyjulia4d.opencl.executor"}
+
+
+def test_march_method_is_resolved_in_planning_only() -> None:
+    calls = {m for m, p in MODULES.items() if re.search(r"\bmarch_method\(", p.read_text())}
+    assert calls - PLANNING == set()

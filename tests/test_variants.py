@@ -13,7 +13,8 @@ import pytest
 
 from harness import packet_widths
 from pyjulia4d.opencl import lanes as lanes_mod
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
 
 SCENES = [

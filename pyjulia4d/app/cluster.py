@@ -408,6 +408,7 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
              f"{rendered_where({(i.worker, i.pid) for i in infos})})")
     # scene: the camera every tile used (camera.fit resolved once), which the header records
     result = RenderResult(**arrays, counts=counts, guards=guards, lanes=first.lanes,
+                          march_method=first.march_method,
                           device_name=", ".join(names) + where,
                           kernel_seconds=sum(r.kernel_seconds for r in parts.values()), scene=scene)
     result.seconds = time.perf_counter() - t0

@@ -47,7 +47,8 @@ import numpy as np
 
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import bounding_radius, camera_frame
-from pyjulia4d.opencl.executor import STATUS_HIT, render
+from pyjulia4d.opencl.executor import render
+from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.fractal.registry import has_distance_estimate
 

@@ -7,7 +7,9 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.opencl import build
-from pyjulia4d.opencl.runner import Precision, launch, queue_for
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.opencl.runner import launch, queue_for
+from pyjulia4d.pipeline import signatures as sig
 from pyjulia4d.pipeline.mesh_plan import MeshPlan
 
 
@@ -21,17 +23,15 @@ class MeshRunner:
         self.sample_k = build.kernel(prg, "mesh_sample")
         self.vertex_k = build.kernel(prg, "mesh_vertices")
         pr = self.pr = Precision(plan.double)
-        self.grid = (pr.v4(tuple(plan.origin) + (0.0,)), pr.scalar(plan.spacing),
-                     *(pr.v4(a) for a in plan.axes), pr.v4(plan.offset))
-        self.fractal = (pr.scalar(plan.radius ** 2), pr.v4(plan.c), np.int32(plan.max_iter), pr.scalar(plan.bailout))
+        self.sample_args = Packed(sig.MESH_SAMPLE, {"mesh": plan}, pr, nx=plan.n, ny=plan.n)
+        self.vertex_args = Packed(sig.MESH_VERTICES, {"mesh": plan}, pr)
 
     def sample(self, k0: int, nk: int) -> np.ndarray:
         """The inside mask of grid layers k0 .. k0 + nk - 1: uint8, shape (nk, n, n), [k, j, i]."""
         n = self.plan.n
         count = nk * n * n
         out = cla.empty(self.queue, count, np.uint8)
-        launch(self.queue, self.sample_k, count, np.int32(n), np.int32(n), np.int32(k0), *self.grid,
-               *self.fractal, out.data)
+        launch(self.queue, self.sample_k, count, *self.sample_args(k0=k0, inside=out))
         return out.get().reshape(nk, n, n)
 
     def vertices(self, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -46,8 +46,8 @@ class MeshRunner:
         vertex = cla.empty(self.queue, m, pr.vec_dtype)
         inner = cla.empty(self.queue, m, pr.vec_dtype)
         width = cla.empty(self.queue, m, pr.scalar)
-        launch(self.queue, self.vertex_k, m, o.data, i.data, *self.fractal, np.int32(self.plan.steps),
-               vertex.data, width.data, inner.data)
+        launch(self.queue, self.vertex_k, m, *self.vertex_args(ends_a=o, ends_b=i, vertex=vertex, width=width,
+                                                                inside_end=inner))
         return _from_vec4(vertex.get()), width.get().astype(np.float64), _from_vec4(inner.get())
 
 

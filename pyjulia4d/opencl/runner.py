@@ -16,9 +16,10 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.opencl import build, pool
-from pyjulia4d.pipeline import colormap, kernel_config
-from pyjulia4d.pipeline.plan import Plan, Tile, gradient_step
-from pyjulia4d.scene.model import Scene
+from pyjulia4d.opencl.records import Packed, Precision, float4
+from pyjulia4d.pipeline import colormap, kernel_config, signatures as sig
+from pyjulia4d.pipeline.plan import Plan, Tile
+from pyjulia4d.pipeline.workload import OUTPUTS_TABLE
 
 
 _queues: dict[int, tuple[cl.Context, cl.CommandQueue]] = {}
@@ -33,24 +34,6 @@ def queue_for(device: cl.Device) -> tuple[cl.Context, cl.CommandQueue]:
         _queues[key] = (ctx, cl.CommandQueue(
             ctx, properties=cl.command_queue_properties.PROFILING_ENABLE))
     return _queues[key]
-
-
-class Precision:
-    """numpy types matching the kernels' real / real4 for one precision."""
-
-    def __init__(self, double: bool):
-        self.scalar = np.float64 if double else np.float32
-        self.vec_dtype = cl.cltypes.double4 if double else cl.cltypes.float4
-        self.cone_dtype = cl.cltypes.double2 if double else cl.cltypes.float2
-
-    def v4(self, v) -> np.ndarray:
-        """A real4 argument (cltypes' make_float4 compiles a lambda with eval at every call:
-        a millisecond of each render's set-up)."""
-        return np.array(tuple(float(x) for x in v), self.vec_dtype)
-
-
-def _float4(v3, w=0.0):
-    return np.array((*(float(x) for x in v3), float(w)), cl.cltypes.float4)
 
 
 # The floor of normals.step = "auto": a central difference of the estimate over a step h
@@ -132,31 +115,6 @@ def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int 
     return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
 
 
-def launch_normals(queue, prg, scene: Scene, method: str, frame, pr: Precision,
-                   point, depth, status, normal, flags, size: tuple[int, int] | None = None,
-                   lanes: int = 1) -> cl.Event | None:
-    """Enqueue the normals kernel of ``method`` (kernels/normals/<method>.cl) on the march's
-    device buffers of one tile of ``size`` = (width, height) pixels (default: the whole
-    image); writes ``normal`` (unit camera-coordinate normal, w 0) and ORs each hit's guard
-    flags into ``flags`` (the march's)."""
-    f = scene.fractal
-    w, h = size or (scene.image.width, scene.image.height)
-    n = w * h
-    c = pr.v4(f.c)
-    eye, fwd, right, up = (pr.v4(v) for v in (frame.position, frame.forward, frame.right, frame.up))
-    kernel = build.kernel(prg, f"normals_{method}")
-    if method == "jacobian":
-        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
-                      pr.scalar(f.bailout), right, up, fwd, normal.data, flags.data, lanes=lanes)
-    if method == "gradient":
-        return launch(queue, kernel, n, point.data, status.data, c, np.int32(f.max_iter),
-                      pr.scalar(f.bailout), pr.scalar(gradient_step(scene)), right, up, fwd, normal.data,
-                      flags.data)
-    return launch(queue, kernel, n, point.data, depth.data, status.data, np.int32(w), np.int32(h), eye,
-                  right, up, fwd, normal.data, flags.data)
-
-
-
 # Small read-only arrays the kernels take (colour map, lights), kept by context and content:
 # each upload waited for its copy, 0.09 ms a buffer, three a render before its first kernel.
 _constants: "OrderedDict[tuple, cla.Array]" = OrderedDict()
@@ -180,15 +138,6 @@ def constant(queue: cl.CommandQueue, ary: np.ndarray) -> cla.Array:
     return got
 
 
-# The device buffers each output needs (march/march.cl, normals_*.cl, shade.cl); status, flags,
-# depth, bracket and the normals' guard word are read back always (one tile's worth): the
-# streamed counts, guards and bracket statistics come from them.
-_READ = {"color": ("rgba",), "alpha": ("status",), "depth": ("depth",), "bracket": ("bracket",),
-         "unresolved": ("unresolved",),
-         "normal": ("normal",), "position": ("point",), "status": ("status",),
-         "samples": ("samples",)}
-
-
 class TileRunner:
     """The kernels of one plan on one device, with two slots of tile buffers (and the host's
     maps of them) so that one tile's kernels run while the previous one is filed."""
@@ -202,7 +151,7 @@ class TileRunner:
         self.march_prg = build.program(self.ctx, plan.march_config)
         self.pr = pr = Precision(plan.double)
         nmax = max(t.n for t in plan.tiles)
-        read = {"status", "flags", "depth", "bracket", "unresolved"} | {b for k in plan.outputs for b in _READ[k]}
+        read = {"status", "flags", "depth", "bracket", "unresolved"} | {b for k in plan.outputs for b in OUTPUTS_TABLE[k].buffers}
         self.read = read
         nb = max(bw * bh for _, _, bw, bh in (t.cone_blocks() for t in plan.tiles)) if plan.march.cone else 0
         extra = "EXTRA_SHADOWS" in plan.config.defines
@@ -210,51 +159,44 @@ class TileRunner:
         self.slot_key = (self.ctx.int_ptr, nmax, plan.double, frozenset(read), plan.normals, plan.shades, nb,
                          plan.reflects, plan.light_terms, extra)
         self.slots = pool.take(self.slot_key) or [self.make_slot(nmax, nb, extra) for _ in range(self.SLOTS)]
-        # the plan's argument records (pipeline/plan.py), in the order the kernels declare them
-        fr, ma, sa, la = plan.frame, plan.march, plan.shade, plan.light_args
-        self.eye, self.fwd, self.right, self.up = (pr.v4(v) for v in (fr.position, fr.forward, fr.right, fr.up))
-        self.camera = (self.eye, self.fwd, self.right, self.up, pr.scalar(fr.tan_half_fov),
-                       np.int32(plan.scene.image.width), np.int32(plan.scene.image.height))
-        self.march_const = (pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
-                            pr.scalar(ma.radius), pr.scalar(ma.near), pr.scalar(ma.far),
-                            np.int32(ma.z_resolution), np.int32(ma.post_steps), np.int32(ma.max_steps))
-        self.shade_const = (self.eye, self.right, self.up, self.fwd, pr.v4(sa.light),
-                            _float4(sa.color), _float4(sa.background), _float4(sa.light_color),
-                            _float4(sa.sky), np.float32(sa.ambient), np.float32(sa.diffuse), np.float32(sa.specular),
-                            np.float32(sa.shininess))
-        self.fog = (np.float32(sa.fog), np.float32(sa.fog_start))
-        self.march_k = build.kernel(self.march_prg, "march")
-        self.cone_k = build.kernel(self.march_prg, "cone_starts") if plan.march.cone else None
-        self.cone_const = (pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.radius),
-                           pr.scalar(ma.near), pr.scalar(ma.far), np.int32(ma.max_steps))
-        planes = plan.clip.planes
-        self.clip_n = tuple(pr.v4(planes[k][0] if k < len(planes) else (0, 0, 0, 0)) for k in range(4))
-        self.clip_args = ((np.int32(len(planes)),) + self.clip_n +
-                          (pr.v4([planes[k][1] if k < len(planes) else 0.0 for k in range(4)]),)
-                          if planes else ())
-        self.clip_k = build.kernel(self.prg, "clip_normals") if planes and plan.normals else None
-        self.shade_k = build.kernel(self.prg, "shade") if plan.shades else None
-        # shade/light.cl: in the march's program, in its packets (kernel_config.march_config)
-        self.light_k = build.kernel(self.march_prg, "light_terms") if plan.light_terms else None
-        self.light_const = ((pr.v4(ma.c), np.int32(ma.max_iter), pr.scalar(ma.bailout), pr.scalar(ma.epsilon),
-                             self.right, self.up, self.fwd, pr.v4(sa.light), pr.scalar(ma.radius),
-                             pr.scalar(la.step), pr.scalar(la.bias), pr.scalar(la.softness), np.int32(la.max_steps),
-                             pr.scalar(la.ao_distance), pr.scalar(la.ao_strength), pr.v4(la.trap))
-                            if plan.light_terms else ())
-        lut = colormap.table(sa.colormap) if sa.colormap is not None else np.zeros((2, 4), np.float32)
-        self.lut = constant(self.queue, lut.view(cl.cltypes.float4).ravel())
-        self.n_lut = np.int32(len(lut))
+        # each kernel's arguments (pipeline/signatures.py) packed from the plan's records once;
+        # a launch gives only its tile's place and buffers
+        rec = plan.records()
+        lut = colormap.table(plan.shade.colormap) if plan.shade.colormap is not None else None
+        march_defines = plan.march_config.defines
+        self.lut = constant(self.queue, (lut if lut is not None else np.zeros((2, 4), np.float32))
+                            .view(cl.cltypes.float4).ravel())
         self.no_terms = constant(self.queue, np.zeros(1, cl.cltypes.float4))
         # shading.lights: positions or directions, colours; their visibility per pixel where
         # shadows are traced (-D EXTRA_SHADOWS)
-        self.lights_geo = constant(self.queue, np.array([pr.v4(g) for g in sa.lights_geo]))
-        self.lights_rgb = constant(self.queue, np.array([_float4(c[:3], c[3]) for c in sa.lights_rgb]))
+        sa = plan.shade
+        lights = dict(lights_geo=constant(self.queue, np.array([pr.v4(g) for g in sa.lights_geo])),
+                      lights_rgb=constant(self.queue, np.array([float4(c) for c in sa.lights_rgb])))
+        self.march_k = build.kernel(self.march_prg, "march")
+        self.march_args = Packed(sig.MARCH, rec, pr, march_defines)
+        self.cone_k = build.kernel(self.march_prg, "cone_starts") if plan.march.cone else None
+        self.cone_args = Packed(sig.CONE_STARTS, rec, pr) if plan.march.cone else None
+        normals = sig.NORMALS[plan.normals_args.method]
+        packet = plan.normals_in_march_config
+        self.normals_k = build.kernel(self.march_prg if packet else self.prg, normals.kernel) if plan.normals else None
+        self.normals_args = Packed(normals, rec, pr)
+        self.normals_lanes = plan.lanes if packet else 1
+        planes = plan.clip.planes
+        self.clip_k = build.kernel(self.prg, "clip_normals") if planes and plan.normals else None
+        self.clip_args = Packed(sig.CLIP, rec, pr)
+        self.shade_k = build.kernel(self.prg, "shade") if plan.shades else None
+        self.shade_args = Packed(sig.SHADE, rec, pr, lut=self.lut, n_lut=len(lut) if lut is not None else 2, **lights)
+        # shade/light.cl: in the march's program, in its packets (kernel_config.march_config)
+        self.light_k = build.kernel(self.march_prg, "light_terms") if plan.light_terms else None
+        self.light_args = Packed(sig.LIGHT_TERMS, rec, pr, **lights)
         if plan.reflects:
             self.refl_prg = build.program(self.ctx, plan.reflect_config)
             self.refl_march_k = build.kernel(self.refl_prg, "march")
+            self.refl_march_args = Packed(sig.MARCH, rec, pr, plan.reflect_config.defines)
             self.reflect_rays_k = build.kernel(self.prg, "reflect_rays")
+            self.reflect_rays_args = Packed(sig.REFLECT_RAYS, rec, pr)
             self.reflect_color_k = build.kernel(self.prg, "reflect_color")
-            self.refl_bias = pr.scalar(la.bias)
+            self.reflect_color_args = Packed(sig.REFLECT_COLOR, rec, pr)
 
     def make_slot(self, nmax: int, nb: int, extra: bool) -> tuple[dict, dict]:
         """One slot: the device buffers of a tile of up to nmax pixels (nb cone blocks) and
@@ -314,47 +256,35 @@ class TileRunner:
         """Queue the tile's kernels - rays through sample ``sample`` of ``samples`` of each
         pixel (rays.cl; one: the centre) - and the maps of what is read back from ``slot``:
         (kernel events, map events); nothing waits."""
-        plan, pr, q = self.plan, self.pr, self.queue
+        plan, q = self.plan, self.queue
         bufs, maps = self.slots[slot]
         n = tile.n
-        kernels, cone = [], ()
+        items = march_items(n, tile.aw, plan.lanes, plan.march_packets)
+        kernels, cone = [], {}
         if self.cone_k is not None:
             bx0, by0, bw, bh = tile.cone_blocks()
-            kernels.append(launch(q, self.cone_k, bw * bh, np.int32(bw), np.int32(bx0), np.int32(by0), *self.camera,
-                                  *self.cone_const, bufs["cone"].data, lanes=plan.lanes * plan.march_packets))
-            cone = (bufs["cone"].data, np.int32(bw))
-        kernels.append(launch(q, self.march_k, n, np.int32(tile.aw), *self.camera, np.int32(tile.ax0),
-                              np.int32(tile.ay0), np.int32(sample), np.int32(samples), *self.march_const,
-                              bufs["depth"].data, bufs["point"].data, bufs["status"].data, bufs["samples"].data,
-                              bufs["flags"].data, bufs["bracket"].data, bufs["unresolved"].data, *self.clip_args,
-                              *cone, items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
+            kernels.append(launch(q, self.cone_k, bw * bh, *self.cone_args(blocks_w=bw, bx0=bx0, by0=by0,
+                                                                           cone=bufs["cone"]),
+                                  lanes=plan.lanes * plan.march_packets))
+            cone = dict(cone=bufs["cone"], cone_w=bw)
+        kernels.append(launch(q, self.march_k, n, *self.march_args(
+            tile_w=tile.aw, x0=tile.ax0, y0=tile.ay0, pixel_sample=sample, pixel_samples=samples,
+            **self.march_outputs(bufs, ""), **cone), items=items))
         if plan.normals:
-            method = plan.scene.normals.method
-            packet = plan.normals_in_march_config
-            kernels.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, method,
-                                          plan.frame, pr, bufs["point"], bufs["depth"], bufs["status"],
-                                          bufs["normal"], bufs["flags"], size=(tile.aw, tile.ah),
-                                          lanes=plan.lanes if packet else 1))
-            if self.clip_k is not None:
-                kernels.append(launch(q, self.clip_k, n, bufs["flags"].data, bufs["status"].data, self.right,
-                                      self.up, self.fwd, *self.clip_n, bufs["normal"].data))
+            kernels += self.enqueue_normals(tile, bufs, "")
         if plan.reflects:
             kernels += self.enqueue_reflection(tile, bufs)
         if plan.light_terms:
-            kernels.append(launch(q, self.light_k, n, np.int32(tile.aw), bufs["point"].data, bufs["normal"].data,
-                                  bufs["status"].data, bufs["bracket"].data, self.eye, *self.light_const,
-                                  self.lights_geo.data, self.lights_rgb.data, bufs["terms"].data,
-                                  bufs["vis_extra"].data,
-                                  items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
+            kernels.append(launch(q, self.light_k, n, *self.light_args(
+                tile_w=tile.aw, point=bufs["point"], normal=bufs["normal"], status=bufs["status"],
+                bracket=bufs["bracket"], terms=bufs["terms"], vis_extra=bufs["vis_extra"]), items=items))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms
             refl = bufs["refl"] if plan.reflects else self.no_terms
-            kernels.append(launch(q, self.shade_k, n, bufs["status"].data, bufs["normal"].data,
-                                  bufs["point"].data, *self.shade_const, terms.data, self.lut.data,
-                                  self.n_lut, *self.fog, self.lights_geo.data, self.lights_rgb.data,
-                                  vis_extra.data, refl.data, np.float32(plan.shade.reflection),
-                                  bufs["rgba"].data))
+            kernels.append(launch(q, self.shade_k, n, *self.shade_args(
+                status=bufs["status"], normal=bufs["normal"], point=bufs["point"], terms=terms,
+                vis_extra=vis_extra, refl=refl, rgba=bufs["rgba"])))
         # read back by mapping (the slot's last maps were let go once its tile was filed): no
         # copy on a CPU device, where copies took 0.1-0.5 ms a buffer of 512x480 pixels on
         # Intel's runtime, in line between this tile's kernels and the next's
@@ -365,30 +295,40 @@ class TileRunner:
             mapped.append(ev)
         return kernels, mapped
 
+    @staticmethod
+    def march_outputs(bufs: dict, suffix: str) -> dict:
+        """The march's output buffers by parameter name: the camera rays' (suffix ""), or the
+        reflected rays' ("2")."""
+        return {k: bufs[k + suffix] for k in ("depth", "point", "status", "samples", "flags", "bracket", "unresolved")}
+
+    def enqueue_normals(self, tile: Tile, bufs: dict, suffix: str) -> list:
+        """The normals of the march's hits (kernels/normals/<method>.cl), then the cut faces'
+        (march/clip.cl): each hit's unit camera-coordinate normal, its guard flags ORed into the
+        march's; ``suffix`` as for march_outputs."""
+        q, n = self.queue, tile.n
+        point, status, flags, normal = (bufs[k + suffix] for k in ("point", "status", "flags", "normal"))
+        given = dict(point=point, status=status, normal=normal, flags=flags)
+        if self.plan.normals_args.method == "zbuffer":
+            given.update(depth=bufs["depth" + suffix], width=tile.aw, height=tile.ah)
+        ev = [launch(q, self.normals_k, n, *self.normals_args(**given), lanes=self.normals_lanes)]
+        if self.clip_k is not None:
+            ev.append(launch(q, self.clip_k, n, *self.clip_args(flags=flags, status=status, normal=normal)))
+        return ev
+
     def enqueue_reflection(self, tile: Tile, bufs: dict) -> list:
         """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
         march reading given rays, in the same packets), its normals and its colour."""
-        plan, pr, q, n = self.plan, self.pr, self.queue, tile.n
-        sa = plan.shade
-        ev = [launch(q, self.reflect_rays_k, n, bufs["point"].data, bufs["normal"].data, bufs["status"].data,
-                     self.eye, self.right, self.up, self.fwd, self.refl_bias, pr.scalar(plan.radius),
-                     bufs["origins"].data, bufs["dirs"].data)]
-        ev.append(launch(q, self.refl_march_k, n, np.int32(tile.aw), bufs["origins"].data, bufs["dirs"].data,
-                         *self.march_const, bufs["depth2"].data, bufs["point2"].data, bufs["status2"].data,
-                         bufs["samples2"].data, bufs["flags2"].data, bufs["bracket2"].data,
-                         bufs["unresolved2"].data, *self.clip_args,
-                         items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
-        packet = plan.normals_in_march_config
-        ev.append(launch_normals(q, self.march_prg if packet else self.prg, plan.scene, plan.scene.normals.method,
-                                 plan.frame, pr, bufs["point2"], bufs["depth2"], bufs["status2"], bufs["normal2"],
-                                 bufs["flags2"], size=(tile.aw, tile.ah), lanes=plan.lanes if packet else 1))
-        if self.clip_k is not None:
-            ev.append(launch(q, self.clip_k, n, bufs["flags2"].data, bufs["status2"].data, self.right, self.up,
-                             self.fwd, *self.clip_n, bufs["normal2"].data))
-        ev.append(launch(q, self.reflect_color_k, n, bufs["status2"].data, bufs["normal2"].data,
-                         bufs["point2"].data, bufs["dirs"].data, self.right, self.up, self.fwd,
-                         pr.v4(sa.light), _float4(sa.color), _float4(sa.background), _float4(sa.light_color),
-                         _float4(sa.sky), np.float32(sa.ambient), np.float32(sa.diffuse), bufs["refl"].data))
+        plan, q, n = self.plan, self.queue, tile.n
+        ev = [launch(q, self.reflect_rays_k, n, *self.reflect_rays_args(
+            point=bufs["point"], normal=bufs["normal"], status=bufs["status"], origins=bufs["origins"],
+            dirs=bufs["dirs"]))]
+        ev.append(launch(q, self.refl_march_k, n, *self.refl_march_args(
+            tile_w=tile.aw, origins=bufs["origins"], dirs=bufs["dirs"], **self.march_outputs(bufs, "2")),
+            items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
+        ev += self.enqueue_normals(tile, bufs, "2")
+        ev.append(launch(q, self.reflect_color_k, n, *self.reflect_color_args(
+            status=bufs["status2"], normal=bufs["normal2"], point=bufs["point2"], dirs=bufs["dirs"],
+            refl=bufs["refl"])))
         return ev
 
     def collect(self, tile: Tile, slot: int) -> dict[str, np.ndarray]:

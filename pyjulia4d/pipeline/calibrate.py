@@ -65,7 +65,7 @@ def probe_tiles(plan: Plan) -> tuple:
     further apart)."""
     from pyjulia4d.pipeline.plan import make_tiles
     x0, y0, w, h = plan.region
-    W, H = plan.scene.image.width, plan.scene.image.height
+    W, H = plan.image.width, plan.image.height
     b = PROBE_BOX
     n = max(1, PROBE_RAYS // (b * b))
     nx = max(1, min(-(-w // b), round(math.sqrt(n * w / h))))
@@ -80,12 +80,6 @@ def probe_tiles(plan: Plan) -> tuple:
     return tuple(tiles)
 
 
-def passes(plan: Plan) -> int:
-    """Passes over every pixel: the centre, and image.samples colour passes (opencl/executor.py)."""
-    s = plan.scene.image.samples
-    return 1 + s if s > 1 and {"color", "alpha"} & plan.outputs else 1
-
-
 def predict(plan: Plan, run_tiles) -> Prediction:
     """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (opencl/executor.py) and
     returns their kernel seconds; scaled to the region's pixels and the passes."""
@@ -94,7 +88,7 @@ def predict(plan: Plan, run_tiles) -> Prediction:
     seconds = run_tiles(tiles)
     spp = seconds / pixels
     _, _, w, h = plan.region
-    return Prediction(spp * w * h * passes(plan), spp, pixels, seconds)
+    return Prediction(spp * w * h * plan.passes, spp, pixels, seconds)
 
 
 def _duration(seconds: float) -> str:
@@ -107,9 +101,7 @@ def _duration(seconds: float) -> str:
 
 def judge(plan: Plan, pred: Prediction, force: bool) -> None:
     """Refuse a render predicted above REFUSE_SECONDS (unless ``force``); warn above WARN_SECONDS."""
-    key = plan.estimate.dominant
-    section, _, name = key.partition(".")
-    value = getattr(getattr(plan.scene, section), name)
+    key, value = plan.estimate.dominant, plan.estimate.value
     text = f"about {_duration(pred.seconds)} on this device ({pred.describe()})"
     if pred.seconds > REFUSE_SECONDS and not force:
         raise WorkloadError(key, f"{value} would take {text}, over the limit of "

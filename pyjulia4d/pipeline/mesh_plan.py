@@ -48,6 +48,13 @@ class MeshPlan:
     def double(self) -> bool:
         return self.scene.render.float == "double"
 
+    # the kernels' names for what they take (pipeline/signatures.py MESH_SAMPLE, MESH_VERTICES)
+    origin4 = property(lambda self: tuple(self.origin) + (0.0,))
+    rx = property(lambda self: self.axes[0])
+    ry = property(lambda self: self.axes[1])
+    rz = property(lambda self: self.axes[2])
+    radius2 = property(lambda self: self.radius ** 2)
+
     def to_world(self, ijk: np.ndarray) -> np.ndarray:
         """World points (..., 4) of grid coordinates (..., 3) (i, j, k; fractional allowed)."""
         xyz = np.asarray(self.origin) + self.spacing * np.asarray(ijk, float)

@@ -18,7 +18,7 @@ from pyjulia4d.pipeline import kernel_config, workload
 from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
 from pyjulia4d.scene.checks import SceneError, show
-from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.model import Fractal, Image, Scene
 from pyjulia4d.fractal.registry import has_distance_estimate, march_method
 
 # Tiles of at most TILE x TILE pixels (plus a one-pixel halo for the Z-buffer normals,
@@ -114,8 +114,25 @@ class MarchArgs:
 
 @dataclass(frozen=True)
 class ClipArgs:
-    """[clip]'s half-spaces in world space, as march.cl and march/clip.cl take them."""
+    """[clip]'s half-spaces in world space, as march.cl and march/clip.cl take them: up to
+    four (normal, offset) pairs, the unused ones zero."""
     planes: tuple[tuple[np.ndarray, float], ...]
+
+    @property
+    def n_clip(self) -> int:
+        return len(self.planes)
+
+    def normal(self, k: int):
+        return self.planes[k][0] if k < len(self.planes) else (0.0, 0.0, 0.0, 0.0)
+
+    clip_n0 = property(lambda self: self.normal(0))
+    clip_n1 = property(lambda self: self.normal(1))
+    clip_n2 = property(lambda self: self.normal(2))
+    clip_n3 = property(lambda self: self.normal(3))
+
+    @property
+    def clip_off(self) -> tuple[float, ...]:
+        return tuple(self.planes[k][1] if k < len(self.planes) else 0.0 for k in range(4))
 
 
 @dataclass(frozen=True)
@@ -134,6 +151,14 @@ class LightArgs:
     ao_distance: float
     ao_strength: float
     trap: tuple[float, float, float, float]
+    shadow: str            # the positioned light's shadows: "none", "hard" or "soft" (none for the light at the eye)
+    extra_shadow: str      # shading.lights' shadows: "none" without them
+    coloring: str          # shading.coloring: the colour value light.cl computes
+
+    @property
+    def used(self) -> bool:
+        """Whether shade/light.cl has anything to compute (kernel_config.light_defines)."""
+        return self.shadow != "none" or self.extra_shadow != "none" or self.ao_strength > 0 or self.coloring != "flat"
 
 
 @dataclass(frozen=True)
@@ -153,8 +178,9 @@ class ShadeArgs:
     fog_start: float       # the eye's distance to the bounding ball (fog_start)
     reflection: float
     colormap: str | None   # shading.colormap where a colour map is used, else None
-    lights_geo: np.ndarray     # shading.lights (camera.extra_lights)
+    lights_geo: np.ndarray     # shading.lights (camera.extra_lights; one inert row where there are none)
     lights_rgb: np.ndarray
+    n_lights: int = 0          # how many shading.lights there are
 
 
 def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
@@ -164,6 +190,7 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     lp = light_position(scene)
     light = light_parameters(scene, radius)
     geo, rgb = extra_lights(scene)
+    point_light = not isinstance(sh.light, str)
     return dict(
         march=MarchArgs(c=tuple(f.c), max_iter=f.max_iter, bailout=f.bailout, epsilon=m.epsilon, radius=radius,
                         near=-1.0 if m.near == "auto" else float(m.near),
@@ -172,18 +199,24 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
                         refine=m.refine, cone=kernel_config.cone_start(scene)),
         clip=ClipArgs(tuple(clip_planes(scene))),
         normals=NormalsArgs(scene.normals.method, gradient_step(scene)),
-        light_args=LightArgs(**light),
+        # light.cl traces the positioned light's shadows (the light at the eye lights all it sees)
+        light_args=LightArgs(**light, shadow=sh.shadow if point_light else "none",
+                             extra_shadow=sh.shadow if sh.lights else "none", coloring=sh.coloring),
         shade=ShadeArgs(light=lp if lp is not None else frame.position, point_light=lp, color=tuple(sh.color),
                         background=tuple(sh.background), light_color=tuple(sh.light_color), sky=tuple(sh.sky),
                         ambient=sh.ambient, diffuse=sh.diffuse, specular=sh.specular, shininess=sh.shininess,
                         fog=sh.fog, fog_start=fog_start(frame.position, radius), reflection=sh.reflection,
-                        colormap=sh.colormap if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb))
+                        colormap=sh.colormap if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb,
+                        n_lights=len(sh.lights)))
 
 
 @dataclass(frozen=True)
 class Plan:
-    """A scene resolved into what its kernels need (see the module docstring)."""
+    """A scene resolved into what its kernels need (see the module docstring).  The executors
+    read the records alone; ``scene`` rides along as the result's metadata."""
     scene: Scene
+    image: Image                  # the image's size and samples (scene.image)
+    fractal: Fractal              # the set (scene.fractal): the float64 twin's formula
     frame: Frame
     march: MarchArgs
     clip: ClipArgs
@@ -197,8 +230,21 @@ class Plan:
     march_config: kernel_config.KernelConfig   # the march, the Jacobian normals, the light terms
     tiles: tuple[Tile, ...]
     estimate: workload.Estimate
+    reflect_config: kernel_config.KernelConfig | None   # the reflected rays' march: given rays (shade/reflect.cl)
+    halo: int                     # pixels around each tile computed for its Z-buffer normals (halo_for)
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
     pairs: bool = False           # two packets per work-item of the march, where they apply (kernel_config.march_packets)
+
+    def records(self) -> dict:
+        """The records kernels take their constants from, by the names pipeline/signatures.py
+        gives them ("march.c")."""
+        return {"camera": self.frame, "image": self.image, "march": self.march, "clip": self.clip,
+                "normals": self.normals_args, "light": self.light_args, "shade": self.shade}
+
+    @property
+    def passes(self) -> int:
+        """Passes over every pixel: the centre, and image.samples colour passes (workload.passes)."""
+        return workload.passes(self.image.samples, self.outputs)
 
     @property
     def radius(self) -> float:
@@ -210,15 +256,10 @@ class Plan:
         """Whether the normals kernel runs: for the normal output or for shading."""
         return bool({"normal", "color"} & self.outputs)
 
-    @property
-    def halo(self) -> int:
-        """Pixels around each tile computed for its Z-buffer normals (which difference neighbours)."""
-        return 1 if self.scene.normals.method == "zbuffer" and self.normals else 0
-
     def retile(self, side: int) -> "Plan":
         """The same plan in tiles of at most side x side pixels (calibrate.tile_side)."""
-        W, H = self.scene.image.width, self.scene.image.height
-        return dataclasses.replace(self, tiles=make_tiles(W, H, side, self.halo, self.region))
+        return dataclasses.replace(self, tiles=make_tiles(self.image.width, self.image.height, side, self.halo,
+                                                          self.region))
 
     @property
     def shades(self) -> bool:
@@ -235,11 +276,6 @@ class Plan:
         return self.shades and "shade/reflect" in self.config.pieces
 
     @property
-    def reflect_config(self) -> kernel_config.KernelConfig:
-        """The march of the reflected rays: this plan's march reading given rays."""
-        return kernel_config.march_config(self.scene, self.lanes, ray_buffers=True, pairs=self.pairs)
-
-    @property
     def march_packets(self) -> int:
         """Packets of rays a work-item of the march takes (kernel_config.march_packets)."""
         return kernel_config.config_packets(self.march_config)
@@ -247,7 +283,13 @@ class Plan:
     @property
     def normals_in_march_config(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
-        return self.scene.normals.method == "jacobian"
+        return self.normals_args.method == "jacobian"
+
+
+def halo_for(normals_method: str, outputs) -> int:
+    """Pixels around each tile computed for its Z-buffer normals, which difference neighbours:
+    one where the normals run (for the normal output or for shading), else none."""
+    return 1 if normals_method == "zbuffer" and {"normal", "color"} & set(outputs) else 0
 
 
 def check_region(scene: Scene, region) -> tuple[int, int, int, int] | None:
@@ -293,6 +335,26 @@ def check_flag(name: str, value) -> bool:
     return value
 
 
+@dataclass(frozen=True)
+class RenderArgs:
+    """A render's own arguments, checked once (check_arguments): the outputs kept, whether to
+    force hopeless work, the tile side and the region (x0, y0, w, h; None: the image)."""
+    outputs: frozenset[str]
+    force: bool = False
+    tile: int = TILE
+    region: tuple[int, int, int, int] | None = None
+
+
+def check_arguments(scene: Scene, outputs=None, force: bool = False, tile: int = TILE, region=None) -> RenderArgs:
+    """``scene``, ``outputs``, ``force``, ``tile`` and ``region`` checked, each with the one-line
+    SceneError naming it."""
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
+    check_tile(tile)
+    check_flag("force", force)
+    return RenderArgs(resolve_outputs(outputs), force, tile, check_region(scene, region))
+
+
 def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
               tile: int = TILE, region=None, pairs: bool = False) -> Plan:
     """Check and resolve ``scene`` for ``device`` (a pyopencl Device, "CPU" or "GPU") with
@@ -300,26 +362,31 @@ def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = Fals
     kernel_config.march_packets), keeping ``outputs`` (None: all), over the image or its
     ``region`` (x0, y0, w, h) alone; each argument is checked, with the one-line SceneError
     naming it."""
-    if not isinstance(scene, Scene):
-        raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
+    args = check_arguments(scene, outputs, force, tile, region)
     check_lanes(lanes)
-    check_tile(tile)
-    check_flag("force", force)
     check_flag("pairs", pairs)
-    region = check_region(scene, region)
-    kept = resolve_outputs(outputs)
-    est = workload.check(scene, device, force=force, outputs=kept)
+    return plan_from(scene, device, lanes, args, pairs)
+
+
+def plan_from(scene: Scene, device, lanes: int, args: RenderArgs, pairs: bool = False,
+              estimate: workload.Estimate | None = None) -> Plan:
+    """The plan of ``scene`` under arguments already checked: the work judged (workload.check,
+    or ``estimate`` where the caller judged it already) and every record resolved."""
+    est = estimate or workload.check(scene, device, force=args.force, outputs=args.outputs)
     frame = camera_frame(scene)
     radius = march_radius(scene)
-    halo = 1 if scene.normals.method == "zbuffer" and {"normal", "color"} & kept else 0
-    args = kernel_arguments(scene, frame, radius)
+    halo = halo_for(scene.normals.method, args.outputs)
+    records = kernel_arguments(scene, frame, radius)
+    region = args.region
     return Plan(
-        scene=scene, frame=frame, march=args["march"], clip=args["clip"],
-        normals_args=args["normals"], light_args=args["light_args"], shade=args["shade"],
-        double=scene.render.float == "double", lanes=lanes, outputs=kept,
+        scene=scene, image=scene.image, fractal=scene.fractal, frame=frame, march=records["march"],
+        clip=records["clip"], normals_args=records["normals"], light_args=records["light_args"],
+        shade=records["shade"], double=scene.render.float == "double", lanes=lanes, outputs=args.outputs,
         config=kernel_config.shade_config(scene),
         march_config=kernel_config.march_config(scene, lanes, pairs=pairs),
-        tiles=make_tiles(scene.image.width, scene.image.height, tile, halo, region),
+        reflect_config=(kernel_config.march_config(scene, lanes, ray_buffers=True, pairs=pairs)
+                        if scene.shading.reflection > 0 else None),
+        halo=halo, tiles=make_tiles(scene.image.width, scene.image.height, args.tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height), pairs=pairs,
         estimate=est)
 

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.pipeline.codes import GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, \
     STATUS_HIT
 from pyjulia4d.scene.model import Scene
@@ -43,6 +42,7 @@ class RenderResult:
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
     lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
     scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
+    march_method: str = ""       # the march that ran: "fixed", "de" or "proven" (the plan's)
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran
 
     def __repr__(self) -> str:
@@ -120,7 +120,7 @@ class RenderResult:
     def proven(self) -> bool:
         """Whether the march proved the space it skipped empty (march.method "proven"); the
         fixed scan and the distance estimate prove nothing in front of their hits."""
-        return self.scene is not None and march_method(self.scene) == "proven"
+        return self.march_method == "proven"
 
     def report(self, stated_p99: float | None = None) -> tuple[dict[str, str], str]:
         """What a render says about itself: (header entries for PNG/EXR, the tail of the

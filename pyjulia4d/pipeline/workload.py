@@ -66,6 +66,7 @@ class Estimate:
     seconds: float             # predicted at ITERATIONS_PER_SECOND[kind, precision]
     kind: str                  # "CPU" or "GPU": the throughput used
     dominant: str              # the dotted key furthest above its typical value
+    value: object = None       # that key's value in the scene
 
     @property
     def hours(self) -> float:
@@ -81,13 +82,11 @@ def _kind(device) -> str:
     return "GPU" if device_type(device) == "GPU" else "CPU"
 
 
-def estimate(scene: Scene, device=None) -> Estimate:
-    """Upper bound of the work of ``scene`` and its predicted time on ``device``
-    (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
+def estimate(scene: Scene, device=None, outputs=None) -> Estimate:
+    """Upper bound of the work of ``scene`` keeping ``outputs`` (None: all) and its predicted
+    time on ``device`` (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
     f, m = scene.fractal, scene.march
-    # image.samples > 1: the centre pass and one colour pass per sample
-    passes = 1 + scene.image.samples if scene.image.samples > 1 else 1
-    pixels = scene.image.width * scene.image.height * passes
+    pixels = scene.image.width * scene.image.height * passes(scene.image.samples, resolve_outputs(outputs))
     # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (march/refine.cl)
     refine = m.post_steps + 3 if m.refine == "itp" else m.post_steps
     if march_method(scene) == "fixed":
@@ -105,7 +104,7 @@ def estimate(scene: Scene, device=None) -> Estimate:
     dominant = max(factors, key=lambda k: factors[k] / _TYPICAL[k])
     if dominant == "image":
         dominant = "image.width" if scene.image.width >= scene.image.height else "image.height"
-    return Estimate(its, its / ips, kind, dominant)
+    return Estimate(its, its / ips, kind, dominant, _value(scene, dominant))
 
 
 def _value(scene: Scene, dotted: str):
@@ -154,12 +153,41 @@ def check_numerics(scene: Scene) -> None:
             raise WorkloadError(key, f"must be below {2**31 - 2} (the kernel's int loop counter), got {v}")
 
 
-# What a render can keep on the host, per pixel (RenderResult's arrays, float32 / int32):
-# bytes each.  "bracket" and "unresolved" are always kept: they are the depth's certificate
-# and every render reports their statistics.  The device holds two tiles at a time (plan.TILE), whatever the size.
-OUTPUT_BYTES = {"color": 12, "alpha": 4, "depth": 4, "bracket": 4, "unresolved": 4, "normal": 12, "position": 16,
-                "status": 4, "samples": 4}
-OUTPUTS = tuple(OUTPUT_BYTES)
+@dataclass(frozen=True)
+class Output:
+    """One array a render can keep (RenderResult's field of the same name): its channels per
+    pixel, its host type, and the tile's device buffers it is read from (opencl/runner.py)."""
+    channels: int
+    dtype: str
+    buffers: tuple[str, ...]
+
+    @property
+    def bytes(self) -> int:
+        return 4 * self.channels
+
+    def shape(self, height: int, width: int) -> tuple[int, ...]:
+        return (height, width) if self.channels == 1 else (height, width, self.channels)
+
+
+# What a render can keep on the host, the one table of them.  "bracket" and "unresolved" are
+# always kept: they are the depth's certificate and every render reports their statistics.
+# The device holds two tiles at a time (plan.TILE), whatever the size.  Alpha is read from
+# shading's colour where it runs, else from the status (a hit).
+OUTPUTS_TABLE = {
+    "color": Output(3, "float32", ("rgba",)), "alpha": Output(1, "float32", ("status",)),
+    "depth": Output(1, "float32", ("depth",)), "bracket": Output(1, "float32", ("bracket",)),
+    "unresolved": Output(1, "float32", ("unresolved",)), "normal": Output(3, "float32", ("normal",)),
+    "position": Output(4, "float32", ("point",)), "status": Output(1, "int32", ("status",)),
+    "samples": Output(1, "int32", ("samples",)),
+}
+OUTPUTS = tuple(OUTPUTS_TABLE)
+OUTPUT_BYTES = {k: o.bytes for k, o in OUTPUTS_TABLE.items()}
+
+
+def passes(samples: int, outputs) -> int:
+    """Passes over every pixel: the centre, and ``samples`` colour passes where there are more
+    than one and colour or alpha is kept (opencl/executor.py, the float64 executor)."""
+    return 1 + samples if samples > 1 and {"color", "alpha"} & set(outputs) else 1
 HOST_MEMORY_SHARE = 0.5     # of the physical memory
 
 
@@ -231,14 +259,14 @@ def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estim
     estimate (the bound)."""
     check_numerics(scene)
     check_memory(scene, outputs)
-    est = estimate(scene, device)
+    est = estimate(scene, device, outputs)
     if (est.iterations > REFUSE_ITERATIONS and probe_iterations(scene, est) > PROBE_LIMIT_ITERATIONS
             and not force):
         text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
                 f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
                 f"on a {est.kind}")
         raise WorkloadError(est.dominant,
-                            f"{_value(scene, est.dominant)} could take {text}, over the limit of "
+                            f"{est.value} could take {text}, over the limit of "
                             f"{REFUSE_ITERATIONS:.0e}; lower {est.dominant}, or force it "
                             f"(--force; render(..., force=True))")
     return est

@@ -46,10 +46,10 @@ def render(scene: Scene) -> RenderResult:
 def execute(plan: Plan, t0: float | None = None) -> RenderResult:
     """Run ``plan`` (every pixel of its scene's image) in float64."""
     t0 = time.perf_counter() if t0 is None else t0
-    scene, frame, ma, sa = plan.scene, plan.frame, plan.march, plan.shade
-    w, h = scene.image.width, scene.image.height
+    frame, ma, sa = plan.frame, plan.march, plan.shade
+    w, h = plan.image.width, plan.image.height
     planes = list(plan.clip.planes)
-    F = formula_of(scene.fractal)
+    F = formula_of(plan.fractal)
     method = plan.normals_args.method
 
     def normals(point, depth, status, guard):
@@ -86,17 +86,17 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
                                  sa.ambient, sa.diffuse)
         terms = light_terms_of_plan(plan, point, normal, status, bracket, F)
         lut = colormap.table(sa.colormap) if sa.colormap is not None else None
-        geo, rgb = (sa.lights_geo, sa.lights_rgb) if scene.shading.lights else (None, None)
+        geo, rgb = (sa.lights_geo, sa.lights_rgb) if sa.n_lights else (None, None)
         rgba = shade(status, normal, point, frame, sa.point_light, sa.color, sa.background, sa.light_color, sa.ambient,
                      sa.diffuse, sa.specular, sa.shininess, terms, lut, sa.fog, sa.fog_start, sa.sky, geo, rgb,
                      extra_visibility_of_plan(plan, point, normal, status, F), refl, sa.reflection)
         return rgba, depth, point, status, smp, normal, guard, bracket, unresolved
 
     rgba, depth, point, status, smp, normal, guard, bracket, unresolved = one_pass(0, 1)
-    S = scene.image.samples
-    if S > 1:
+    S = plan.image.samples
+    if plan.passes > 1:
         mean = np.mean([one_pass(k, S)[0] for k in range(S)], axis=0)
-        if scene.image.adaptive:   # antialias.py: the flagged pixels alone take the mean
+        if plan.image.adaptive:   # antialias.py: the flagged pixels alone take the mean
             flags = flag_edges(rgba[:, :3].reshape(h, w, 3), rgba[:, 3].reshape(h, w), THRESHOLD).ravel()
             mean = np.where(flags[:, None], mean, rgba)
         rgba = mean
@@ -105,7 +105,7 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
                        position=point.reshape(h, w, 4), status=status.reshape(h, w),
                        samples=smp.reshape(h, w), bracket=bracket.reshape(h, w),
                        unresolved=unresolved.reshape(h, w),
-                       device_name="numpy float64 reference", scene=scene,
+                       device_name="numpy float64 reference", scene=plan.scene, march_method=ma.method,
                        guards=count_guards(status, depth, guard))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

@@ -188,23 +188,24 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
 def extra_visibility_of_plan(plan, point, normal, status, F: Formula):
     """extra_visibility with the plan's records (pipeline/plan.py), or None without shadows
     or shading.lights."""
-    sh, ma, la, sa = plan.scene.shading, plan.march, plan.light_args, plan.shade
-    if sh.shadow == "none" or not sh.lights:
+    ma, la, sa = plan.march, plan.light_args, plan.shade
+    if la.extra_shadow == "none":
         return None
     return extra_visibility(point, normal, status, plan.frame, sa.lights_geo, sa.lights_rgb, ma.c, ma.max_iter,
-                            ma.bailout, ma.radius, la.step, la.bias, la.softness, la.max_steps, sh.shadow == "soft", F)
+                            ma.bailout, ma.radius, la.step, la.bias, la.softness, la.max_steps,
+                            la.extra_shadow == "soft", F)
 
 
 def light_terms_of_plan(plan, point, normal, status, bracket, F: Formula):
     """light_terms with the plan's records (LightArgs), or None when the scene uses none of
     them."""
-    sh, ma, la, fr = plan.scene.shading, plan.march, plan.light_args, plan.frame
-    shadow = sh.shadow if not isinstance(sh.light, str) else "none"   # kernel_config.light_defines
-    if sh.shadow == "none" and sh.ao == 0 and sh.coloring == "flat":
+    ma, la, fr = plan.march, plan.light_args, plan.frame
+    if not la.used:
         return None
     return light_terms(point, normal, status, bracket, fr.position, ma.c, ma.max_iter, ma.bailout, fr,
                        plan.shade.light, ma.radius, la.step, la.bias, la.softness, la.max_steps, la.ao_distance,
-                       la.ao_strength, la.trap, shadow, sh.ao > 0, sh.coloring, F, plan.scene.fractal.kind == "mandelbrot")
+                       la.ao_strength, la.trap, la.shadow, la.ao_strength > 0, la.coloring, F,
+                       plan.fractal.kind == "mandelbrot")
 
 
 def unit_or(a, fallback):
