@@ -33,7 +33,8 @@ for p in (ROOT / "benchmarks", ROOT):
         sys.path.insert(0, str(p))
 
 from pyjulia4d import Scene, reference as ref, render  # noqa: E402
-from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
+from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
+from pyjulia4d.pipeline.plan import march_args  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from pyjulia4d.opencl.lanes import lanes_for  # noqa: E402
 from pyjulia4d.reference.formula import formula_of  # noqa: E402
@@ -55,7 +56,7 @@ def proof_share(scene: Scene) -> float:
     M = importlib.import_module("pyjulia4d.reference.march")
     s = scene.with_overrides(["image.width=40", "image.height=30"])
     o, d = ref.generate_rays(camera_frame(s), 40, 30)
-    f, m, F = s.fractal, s.march, formula_of(s.fractal)
+    F = formula_of(s.fractal)
     counts = [0, 0]
     original = M.enc_prove
 
@@ -67,8 +68,7 @@ def proof_share(scene: Scene) -> float:
 
     M.enc_prove = counted
     try:
-        M.march(o, d, f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), -1, -1, m.z_resolution,
-                m.post_steps, m.max_steps, "proven", None, m.refine, None, F, None)
+        M.march(o, d, march_args(s, method="proven"), None, None, F, None)
     finally:
         M.enc_prove = original
     return counts[0] / max(counts[1], 1)

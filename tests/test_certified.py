@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.geometry.camera import camera_frame
 from pyjulia4d.opencl.executor import render
 from pyjulia4d.pipeline.codes import STATUS_HIT
+from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d.pipeline.result import percentiles
 from pyjulia4d.scene.model import Scene
 
@@ -34,10 +35,9 @@ def truth(name):
     max_iter 20 the scan alone steps over thin parts on ~14 % of these rays."""
     s = scene(name, [])
     o, d, t_scan = brute_force(s)
-    f = s.fractal
     br = np.zeros(len(o))
-    t, _, st, _ = ref.march(o, d, f.c, f.max_iter, f.bailout, 1e-6, march_radius(s), -1, -1, 100, 40,
-                            200000, "de", None, "itp", br)
+    t, _, st, _ = ref.march(o, d, march_args(s, epsilon=1e-6, z_resolution=100, post_steps=40, max_steps=200000,
+                                             method="de", refine="itp"), None, br)
     t_de = np.where(st == STATUS_HIT, t + br, np.inf).reshape(H, W)
     return o, d, np.minimum(t_scan, t_de)
 

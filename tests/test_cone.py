@@ -8,7 +8,9 @@ from harness import Runner, packet_widths
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.opencl.executor import render
 from pyjulia4d.pipeline import kernel_config
-from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.pipeline import signatures
+from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks, make_plan, march_args
 from pyjulia4d.reference.cone import CONE_SPREAD, cone_of_pixels, cone_starts
 from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.reference.iterate import julia_inside
@@ -53,19 +55,15 @@ def test_cone_kernel_matches_reference(name, lanes, pairs):
     cfg = (kernel_config.march_config(s, lanes, pairs=pairs) if lanes > 1 else kernel_config.scene_config(s))
     assert ("PACKET_PAIRS" in cfg.defines) == pairs
     R = Runner(cfg)
-    fr = camera_frame(s)
-    f, m = s.fractal, s.march
+    plan = make_plan(s, "CPU", 1)   # kernel and twin take its records (pipeline/signatures.py CONE_STARTS)
     W, H = s.image.width, s.image.height
     region = (5, 3, 50, 40)
     bx0, by0, bw, bh = cone_blocks(*region)
     out = R.out(2 * bw * bh)   # real2 per block
-    R("cone_starts", (bw * bh,), np.int32(bw), np.int32(bx0), np.int32(by0), R.vec(fr.position), R.vec(fr.forward),
-      R.vec(fr.right), R.vec(fr.up), R.scalar(fr.tan_half_fov), np.int32(W), np.int32(H), R.vec(f.c),
-      np.int32(f.max_iter), R.scalar(f.bailout), R.scalar(march_radius(s)), R.scalar(-1), R.scalar(-1),
-      np.int32(m.max_steps), out, lanes=lanes * (2 if pairs else 1))
+    packed = Packed(signatures.CONE_STARTS, plan.records(), Precision(R.double))
+    R("cone_starts", (bw * bh,), *packed(blocks_w=bw, bx0=bx0, by0=by0, cone=out), lanes=lanes * (2 if pairs else 1))
     k = out.get().astype(np.float64).reshape(-1, 2)
-    t_lo, t_last = cone_starts(fr, W, H, f.c, f.max_iter, f.bailout, march_radius(s), -1.0, -1.0, m.max_steps,
-                               formula_of(f), region)
+    t_lo, t_last = cone_starts(plan.frame, W, H, plan.march, formula_of(s.fractal), region)
     held_k, held_r = k[:, 1] >= 0, t_last >= 0
     assert held_r.mean() > 0.2                         # the cone is taken on a good share of blocks
     assert np.mean(held_k == held_r) >= 0.98
@@ -82,10 +80,9 @@ def test_no_ray_starts_past_the_set(name):
     scenes: 200 samples of each ray's skipped stretch."""
     s = Scene.default().with_overrides(SCENES[name] + ["image.width=96", "image.height=72"])
     fr = camera_frame(s)
-    f, m = s.fractal, s.march
+    f = s.fractal
     W, H = s.image.width, s.image.height
-    t_lo, t_last = cone_of_pixels(cone_starts(fr, W, H, f.c, f.max_iter, f.bailout, march_radius(s), -1.0, -1.0,
-                                              m.max_steps, formula_of(f)), (0, 0, W, H))
+    t_lo, t_last = cone_of_pixels(cone_starts(fr, W, H, march_args(s), formula_of(f)), (0, 0, W, H))
     for sample in (0, 1):   # the pixel's centre, and a jittered sample of two
         o, d = generate_rays(fr, W, H, sample=sample, samples=1 + sample)
         b = np.sum(o * d, 1)

@@ -25,6 +25,7 @@ from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF, MANDELBROT_START
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.measure.truth import brute_force_depth
 from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.march import enc_prove
 
@@ -359,9 +360,8 @@ def test_grazing_rays_widen_the_floor_and_finish():
     depth, status, bracket, unresolved = march_on_rays(s, o, d)
     f, m = s.fractal, s.march
     rb, ru = np.zeros(len(o)), np.zeros(len(o))
-    rd, _, rs, rn = ref.march(o, d, f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), -1.0, -1.0,
-                              m.z_resolution, m.post_steps, m.max_steps, "proven", bracket=rb,
-                              formula=formula_of(f), unresolved=ru)
+    rd, _, rs, rn = ref.march(o, d, march_args(s, method="proven"), bracket=rb, formula=formula_of(f),
+                              unresolved=ru)
     assert np.all(status != 2) and np.all(rs != 2)          # none capped
     assert np.mean(status != rs) <= 0.1
     assert np.all(rn < m.max_steps / 8)

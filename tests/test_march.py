@@ -5,6 +5,7 @@ import pytest
 
 from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.opencl.runner import march_items
@@ -43,11 +44,10 @@ def run_march(s: Scene, lanes: int = 1):
               else kernel_config.scene_config(s, ray_buffers=True))
     out, o, d, args = march_kernel(s, config, lanes)
     k = (out["depth"].astype(float), out["point"], out["status"], out["samples"], out["bracket"].astype(float))
-    m = s.march
     n = len(o)
     rflags = np.zeros(n, np.int32)
     rbracket = np.zeros(n)
-    r = ref.march(o, d, *args, m.method, rflags, m.refine, rbracket) + (rbracket,)
+    r = ref.march(o, d, march_args(s), rflags, rbracket) + (rbracket,)
     # the guard flags (kernels/common/codes.cl) agree wherever the statuses do
     same = k[2] == r[2]
     assert np.array_equal(out["flags"][same], rflags[same])
@@ -155,8 +155,8 @@ def test_itp_needs_fewer_set_tests_than_bisection():
     s = Scene.default().with_overrides(["fractal.c=-0.2,0.8,0,0"])
     f = s.fractal
     o, d = ref.generate_rays(camera_frame(s), 24, 18)
-    t, _, st, _ = ref.march(o, d, f.c, f.max_iter, f.bailout, 1e-3, march_radius(s), -1, -1, 250, 0, 4096,
-                          "fixed")
+    t, _, st, _ = ref.march(o, d, march_args(s, epsilon=1e-3, z_resolution=250, post_steps=0, max_steps=4096,
+                                             method="fixed"))
     hit = st == 1
     o, d, t = o[hit], d[hit], t[hit]
     h = 0.02

@@ -7,7 +7,8 @@ from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.pipeline.codes import GUARD_ULP_STEP
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import camera_frame, march_radius
+from pyjulia4d.geometry.camera import camera_frame
+from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d.scene.model import Scene
 
 W, H = 64, 48
@@ -15,11 +16,9 @@ W, H = 64, 48
 
 def hits(s: Scene, real):
     """Reference hit points of a small image, rounded to the kernel's precision."""
-    f, m = s.fractal, s.march
+    m = s.march
     o, d = ref.generate_rays(camera_frame(s), W, H)
-    depth, point, status, _ = ref.march(o, d, f.c, f.max_iter, f.bailout, m.epsilon,
-                                        march_radius(s), -1.0, -1.0, m.z_resolution,
-                                        m.post_steps, m.max_steps, m.method)
+    depth, point, status, _ = ref.march(o, d, march_args(s, method=m.method))
     return depth.astype(real).astype(float), point.astype(real).astype(float), status
 
 

@@ -1,14 +1,19 @@
 """shade/shade.cl and shade/light.cl against reference.shade / reference.light_terms on
 identical normals and points; whole renders with shadows, occlusion and colour maps against
 the reference render."""
+import dataclasses
+
 import numpy as np
 import pyopencl as cl
 import pytest
 
 from harness import Runner
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.pipeline import signatures
+from pyjulia4d.pipeline.plan import make_plan
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import camera_frame, extra_lights, light_position
+from pyjulia4d.geometry.camera import camera_frame, extra_lights
 from pyjulia4d.scene.model import Scene
 
 
@@ -36,7 +41,6 @@ def test_shade_matches_reference(over, fl):
     nrm[:, 2] = np.abs(nrm[:, 2])  # facing the eye, like every visible surface
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     point, nrm = point.astype(R.real).astype(float), nrm.astype(R.real).astype(float)
-    lp = light_position(s)
     sh = s.shading
     geo, rgb = extra_lights(s)
     geo = geo.astype(R.real).astype(float)
@@ -46,19 +50,19 @@ def test_shade_matches_reference(over, fl):
     terms = np.tile([1.0, 1.0, 0.0, 0.0], (n, 1))
     refl = rng.uniform(0, 1, (n, 4))   # reflect.cl's colour of the bounce (given here)
     out = R.out(n, cl.cltypes.float4)
-    c4 = lambda v: cl.cltypes.make_float4(*[float(x) for x in v], 0.0)
-    R("shade", (n,), R.buf(status, np.int32), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf4(point),
-      R.vec(fr.position), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward),
-      R.vec(lp if lp is not None else fr.position), c4(sh.color), c4(sh.background),
-      c4(sh.light_color), c4(sh.sky), np.float32(sh.ambient), np.float32(sh.diffuse), np.float32(sh.specular),
-      np.float32(sh.shininess), R.buf(terms, np.float32), R.buf(np.zeros((2, 4)), np.float32),
-      np.int32(2), np.float32(sh.fog), np.float32(1.5), R.buf4(geo), R.buf(rgb, np.float32),
-      R.buf(vis, np.float32), R.buf(refl, np.float32), np.float32(sh.reflection), out)
+    # kernel and twin take the same record: the plan's (pipeline/plan.ShadeArgs), the kernel's
+    # packed by its signature (pipeline/signatures.py)
+    plan = make_plan(s, "CPU", 1)
+    sa = dataclasses.replace(plan.shade, fog_start=1.5, lights_geo=geo)
+    packed = Packed(signatures.SHADE, {**plan.records(), "shade": sa}, Precision(fl == "double"),
+                    lut=R.buf(np.zeros((2, 4)), np.float32), n_lut=2, lights_geo=R.buf4(geo),
+                    lights_rgb=R.buf(rgb, np.float32))
+    R("shade", (n,), *packed(status=R.buf(status, np.int32), normal=R.buf4(np.c_[nrm, np.zeros(n)]),
+                             point=R.buf4(point), terms=R.buf(terms, np.float32), vis_extra=R.buf(vis, np.float32),
+                             refl=R.buf(refl, np.float32), rgba=out))
     got = out.get().view(np.float32).reshape(4, n).T   # shade.cl's four planes
-    want = ref.shade(status, nrm, point, fr, lp, sh.color, sh.background, sh.light_color,
-                     sh.ambient, sh.diffuse, sh.specular, sh.shininess, fog=sh.fog, fog_start=1.5,
-                     terms=terms, sky=sh.sky, lights_geo=geo if sh.lights else None, lights_rgb=rgb,
-                     vis_extra=vis, refl=refl if sh.reflection > 0 else None, reflection=sh.reflection)
+    want = ref.shade(status, nrm, point, fr, sa, terms=terms, vis_extra=vis,
+                     refl=refl if sh.reflection > 0 else None)
     # the shading itself is float32 in both variants (colour needs no more; shade.cl):
     # float32 arithmetic on values of order 1 (pow() amplifies by the shininess: 40 x 6e-8)
     np.testing.assert_allclose(got, want, atol=2e-5)
@@ -224,17 +228,14 @@ def test_reflect_kernels_match_reference(light, fl):
     dv = point - fr.position
     dv /= np.linalg.norm(dv, axis=1, keepdims=True)
     np.testing.assert_allclose(np.sum(got_d * nw, 1)[hit], -np.sum(dv * nw, 1)[hit], atol=10 * tol)
-    sh = s.shading
-    lp = light_position(s)
-    c4 = lambda v: cl.cltypes.make_float4(*[float(x) for x in v], 0.0)
+    # the bounce's colour: kernel and twin take the plan's shading record
+    plan = make_plan(s, "CPU", 1)
     out = R.out(n, cl.cltypes.float4)
-    R("reflect_color", (n,), R.buf(status, np.int32), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf4(point),
-      R.buf4(want_d), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), R.vec(lp if lp is not None else fr.position),
-      c4(sh.color), c4(sh.background), c4(sh.light_color), c4(sh.sky), np.float32(sh.ambient),
-      np.float32(sh.diffuse), out)
+    packed = Packed(signatures.REFLECT_COLOR, plan.records(), Precision(fl == "double"))
+    R("reflect_color", (n,), *packed(status=R.buf(status, np.int32), normal=R.buf4(np.c_[nrm, np.zeros(n)]),
+                                     point=R.buf4(point), dirs=R.buf4(want_d), refl=out))
     got = out.get().view(np.float32).reshape(n, 4)
-    want = ref.reflect_color(status, nrm, point, want_d.astype(R.real).astype(float), fr, lp, sh.color,
-                             sh.background, sh.light_color, sh.sky, sh.ambient, sh.diffuse)
+    want = ref.reflect_color(status, nrm, point, want_d.astype(R.real).astype(float), plan.frame, plan.shade)
     np.testing.assert_allclose(got, want, atol=2e-5)
 
 

@@ -196,7 +196,11 @@ EXECUTORS = {
     "pyjulia4d.opencl.runner": "*",
     "pyjulia4d.pipeline.calibrate": "*",
     "pyjulia4d.reference.executor": {"execute"},
-    "pyjulia4d.reference.shade": {"light_terms_of_plan", "extra_visibility_of_plan"},
+    "pyjulia4d.reference.march": "*",
+    "pyjulia4d.reference.cone": "*",
+    "pyjulia4d.reference.normals": "*",
+    "pyjulia4d.reference.shade": "*",
+    "pyjulia4d.reference.rays": "*",
 }
 
 

@@ -69,14 +69,14 @@ def surface_point() -> tuple[float, float, float, float]:
     meets it, by a float64 reference scan (z_resolution 4000, 40 post-steps: the
     bracket is below 1e-15)."""
     from pyjulia4d import reference as ref
-    from pyjulia4d.geometry.camera import camera_frame, march_radius
+    from pyjulia4d.geometry.camera import camera_frame
+    from pyjulia4d.pipeline.plan import march_args
     s = Scene.default().with_overrides([f"camera.position={_v(EYE)}", "camera.target=0,0,0,0",
                                         "march.method=fixed"])
-    f = s.fractal
     fr = camera_frame(s)
-    depth, point, status, _ = ref.march(fr.position[None], fr.forward[None], f.c, f.max_iter,
-                                        f.bailout, 1e-3, march_radius(s), -1.0, -1.0, 4000, 40,
-                                        1, "fixed")
+    depth, point, status, _ = ref.march(fr.position[None], fr.forward[None],
+                                        march_args(s, epsilon=1e-3, z_resolution=4000, post_steps=40, max_steps=1,
+                                                   method="fixed"))
     assert status[0] == 1, "the centre ray of the default scene must hit the set"
     return tuple(float(x) for x in point[0])
 

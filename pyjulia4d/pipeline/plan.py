@@ -183,6 +183,18 @@ class ShadeArgs:
     n_lights: int = 0          # how many shading.lights there are
 
 
+def march_args(scene: Scene, radius: float | None = None, **changes) -> MarchArgs:
+    """The march's record of ``scene`` (its bounding ball's ``radius``: camera.march_radius
+    where None), with ``changes`` to its fields (the tests' and benchmarks' own settings)."""
+    f, m = scene.fractal, scene.march
+    args = MarchArgs(c=tuple(f.c), max_iter=f.max_iter, bailout=f.bailout, epsilon=m.epsilon,
+                     radius=march_radius(scene) if radius is None else radius,
+                     near=-1.0 if m.near == "auto" else float(m.near), far=-1.0 if m.far == "auto" else float(m.far),
+                     z_resolution=m.z_resolution, post_steps=m.post_steps, max_steps=m.max_steps,
+                     method=march_method(scene), refine=m.refine, cone=kernel_config.cone_start(scene))
+    return dataclasses.replace(args, **changes) if changes else args
+
+
 def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     """The argument records of every kernel of ``scene`` (Plan's march, clip, normals,
     light_args, shade)."""
@@ -192,11 +204,7 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     geo, rgb = extra_lights(scene)
     point_light = not isinstance(sh.light, str)
     return dict(
-        march=MarchArgs(c=tuple(f.c), max_iter=f.max_iter, bailout=f.bailout, epsilon=m.epsilon, radius=radius,
-                        near=-1.0 if m.near == "auto" else float(m.near),
-                        far=-1.0 if m.far == "auto" else float(m.far), z_resolution=m.z_resolution,
-                        post_steps=m.post_steps, max_steps=m.max_steps, method=march_method(scene),
-                        refine=m.refine, cone=kernel_config.cone_start(scene)),
+        march=march_args(scene, radius),
         clip=ClipArgs(tuple(clip_planes(scene))),
         normals=NormalsArgs(scene.normals.method, gradient_step(scene)),
         # light.cl traces the positioned light's shadows (the light at the eye lights all it sees)

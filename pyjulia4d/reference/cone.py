@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from pyjulia4d.geometry.camera import Frame
-from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks
+from pyjulia4d.pipeline.plan import CONE_BLOCK, MarchArgs, cone_blocks
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 from pyjulia4d.reference.iterate import julia_distance_formula
 from pyjulia4d.reference.march import ball_span
@@ -15,12 +15,13 @@ from pyjulia4d.reference.march import ball_span
 CONE_SPREAD = 2.8285   # 2 sqrt(2), rounded up (march/cone.cl)
 
 
-def cone_starts(frame: Frame, width: int, height: int, c, max_iter: int, bailout: float, radius: float,
-                near_set: float, far_set: float, max_steps: int, formula: Formula = QUATERNION_SQR,
+def cone_starts(frame: Frame, width: int, height: int, args: MarchArgs, formula: Formula = QUATERNION_SQR,
                 region: tuple[int, int, int, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(t_lo, t_last) of the blocks that the pixels of ``region`` = (x0, y0, w, h) (default:
-    the image) meet, row-major: the cone is covered from t_lo, and t_last is the last centre
-    point whose ball held it (-1: none did)."""
+    """march/cone.cl with the march's record (``args``: pipeline/plan.MarchArgs): (t_lo,
+    t_last) of the blocks that the pixels of ``region`` = (x0, y0, w, h) (default: the image)
+    meet, row-major: the cone is covered from t_lo, and t_last is the last centre point whose
+    ball held it (-1: none did)."""
+    c, max_iter, bailout, max_steps = args.c, args.max_iter, args.bailout, args.max_steps
     x0, y0, w, h = region or (0, 0, width, height)
     bx0, by0, bw, bh = cone_blocks(x0, y0, w, h)
     by, bx = (a.ravel() for a in np.mgrid[by0:by0 + bh, bx0:bx0 + bw])
@@ -31,7 +32,7 @@ def cone_starts(frame: Frame, width: int, height: int, c, max_iter: int, bailout
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     o = np.tile(np.asarray(frame.position, np.float64), (len(d), 1))
     k = CONE_SPREAD * 2 * frame.tan_half_fov / height
-    t, far, meets = ball_span(o, d, radius, near_set, far_set)
+    t, far, meets = ball_span(o, d, args.radius, args.near, args.far)
     active = meets & (far >= t)
     t_lo, t_last = np.full(len(d), np.inf), np.full(len(d), -1.0)
     for i in range(max_steps):

@@ -18,7 +18,7 @@ from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.reference.march import march
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian, normals_zbuffer
 from pyjulia4d.reference.rays import generate_rays
-from pyjulia4d.reference.shade import extra_visibility_of_plan, light_terms_of_plan, reflect_color, reflect_rays, shade
+from pyjulia4d.reference.shade import extra_visibility, light_terms, reflect_color, reflect_rays, shade
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.scene.model import Scene
 
@@ -62,34 +62,28 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
 
     cone = None
     if ma.cone:   # march/cone.cl: each block's start, the same for every sample of its pixels
-        cone = cone_of_pixels(cone_starts(frame, w, h, ma.c, ma.max_iter, ma.bailout, ma.radius, ma.near, ma.far,
-                                          ma.max_steps, F), (0, 0, w, h))
+        cone = cone_of_pixels(cone_starts(frame, w, h, ma, F), (0, 0, w, h))
 
     def one_pass(sample: int, samples: int):
         origins, dirs = generate_rays(frame, w, h, sample=sample, samples=samples)
         guard = np.zeros(len(origins), np.int64)
         bracket = np.full(len(origins), np.inf)
         unresolved = np.zeros(len(origins))
-        depth, point, status, smp = march(origins, dirs, ma.c, ma.max_iter, ma.bailout, ma.epsilon, ma.radius,
-                                          ma.near, ma.far, ma.z_resolution, ma.post_steps, ma.max_steps,
-                                          ma.method, guard, ma.refine, bracket, F, planes, unresolved, cone)
+        depth, point, status, smp = march(origins, dirs, ma, guard, bracket, F, planes, unresolved, cone)
         normal = clip_normals(guard, status, frame, planes, normals(point, depth, status, guard))
         refl = None
         if sa.reflection > 0:   # shade/reflect.cl: one mirror bounce, marched like a camera ray
             o2, d2 = reflect_rays(point, normal, status, frame, plan.light_args.bias, ma.radius)
             g2 = np.zeros(len(o2), np.int64)
-            _, p2, s2, _ = march(o2, d2, ma.c, ma.max_iter, ma.bailout, ma.epsilon, ma.radius, ma.near, ma.far,
-                                 ma.z_resolution, ma.post_steps, ma.max_steps, ma.method, g2, ma.refine,
-                                 None, F, planes)
+            _, p2, s2, _ = march(o2, d2, ma, g2, None, F, planes)
             n2 = clip_normals(g2, s2, frame, planes, normals(p2, None, s2, g2))
-            refl = reflect_color(s2, n2, p2, d2, frame, sa.point_light, sa.color, sa.background, sa.light_color, sa.sky,
-                                 sa.ambient, sa.diffuse)
-        terms = light_terms_of_plan(plan, point, normal, status, bracket, F)
+            refl = reflect_color(s2, n2, p2, d2, frame, sa)
+        la = plan.light_args
+        terms = (light_terms(point, normal, status, bracket, frame, ma, la, sa.light, F, plan.fractal.kind == "mandelbrot")
+                 if la.used else None)
+        vis_extra = extra_visibility(point, normal, status, frame, ma, la, sa, F) if la.extra_shadow != "none" else None
         lut = colormap.table(sa.colormap) if sa.colormap is not None else None
-        geo, rgb = (sa.lights_geo, sa.lights_rgb) if sa.n_lights else (None, None)
-        rgba = shade(status, normal, point, frame, sa.point_light, sa.color, sa.background, sa.light_color, sa.ambient,
-                     sa.diffuse, sa.specular, sa.shininess, terms, lut, sa.fog, sa.fog_start, sa.sky, geo, rgb,
-                     extra_visibility_of_plan(plan, point, normal, status, F), refl, sa.reflection)
+        rgba = shade(status, normal, point, frame, sa, terms, lut, vis_extra, refl)
         return rgba, depth, point, status, smp, normal, guard, bracket, unresolved
 
     rgba, depth, point, status, smp, normal, guard, bracket, unresolved = one_pass(0, 1)

@@ -2,11 +2,16 @@
 (the marches along one ray) and march.cl (every ray of an image, with clip planes)."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula, julia_inside, julia_level
+
+if TYPE_CHECKING:
+    from pyjulia4d.pipeline.plan import MarchArgs
 
 def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None,
                    formula: Formula = QUATERNION_SQR):
@@ -307,11 +312,12 @@ def ball_span(o, d, radius, near_set, far_set):
     return near, far, disc >= 0
 
 
-def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_set,
-          z_resolution, post_steps, max_steps, method, flags=None, refine="itp", bracket=None,
-          formula: Formula = QUATERNION_SQR, clip=None, unresolved=None, cone=None):
-    """Clip each ray to the bounding 4-ball (and the ``clip`` half-spaces m . x <= e, world
-    space: camera.clip_planes), then march; returns (depth, point, status, samples).  A hit
+def march(origins, dirs, args: MarchArgs, flags=None, bracket=None, formula: Formula = QUATERNION_SQR, clip=None,
+          unresolved=None, cone=None):
+    """march/march.cl with the same record (``args``: pipeline/plan.MarchArgs, its method,
+    refinement and numbers).  Clip each ray to the bounding 4-ball (and the ``clip``
+    half-spaces m . x <= e, world space: camera.clip_planes), then march; returns (depth,
+    point, status, samples).  A hit
     at the first point of an interval a plane started is on its cut face: flags get
     FLAG_CUT_FACE | k << 5.
     ``flags`` (int array, optional) gets the march's guard flags (march/march.cl's flags buffer),
@@ -321,9 +327,12 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
     ball).  ``cone`` = (t_lo, t_last) per ray (reference/cone.py, -D CONE_START): a ray whose
     entry is at or after t_lo starts at t_last, and is marched again from its entry where
     that first point is inside."""
+    c, max_iter, bailout, epsilon = args.c, args.max_iter, args.bailout, args.epsilon
+    z_resolution, post_steps, max_steps, method = args.z_resolution, args.post_steps, args.max_steps, args.method
+    itp = args.refine == "itp"
     o = np.asarray(origins, np.float64)
     d = np.asarray(dirs, np.float64)
-    near, far, live = ball_span(o, d, radius, near_set, far_set)
+    near, far, live = ball_span(o, d, args.radius, args.near, args.far)
     cut = np.zeros(len(o), np.int64)      # 1 + the plane that set near (march.cl, -D CLIP)
     for k, (m, off) in enumerate(clip or ()):
         dn, on = d @ m, o @ m - off
@@ -350,7 +359,7 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
         fn = {"fixed": march_fixed, "proven": march_proven}.get(method, march_de)
         depth[k], status[k], samples[k], fl, wd, un = fn(o[k], d[k], start[k], far[k], c, max_iter, bailout,
                                                      epsilon, z_resolution, post_steps, max_steps,
-                                                     refine == "itp", formula)
+                                                     itp, formula)
         if cone is not None:
             # a first point inside: the cone's estimate was wrong for this ray (march/march.cl)
             redo = coned[k] & (status[k] == STATUS_HIT) & (wd == 0)
@@ -358,7 +367,7 @@ def march(origins, dirs, c, max_iter, bailout, epsilon, radius, near_set, far_se
             if j.size:
                 depth[j], status[j], samples[j], fl2, wd[redo], un[redo] = fn(
                     o[j], d[j], near[j], far[j], c, max_iter, bailout, epsilon, z_resolution, post_steps,
-                    max_steps, refine == "itp", formula)
+                    max_steps, itp, formula)
                 fl[redo] |= fl2
             moved = coned[k] & ~redo
             un[moved] += start[k][moved] - near[k][moved]

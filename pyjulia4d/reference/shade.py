@@ -1,6 +1,8 @@
 """float64 twins of kernels/shade/light.cl and kernels/shade/shade.cl."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from pyjulia4d.geometry.camera import Frame
@@ -10,6 +12,9 @@ from pyjulia4d.pipeline.colormap import lookup
 from pyjulia4d.reference.iterate import dot4, julia_distance_formula, julia_inside
 from pyjulia4d.reference.normals import to_camera
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
+
+if TYPE_CHECKING:
+    from pyjulia4d.pipeline.plan import LightArgs, MarchArgs, ShadeArgs
 
 
 def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,
@@ -121,10 +126,14 @@ def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR, mande
     return 1 - np.exp(-3 * np.sqrt(best))
 
 
-def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame: Frame, light_pos,
-                radius, step, bias, softness, max_steps, ao_distance, ao_strength, trap,
-                shadow="none", ao=False, coloring="flat", F: Formula = QUATERNION_SQR, mandelbrot=False):
-    """(visibility, ambient factor, colour value, 0) per item, (1, 1, 0, 0) off hits."""
+def light_terms(point, normal, status, bracket, frame: Frame, march: MarchArgs, light: LightArgs, light_pos,
+                F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
+    """shade/light.cl light_terms with the same records (``march``, ``light``:
+    pipeline/plan.MarchArgs, LightArgs; ``light_pos`` the positioned light, ShadeArgs.light):
+    (visibility, ambient factor, colour value, 0) per item, (1, 1, 0, 0) off hits."""
+    c, max_iter, bailout, radius, eye = march.c, march.max_iter, march.bailout, march.radius, frame.position
+    step, bias, softness, max_steps, trap = light.step, light.bias, light.softness, light.max_steps, light.trap
+    shadow, coloring = light.shadow, light.coloring
     n = len(status)
     out = np.tile(np.array([1.0, 1.0, 0.0, 0.0]), (n, 1))
     hit = status == STATUS_HIT
@@ -142,8 +151,8 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
         f = dot4(nw, np.asarray(light_pos, np.float64) - p) > 0
         out[k, 0] = shadow_ray(o, lv / np.maximum(dist, 1e-300)[:, None], dist, c, max_iter, bailout, radius,
                                step, softness, max_steps, shadow == "soft", F, lit=f)
-    if ao:
-        out[k, 1] = ambient_occlusion(p + bias * nw, nw, c, max_iter, bailout, ao_distance, ao_strength, F)
+    if light.ao_strength > 0:
+        out[k, 1] = ambient_occlusion(p + bias * nw, nw, c, max_iter, bailout, light.ao_distance, light.ao_strength, F)
     if coloring == "iteration":
         dirs = p - np.asarray(eye, np.float64)
         dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
@@ -155,11 +164,14 @@ def light_terms(point, normal, status, bracket, eye, c, max_iter, bailout, frame
     return out
 
 
-def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter, bailout, radius, step,
-                     bias, softness, max_steps, soft, F: Formula = QUATERNION_SQR):
-    """The visibility of each of shading.lights (shade/light.cl, EXTRA_SHADOWS): (n, 4), column
-    j for light j (geo, rgb as camera.extra_lights: rgb[j, 3] = 1 a distant light along
-    geo[j]), 1 off hits and in unused columns."""
+def extra_visibility(point, normal, status, frame: Frame, march: MarchArgs, light: LightArgs, shade: ShadeArgs,
+                     F: Formula = QUATERNION_SQR):
+    """The visibility of each of shading.lights (shade/light.cl, EXTRA_SHADOWS) with the same
+    records: (n, 4), column j for light j (geo, rgb as camera.extra_lights: rgb[j, 3] = 1 a
+    distant light along geo[j]), 1 off hits and in unused columns."""
+    c, max_iter, bailout, radius = march.c, march.max_iter, march.bailout, march.radius
+    step, bias, softness, max_steps = light.step, light.bias, light.softness, light.max_steps
+    soft, geo, rgb = light.extra_shadow == "soft", shade.lights_geo[:shade.n_lights], shade.lights_rgb
     n = len(status)
     out = np.ones((n, 4))
     out[:, 3] = 0.0
@@ -185,29 +197,6 @@ def extra_visibility(point, normal, status, frame: Frame, geo, rgb, c, max_iter,
     return out
 
 
-def extra_visibility_of_plan(plan, point, normal, status, F: Formula):
-    """extra_visibility with the plan's records (pipeline/plan.py), or None without shadows
-    or shading.lights."""
-    ma, la, sa = plan.march, plan.light_args, plan.shade
-    if la.extra_shadow == "none":
-        return None
-    return extra_visibility(point, normal, status, plan.frame, sa.lights_geo, sa.lights_rgb, ma.c, ma.max_iter,
-                            ma.bailout, ma.radius, la.step, la.bias, la.softness, la.max_steps,
-                            la.extra_shadow == "soft", F)
-
-
-def light_terms_of_plan(plan, point, normal, status, bracket, F: Formula):
-    """light_terms with the plan's records (LightArgs), or None when the scene uses none of
-    them."""
-    ma, la, fr = plan.march, plan.light_args, plan.frame
-    if not la.used:
-        return None
-    return light_terms(point, normal, status, bracket, fr.position, ma.c, ma.max_iter, ma.bailout, fr,
-                       plan.shade.light, ma.radius, la.step, la.bias, la.softness, la.max_steps, la.ao_distance,
-                       la.ao_strength, la.trap, la.shadow, la.ao_strength > 0, la.coloring, F,
-                       plan.fractal.kind == "mandelbrot")
-
-
 def unit_or(a, fallback):
     """a / |a| per row, ``fallback`` where a has no direction (|a|^2 is 0 or not finite):
     shade.cl's UNIT3 (common/lanes.cl)."""
@@ -216,15 +205,18 @@ def unit_or(a, fallback):
     return np.where(ok, a / np.sqrt(np.where(ok, aa, 1.0)), fallback)
 
 
-def shade(status, normal, point, frame: Frame, light_pos, color, background, light_color,
-          ambient, diffuse, specular, shininess, terms=None, lut=None, fog=0.0, fog_start=0.0,
-          sky=(1.0, 1.0, 1.0), lights_geo=None, lights_rgb=None, vis_extra=None, refl=None,
-          reflection=0.0):
-    """Lambert (light at the eye by default, seed 001 §4) + ambient (times ``sky``) +
-    Blinn-Phong, with the light's visibility and ambient occlusion from ``terms`` and the
-    base colour from the colour table ``lut`` at terms' colour value; the lights of
-    ``lights_geo``/``lights_rgb`` (camera.extra_lights) likewise, their visibility from
-    ``vis_extra`` (shade/shade.cl); RGBA, linear light."""
+def shade(status, normal, point, frame: Frame, args: ShadeArgs, terms=None, lut=None, vis_extra=None, refl=None):
+    """shade/shade.cl with the same record (``args``: pipeline/plan.ShadeArgs).  Lambert
+    (light at the eye by default, seed 001 §4) + ambient (times the sky) + Blinn-Phong, with
+    the light's visibility and ambient occlusion from ``terms`` and the base colour from the
+    colour table ``lut`` at terms' colour value; shading.lights (camera.extra_lights)
+    likewise, their visibility from ``vis_extra``; the mirror bounce's colour ``refl``
+    (shade/reflect.cl) mixed in; RGBA, linear light."""
+    light_pos, color, background, light_color = args.point_light, args.color, args.background, args.light_color
+    ambient, diffuse, specular, shininess = args.ambient, args.diffuse, args.specular, args.shininess
+    fog, fog_start, sky, reflection = args.fog, args.fog_start, args.sky, args.reflection
+    lights_geo = args.lights_geo[:args.n_lights] if args.n_lights else None
+    lights_rgb = args.lights_rgb[:args.n_lights] if args.n_lights else None
     hit = status == STATUS_HIT
     rgba = np.zeros((len(status), 4))
     rgba[:, :3] = background
@@ -293,11 +285,13 @@ def reflect_rays(point, normal, status, frame: Frame, bias, radius):
     return origins, dirs
 
 
-def reflect_color(status, normal, point, dirs, frame: Frame, light_pos, color, background, light_color,
-                  sky, ambient, diffuse):
-    """shade/reflect.cl reflect_color: color (ambient sky + diffuse max(n . l, 0) light_color) on
-    the reflected hits, l towards the light (back along the ray for the light at the eye);
-    the background elsewhere.  RGBA (alpha 1 on hits)."""
+def reflect_color(status, normal, point, dirs, frame: Frame, args: ShadeArgs):
+    """shade/reflect.cl reflect_color with shading's record (``args``: pipeline/plan.ShadeArgs):
+    color (ambient sky + diffuse max(n . l, 0) light_color) on the reflected hits, l towards
+    the light (back along the ray for the light at the eye); the background elsewhere.  RGBA
+    (alpha 1 on hits)."""
+    light_pos, color, background, light_color = args.point_light, args.color, args.background, args.light_color
+    sky, ambient, diffuse = args.sky, args.ambient, args.diffuse
     out = np.zeros((len(status), 4))
     out[:, :3] = background
     k = np.nonzero(status == STATUS_HIT)[0]
