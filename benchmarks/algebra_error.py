@@ -71,7 +71,7 @@ SCENES = {
                   "CQuat sqr, c = -0.7323-0.2179i+0.1j, max_iter 12"),
     "comm_sqr": (["fractal.algebra=commutative", "fractal.c=-0.7323,-0.2179,0.1,0", "fractal.max_iter=12",
                   "camera.position=-2,1,5,0"],
-                 "commutative sqr, seed 000 Fig. 7's c = -0.7323-0.2179i+0.1j, max_iter 12"),
+                 "commutative sqr, Ödegaard & Wennergren Fig. 7's c = -0.7323-0.2179i+0.1j, max_iter 12"),
 }
 
 FIXED = [(z, p) for z in (70, 250, 1000, 4000) for p in (0, 4, 10)]

@@ -1,5 +1,5 @@
 """Antialiasing's edge error and cost: uniform supersampling (image.samples) against the
-adaptive mode (image.adaptive, pyjulia4d/antialias.py), each against a 16-sample uniform
+adaptive mode (image.adaptive, pyjulia4d/pipeline/antialias.py), each against a 16-sample uniform
 render of the same scene.
 
 Per scene and mode: the error of the colour, sRGB-encoded (what a PNG stores), as the

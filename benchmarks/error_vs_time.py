@@ -11,10 +11,10 @@ test).  Then for a grid of
   ITP refinement (march.refine = itp, the default), epsilon 5e-7, 3e-7 and 1e-7 (at and
   below float32's spacing of t at depths 2-8: the smallest steps become one ulp,
   counted as ulp_step) with 10 and 20, and a few
-  settings with bisection (march.refine = bisect, seed 000's post-stepping);
+  settings with bisection (march.refine = bisect, Ödegaard & Wennergren's post-stepping);
 * fixed marching: z_resolution 35 .. 16,000 (log-spaced) x post_steps 0, 4, 10, 20 with
   ITP, a few with bisection, and z = 256,000 without post-steps on the Fig. 5 scene only
-  (seed 000's claim),
+  (Ödegaard & Wennergren's claim),
 
 it renders the scene (float32 kernels, the default) and records the median wall time
 over repeats - kernels alone and the whole render, separately; each program is built
@@ -79,20 +79,20 @@ from pyjulia4d.pipeline import signatures  # noqa: E402
 from pyjulia4d.pipeline.plan import make_plan  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
 
-# name -> (overrides, description).  The first nine: seed 000's figures, POV-Ray's example
+# name -> (overrides, description).  The first nine: Ödegaard & Wennergren's figures, POV-Ray's example
 # and the two exact oracles, all max_iter 8-12 with w = 0 cameras.  The rest: max_iter 20
 # and 50, c near the boundary of the connectedness locus (critical orbit bounded) or just
 # outside it (dust: the critical orbit escapes, at the iteration given), 4D cameras
 # (w != 0 or a tilted limbo vector) and a tilted slice.
 SCENES = {
-    "fig1": (["fractal.c=-0.7,-0.2,0,0"], "seed 000 Fig. 1, c = -0.7-0.2i"),
+    "fig1": (["fractal.c=-0.7,-0.2,0,0"], "Ödegaard & Wennergren Fig. 1, c = -0.7-0.2i"),
     "fig5": (["fractal.c=-0.803762,-0.40615,0,0", "fractal.max_iter=8"],
-             "seed 000 Fig. 5, c = -0.803762-0.40615i, max_iter 8"),
+             "Ödegaard & Wennergren Fig. 5, c = -0.803762-0.40615i, max_iter 8"),
     "fig6": (["fractal.c=-0.7323,-0.2179,0,0", "camera.position=-2,1,5,0"],
-             "seed 000 Fig. 6 (left), c = -0.7323-0.2179i, camera (-2, 1, 5, 0)"),
-    "fig8_i8": (["fractal.c=0.4,0.5,0,0", "fractal.max_iter=8"], "seed 000 Fig. 8, c = 0.4+0.5i, max_iter 8"),
-    "fig8_i12": (["fractal.c=0.4,0.5,0,0", "fractal.max_iter=12"], "seed 000 Fig. 8, c = 0.4+0.5i, max_iter 12"),
-    "fig9": (["fractal.c=-0.8,0.4,0,0"], "seed 000 Fig. 9, c = -0.8+0.4i"),
+             "Ödegaard & Wennergren Fig. 6 (left), c = -0.7323-0.2179i, camera (-2, 1, 5, 0)"),
+    "fig8_i8": (["fractal.c=0.4,0.5,0,0", "fractal.max_iter=8"], "Ödegaard & Wennergren Fig. 8, c = 0.4+0.5i, max_iter 8"),
+    "fig8_i12": (["fractal.c=0.4,0.5,0,0", "fractal.max_iter=12"], "Ödegaard & Wennergren Fig. 8, c = 0.4+0.5i, max_iter 12"),
+    "fig9": (["fractal.c=-0.8,0.4,0,0"], "Ödegaard & Wennergren Fig. 9, c = -0.8+0.4i"),
     "povray": (["fractal.c=-0.083,0,-0.83,-0.025", "fractal.max_iter=8"],
                "POV-Ray example <-0.083, 0, -0.83, -0.025>, max_iter 8"),
     "sphere": (["fractal.c=0,0,0,0"], "c = 0 (the ball; analytic truth)"),
@@ -127,7 +127,7 @@ DE_BISECT = [(1e-4, 6), (1e-4, 10), (1e-5, 6), (1e-5, 10), (1e-5, 20), (1e-6, 10
 Z_RES = [35, 70, 250, 1000, 4000, 16000]
 FIXED_POSTS = [0, 4, 10, 20]
 FIXED_BISECT = [(250, 10), (250, 20), (1000, 10), (4000, 10)]
-ONLY = {("fixed", 256000, 0, "itp"): ["fig5"]}              # seed 000's claim: one scene is enough
+ONLY = {("fixed", 256000, 0, "itp"): ["fig5"]}              # Ödegaard & Wennergren's claim: one scene is enough
 # ITP against bisection, interleaved: (method, z_resolution, epsilon, post_steps)
 ITP_PAIRS = [("de", 250, 1e-5, 6), ("de", 250, 1e-6, 10), ("de", 250, 5e-7, 20), ("fixed", 250, 1e-3, 10),
              ("fixed", 1000, 1e-3, 20)]
@@ -590,7 +590,7 @@ def write_markdown(path: Path, rows: list[dict], meta: dict, truths: dict, prese
     L.append("")
     ptab = preset_table(rows) if meta["mode"] == "full" else []
     if ptab:
-        L += ["## The presets (pyjulia4d/quality.py) on every scene", "",
+        L += ["## The presets (pyjulia4d/scene/quality.py) on every scene", "",
               f"Stated bounds apply to scenes with max_iter <= {BOUND_MAX_ITER}; the "
               "max_iter 50 scenes are reported beside them (no float32 bound is stated there).", "",
               f"| quality | setting | stated p99 | worst p99, max_iter <= {BOUND_MAX_ITER} (scene) | worst p99, max_iter 50 "
@@ -820,8 +820,8 @@ def seed_claim(rows: list[dict], meta: dict) -> str | None:
                 f"{fmt(r['depth_err_px_p99'])} | {fmt(r['bracket_p99'])} | {fmt(r['normal_err_jacobian_median'])} / "
                 f"{fmt(r['normal_err_jacobian_p95'])} |")
 
-    L = ["# Seed 000's post-stepping claim, tested (Fig. 5 scene)", "",
-         "Seed 000 (§9, Fig. 5: c = -0.803762-0.40615i, max_iter 8) says z-resolution 250 with 10 post-steps "
+    L = ["# Ödegaard & Wennergren's post-stepping claim, tested (Fig. 5 scene)", "",
+         "Ödegaard & Wennergren (§9, Fig. 5: c = -0.803762-0.40615i, max_iter 8) says z-resolution 250 with 10 post-steps "
          "gives the detail of z-resolution 256,000 (250 x 2^10) for about 7 % more time than z-resolution 250 "
          "alone (19.1 s against 17.9 s).", "",
          f"Measured here: {meta['device']}, {meta['width']}x{meta['height']} px, float32 kernels, "

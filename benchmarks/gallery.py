@@ -158,12 +158,12 @@ SCENES: dict[str, list[str]] = {
         "fractal.function=pwr", "fractal.exponent=3,0.5", "fractal.c=-0.7,0,0,0", "fractal.max_iter=8",
         "slice.normal=1,0,0,1", "camera.position=0.6,3.8,-1.7", "camera.target=0,0.25,0",
         "camera.fov=38", "shading.light=3,4,-3", srgb(0.95, 0.5, 0.65)],
-    # Gintz's CQuats (seed 000 eq. 14) at seed 000 Fig. 7's c: square angles and square holes
+    # Gintz's CQuats (Ödegaard & Wennergren eq. 14) at Ödegaard & Wennergren Fig. 7's c: square angles and square holes
     "cquat_sqr": [
         "fractal.algebra=cquat", "fractal.c=-0.7323,-0.2179,0.1,0", "fractal.max_iter=12",
         "camera.position=-1.4,0.7,3.5", "shading.light=-3,4,4", "shading.shadow=hard",
         srgb(0.8, 0.85, 0.55)],
-    # seed 000 eq. 15, the naive commutative rules, Fig. 7's c: "highly irregular shapes"
+    # Ödegaard & Wennergren eq. 15, the naive commutative rules, Fig. 7's c: "highly irregular shapes"
     "commutative_sqr": [
         "fractal.algebra=commutative", "fractal.c=-0.7323,-0.2179,0.1,0", "fractal.max_iter=12",
         "camera.position=-1.4,0.7,3.5", "shading.light=-3,4,4", "shading.shadow=hard",

@@ -1,8 +1,8 @@
 """Gallery pictures and depth error against run time for the sets beside the Julia set:
 quaternion and hypercomplex Mandelbrot sets (fractal.kind = "mandelbrot"), rotated
-quaternion Julia sets (fractal.theta, seed 001 §2.3), Julia set stacks (fractal.kind =
-"julia_stack", seed 001 §5.1; its "de" rows are the empirical estimate) and the cubic
-connectedness locus (fractal.kind = "cubic_locus", seed 001 §5.2; fixed scan only).
+quaternion Julia sets (fractal.theta, Hart, Sandin & Kauffman 1989 §2.3), Julia set stacks (fractal.kind =
+"julia_stack", Hart, Sandin & Kauffman 1989 §5.1; its "de" rows are the empirical estimate) and the cubic
+connectedness locus (fractal.kind = "cubic_locus", Hart, Sandin & Kauffman 1989 §5.2; fixed scan only).
 
 Pictures: each scene of GALLERY rendered from the CLI's code path (pyjulia4d.render) at
 --picture size, written to benchmarks/results/kinds/<name>.png.
@@ -68,13 +68,13 @@ GALLERY = {
     "julia_theta_45": (J_CAM + ["fractal.c=-0.2,0.8,0,0", "fractal.theta=45"], "the same map rotated by 45 degrees"),
     "julia_theta_90": (J_CAM + ["fractal.c=-0.2,0.8,0,0", "fractal.theta=90"],
                        "rotated by 90 degrees: the complex Julia set turned a quarter, its quaternion "
-                       "superset cut by another 3D space (seed 001 Fig. 1)"),
+                       "superset cut by another 3D space (Hart, Sandin & Kauffman 1989 Fig. 1)"),
     "julia_stack": (STACK + ["fractal.max_iter=20", "camera.position=2.0,2.4,-3.2,0", "image.samples=4"],
                     "Julia set stack (the default c-line): z^2 + c(u), c from -1 (the basilica, the cap "
                     "in front) to -0.1+0.75i (near the rabbit, at the back), max_iter 20"),
     "julia_stack_real": (STACK + ["fractal.c_from=0.25,0", "fractal.c_to=-1.3,0", "fractal.max_iter=20",
                                   "camera.position=2.2,2.6,-3.0,0", "image.samples=4"],
-                         "Julia set stack along the real axis (seed 001 Fig. 4, Im c = 0): c from 1/4 "
+                         "Julia set stack along the real axis (Hart, Sandin & Kauffman 1989 Fig. 4, Im c = 0): c from 1/4 "
                          "(the cauliflower, in front) to -1.3, max_iter 20"),
     "cubic_locus_plus": (LOCUS + ["fractal.max_iter=8", "camera.fit=true", "image.samples=4"],
                          "cubic connectedness locus C+ (the orbit of +a bounded under z^3 - 3a^2 z + b), "

@@ -2,7 +2,7 @@
 
 The scene is pyjulia4d's default (c = -0.2 + 0.8i, quaternion sqr, 12 iterations, the eye
 at (1.8, 1.6, -2.2) looking at the origin, 40 degrees vertical field of view, a light at the
-eye, no shadows, no ambient occlusion: pyjulia4d's default with ``MATCHED``), written as POV-Ray 3.7 SDL (seed 003's julia_fractal: `max_iteration 12`, POV-Ray's
+eye, no shadows, no ambient occlusion: pyjulia4d's default with ``MATCHED``), written as POV-Ray 3.7 SDL (POV-Ray 3.6 documentation's julia_fractal: `max_iteration 12`, POV-Ray's
 default `precision 20`; a shadowless light, since pyjulia4d traces no shadow rays; the
 horizontal angle POV-Ray wants from the vertical one) and as a Mandelbulber2 2.20 settings
 file (formula 5 "quaternion", julia_mode, N 12, bailout 4 as pyjulia4d's escape radius;

@@ -1,8 +1,8 @@
 """POV-Ray 3.7 and pyjulia4d on the same julia_fractal scenes, against a float64 brute-force truth.
 
-Each scene is POV-Ray SDL (POV-Ray's documentation example, seed 003, and hypercomplex
+Each scene is POV-Ray SDL (POV-Ray's documentation example, POV-Ray 3.6 documentation, and hypercomplex
 sqr, cube, sin, exp, ln and pwr); pyjulia4d renders what ``import-pov`` makes of it
-(pyjulia4d/povray.py), so the view, the iteration and the escape radius are POV-Ray's.
+(pyjulia4d/interop/povray/), so the view, the iteration and the escape radius are POV-Ray's.
 Every scene is lit by one shadowless light at the eye, white, with ``finish { ambient 0
 diffuse 1 }``: a hit pixel's value is then |n . l|, the cosine between the surface normal
 and the view ray, in both renderers (POV-Ray writes it to a linear half-float OpenEXR

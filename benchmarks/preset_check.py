@@ -1,6 +1,6 @@
 """Do the quality presets keep their stated error on scenes they were not derived from?
 
-``benchmarks/error_vs_time.py`` derives the presets of pyjulia4d/quality.py from its
+``benchmarks/error_vs_time.py`` derives the presets of pyjulia4d/scene/quality.py from its
 own seventeen scenes.  This check draws NEW scenes, deterministically from a seed, of
 the kinds that broke the earlier presets:
 
@@ -18,7 +18,7 @@ the kinds that broke the earlier presets:
 
 Scenes whose truth hits fewer than MIN_HIT of the pixels are redrawn (counted in the
 report).  Each scene is rendered with each preset (float32 kernels, the default) at a
-small size and compared with ground truth from pyjulia4d/truth.py (the converged
+small size and compared with ground truth from pyjulia4d/measure/truth.py (the converged
 double-precision scan combined with the double-precision de search; never a preset's
 own setting).  Per preset the report gives the worst p99 and max depth error, the worst
 silhouette error, the render's own bracket p99 and pixels whose truth lies in front of

@@ -2,8 +2,8 @@
  * (common/lanes.cl: one ray, or a packet of rays whose finished lanes are frozen).
  *
  * A point p is inside when |q_n| <= bailout for n = 0 .. max_iter, with q_0 = p and
- * q_{n+1} = f(q_n) + c (seed 003: "none of the vectors in the sequence escapes";
- * seed 000 §2.1, eq. 5).  The algebra piece (algebra/<name>.cl) supplies the map, the
+ * q_{n+1} = f(q_n) + c (POV-Ray 3.6 documentation: "none of the vectors in the sequence escapes";
+ * Odegaard & Wennergren §2.1, eq. 5).  The algebra piece (algebra/<name>.cl) supplies the map, the
  * iterate's coordinates (ALG_IN, ALG_C) and its norm (ALG_NORM2). */
 
 /* Where a lane whose ray has ended (a hit: an inside point; a miss; a shadow ray in shadow)
@@ -72,7 +72,7 @@ inline lreal level_value(lreal m2, lmask steps, julia_params jp, lmask *inside)
  * N = max_iter, <= 0 exactly when the point is inside (*inside, the same test as
  * julia_inside).  With bailout >= the escape radius every |q_n| > bailout stays so, so
  * the set is {F <= 0} and its surface the level set F = 0 of a polynomial in the
- * point (seed 002_6b6c8e6b1cd19649.txt).  An orbit that escapes at n < N is not iterated
+ * point (Quilez 2002).  An orbit that escapes at n < N is not iterated
  * on (it would overflow); |q_N|^2 is extrapolated as (|q_n|^2)^(D^(N-n)), the growth of
  * q^D for large q (D = JULIA_GROWTH; 2 for functions that are no polynomial), and capped
  * at 1e30: only the interpolation uses the value, never the inside test. */
@@ -119,7 +119,7 @@ inline void julia_inside_pair(quat pa, quat pb, julia_params jp, lmask *inside_a
 #endif
 
 #ifdef ALG_HAS_DE
-/* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (seed 001 §3.1, eq. 8)
+/* Distance-estimate formula d = |q_n| ln|q_n| / (2 |q_n'|)  (Hart, Sandin & Kauffman 1989 §3.1, eq. 8)
  * evaluated at the last iterate, whether or not it escaped.  The derivative is
  * carried squared, so the loop needs no sqrt: |q'_{n+1}|^2 = 4 |q_n|^2 |q'_n|^2, and
  * d = sqrt(m2 / dm2) ln(m2) / 4.  Where |q'| would overflow, it is carried as a
@@ -214,7 +214,7 @@ inline void julia_distance_formula_pair(quat pa, quat pb, julia_params jp, lmask
  * distance to a product is sqrt(dist(a, K_a)^2 + dist(b, K_b)^2), and the split scales 4D
  * lengths by sqrt(2) (|a|^2 + |b|^2 = 2 |h|^2), so
  *     d = sqrt(d_a^2 + d_b^2) / sqrt(2),
- * each d_a = |a_n| ln|a_n| / (2 |a_n'|) the complex estimate of seed 001 §3.1 (eq. 8;
+ * each d_a = |a_n| ln|a_n| / (2 |a_n'|) the complex estimate of Hart, Sandin & Kauffman 1989 §3.1 (eq. 8;
  * |a'_{n+1}| = D |a_n|^(D-1) |a'_n|) where the component has provably escaped, |a_n| > 1 +
  * |c_a| (then |a^D + c_a| > |a|), and 0 where it has not (an under-estimate: safe steps).
  * The loop is the set test's (|h_n| <= bailout); *escaped is that test's. */

@@ -1,4 +1,4 @@
-/* rays.cl: one 4D ray per pixel from the pinhole 4D camera of seed 000 §4.
+/* rays.cl: one 4D ray per pixel from the pinhole 4D camera of Odegaard & Wennergren §4.
  * The host builds the orthonormal frame (forward, right, up; right from the 4D cross
  * product with the limbo vector); pixel (x, y) looks along
  *     normalize(forward + u right + v up),  u, v in [-tan(fov/2) aspect, ..] x [.., tan(fov/2)],

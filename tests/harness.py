@@ -20,7 +20,7 @@ def device():
 
 def packet_widths(widths=(4, 8, 16), double: bool = False):
     """The packet widths the device under test survives: those up to the width its probe
-    found for the precision (pyjulia4d/lanes.py runs the probe in a child process; a width a
+    found for the precision (pyjulia4d/opencl/lanes.py runs the probe in a child process; a width a
     driver crashes on - PyPI's PoCL on float16 - must never run in the test process itself)."""
     from pyjulia4d.opencl.lanes import lanes_for
 

@@ -28,7 +28,7 @@ def rand4(n, seed, scale=1.0):
 # ------------------------------------------------------------ multiplication tables
 
 def test_quaternion_table():
-    # i^2 = j^2 = k^2 = ijk = -1, ij = -ji = k: associative, not commutative (seed 000 eq. 3)
+    # i^2 = j^2 = k^2 = ijk = -1, ij = -ji = k: associative, not commutative (Ödegaard & Wennergren eq. 3)
     m = qa.alg_mul
     for u in (I, J, K):
         np.testing.assert_array_equal(m(u, u), -ONE)
@@ -46,7 +46,7 @@ def test_quaternion_table():
 
 
 def test_hypercomplex_table():
-    # ij = ji = k, jk = kj = -i, ki = ik = -j, i^2 = j^2 = -1, k^2 = +1 (seed 003's table:
+    # ij = ji = k, jk = kj = -i, ki = ik = -j, i^2 = j^2 = -1, k^2 = +1 (POV-Ray 3.6 documentation's table:
     # its "kk = -1" contradicts ij = k with ijk = 1); commutative and associative, with
     # zero divisors (1 + k)(1 - k) = 0
     m = hc.alg_mul
@@ -64,7 +64,7 @@ def test_hypercomplex_table():
 
 
 def test_cquat_table():
-    # seed 000 eq. 14: i^2 = -1, j^2 = k^2 = 1, ij = ji = -k, ki = ik = -j, jk = kj = i;
+    # Ödegaard & Wennergren eq. 14: i^2 = -1, j^2 = k^2 = 1, ij = ji = -k, ki = ik = -j, jk = kj = i;
     # commutative, NOT associative, zero divisors (1 + j)(1 - j) = 0
     m = cq.alg_mul
     np.testing.assert_array_equal(m(I, I), -ONE)
@@ -81,7 +81,7 @@ def test_cquat_table():
 
 
 def test_commutative_table():
-    # seed 000 eq. 15: i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j, jk = kj = i;
+    # Ödegaard & Wennergren eq. 15: i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j, jk = kj = i;
     # commutative, NOT associative
     m = cm.alg_mul
     for u in (I, J, K):

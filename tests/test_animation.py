@@ -1,4 +1,4 @@
-"""Keyframed animation (pyjulia4d/keyframes.py, animation.py, video.py): interpolation,
+"""Keyframed animation (pyjulia4d/scene/keyframes.py, animation.py, video.py): interpolation,
 bad keyframes, numbered frames with their scene in the header, resuming after SIGKILL,
 and the video played back."""
 from __future__ import annotations

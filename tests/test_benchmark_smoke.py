@@ -36,7 +36,7 @@ def test_quick_run_writes_sane_results(tmp_path):
         # the render's own certified bracket is recorded beside the error, and checked against the truth
         assert 0 <= float(r["bracket_p50"]) <= float(r["bracket_p99"]) <= float(r["bracket_max"])
         assert 0 <= int(r["stepped_over"]) <= int(r["n_both"]) and int(r["after_bracket"]) >= 0
-    # post-stepping makes the fixed scan's depth more accurate (seed 000 eq. 12); on the
+    # post-stepping makes the fixed scan's depth more accurate (Ödegaard & Wennergren eq. 12); on the
     # real-c scene (on the c = 0 ball the bounding sphere is the surface: no bracket to narrow)
     real = {(r["method"], r["post_steps"]): float(r["depth_err_median"]) for r in rows if r["scene"] == "real"}
     assert real[("fixed", "10")] < real[("fixed", "0")] / 100

@@ -1,4 +1,4 @@
-"""Rendering on a Dask cluster (pyjulia4d/distributed.py): a worker killed mid-animation,
+"""Rendering on a Dask cluster (pyjulia4d/app/cluster.py): a worker killed mid-animation,
 tiles equal to the whole render, programs built once per worker, the render command's
 --workers."""
 from __future__ import annotations

@@ -65,6 +65,8 @@ def test_readme_is_a_front_door() -> None:
 @pytest.mark.parametrize("doc", DOCS, ids=lambda p: p.name)
 def test_user_text_cites_papers_not_seeds_nor_issues(doc: Path) -> None:
     text = doc.read_text(encoding="utf-8")
+    if doc.name == "bibliography.md":   # its key from the source files' names to the papers
+        text = re.sub(r"^\| `00\d_[0-9a-f]{16}\.txt` \|.*$", "", text, flags=re.M)
     assert not re.search(r"\bseed 00\d|\b00\d_[0-9a-f]{16}\.txt", text)
     assert not re.search(r"\bissue #?\d+|#\d{1,3}\b(?![0-9a-f])", _strip_code(text))
 

@@ -1,4 +1,4 @@
-"""Issue 4: the extreme-case catalogue (pyjulia4d/catalogue.py), both march methods.
+"""The extreme-case catalogue (pyjulia4d/measure/catalogue.py), both march methods.
 
 Every case must terminate within its step caps, leak no NaN or infinity into the
 outputs, count every guard that fired, and agree with the float64 render of the same

@@ -1,4 +1,4 @@
-"""camera.fit (pyjulia4d/framing.py): a quick first pass frames the set, keeping the view
+"""camera.fit (pyjulia4d/pipeline/framing.py): a quick first pass frames the set, keeping the view
 direction."""
 import numpy as np
 import pytest

@@ -58,7 +58,7 @@ def _import(tmp_path: Path, text: str | bytes, capsys, *extra: str, name: str = 
 # ------------------------------------------------------------------ conversions
 
 def test_documentation_example_converts_and_renders(tmp_path, capsys, monkeypatch):
-    """Seed 003's example as it stands (no camera: POV-Ray's default one at the origin,
+    """POV-Ray 3.6 documentation's example as it stands (no camera: POV-Ray's default one at the origin,
     looking along +z), then with a camera; both load and render."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / "doc.pov").write_text(DOC_JULIA)

@@ -75,7 +75,7 @@ def test_quaternion_algebra():
     np.testing.assert_allclose(ref.alg_mul(ref.alg_mul(a, b), c), ref.alg_mul(a, ref.alg_mul(b, c)), atol=1e-12)
     np.testing.assert_allclose(ref.alg_sqr(a), ref.alg_mul(a, a), atol=1e-12)
     i, j, k = np.eye(4)[1:]
-    np.testing.assert_allclose(ref.alg_mul(i, j), k)   # seed 000 eq. 3
+    np.testing.assert_allclose(ref.alg_mul(i, j), k)   # Ödegaard & Wennergren eq. 3
     np.testing.assert_allclose(ref.alg_mul(j, i), -k)
     h = 1e-6
     jvp = ref.alg_sqr_jvp(a, b)

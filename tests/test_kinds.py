@@ -84,7 +84,7 @@ def test_mandelbrot_twin_on_the_complex_plane(function, power):
 
 def test_quaternion_mandelbrot_is_a_solid_of_revolution():
     # q^2 + c with c = (x, v): every iterate lies in the complex plane of 1 and v, so the set
-    # depends on x and |v| only (seed 002's 3D Mandelbrot)
+    # depends on x and |v| only (Quilez 2002's 3D Mandelbrot)
     p = rand4(20000, 2, 0.7) + [-0.3, 0, 0, 0]
     F = Formula("quaternion", "sqr", kind="mandelbrot")
     turned = np.stack([p[:, 0], np.linalg.norm(p[:, 1:], axis=1), 0 * p[:, 0], 0 * p[:, 0]], axis=1)

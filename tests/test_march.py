@@ -133,7 +133,7 @@ def test_step_cap_is_reported_not_hung():
 
 
 def test_post_steps_halve_the_bracket():
-    # seed 000 eq. 12: n post-steps shrink the bracket from h to h / 2^n; ITP reaches the
+    # Ödegaard & Wennergren eq. 12: n post-steps shrink the bracket from h to h / 2^n; ITP reaches the
     # same bound (or better) with no more set tests
     s = Scene.default().with_overrides(["fractal.c=0,0,0,0", "fractal.max_iter=3"])
     f = s.fractal

@@ -1,5 +1,5 @@
 """The explorer's camera moves (pyjulia4d/geometry/navigate.py) against their definition: rotations
-of the camera's orthonormal frame (seed 000 §4) about the target, in one plane each."""
+of the camera's orthonormal frame (Ödegaard & Wennergren §4) about the target, in one plane each."""
 import math
 
 import numpy as np

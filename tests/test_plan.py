@@ -1,4 +1,4 @@
-"""The render plan (pyjulia4d/plan.py) and its execution in tiles (render.TileRunner):
+"""The render plan (pyjulia4d/pipeline/plan.py) and its execution in tiles (render.TileRunner):
 outputs kept on request, device memory independent of the image size, a plan that travels."""
 import pickle
 import subprocess

@@ -36,7 +36,7 @@ def test_frame_is_orthonormal_and_default_drops_w():
     f = camera_frame(s)
     m = np.stack([f.forward, f.right, f.up])
     np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
-    assert np.allclose(m[:, 3], 0)   # limbo e_w, w = 0: the 3D view of seed 000 §4
+    assert np.allclose(m[:, 3], 0)   # limbo e_w, w = 0: the 3D view of Ödegaard & Wennergren §4
     np.testing.assert_allclose(f.right, [1, 0, 0, 0], atol=1e-12)  # looking +z with y up: x is right
 
 

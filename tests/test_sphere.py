@@ -64,7 +64,7 @@ def test_fixed_scan_depth(renderer, post):
     slack = (1.5e-6 / cos + 1e-6) if res.device_name != "numpy float64 reference" else 1e-9
     if post == 0:   # first inside sample: at or after the entry, less than one step after
         assert np.all(err > -slack) and np.all(err < h[hit] + slack)
-    else:           # seed 000 eq. 12: within h / 2^n
+    else:           # Ödegaard & Wennergren eq. 12: within h / 2^n
         assert np.all(np.abs(err) <= h[hit] / 2 ** post + slack)
 
 

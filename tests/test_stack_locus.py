@@ -1,5 +1,5 @@
-"""Julia set stacks (fractal.kind = "julia_stack", kernels/kind/julia_stack.cl, seed
-001_01b4b6353b5280e3.txt §5.1) and the cubic connectedness locus (fractal.kind =
+"""Julia set stacks (fractal.kind = "julia_stack", kernels/kind/julia_stack.cl,
+Hart, Sandin & Kauffman 1989 §5.1) and the cubic connectedness locus (fractal.kind =
 "cubic_locus", kernels/kind/cubic_locus.cl, §5.2): each kernel against its float64 twin
 (pyjulia4d/reference/kind/), and the twin and kernels against the mathematics - every
 u = const section of a stack is the complex Julia set of c(u), the locus is the bounded orbit
@@ -203,7 +203,7 @@ def test_stack_keys_refused_with_the_key(over, key):
 
 
 # ============================================================ the cubic connectedness locus
-# fractal.kind = "cubic_locus" (kernels/kind/cubic_locus.cl, seed 001 §5.2): p = (a, b) in C^2
+# fractal.kind = "cubic_locus" (kernels/kind/cubic_locus.cl, Hart, Sandin & Kauffman 1989 §5.2): p = (a, b) in C^2
 
 def locus(*over):
     return Scene.default().with_overrides(["fractal.kind=cubic_locus", *over])

@@ -242,3 +242,40 @@ PLANNING = {"pyjulia4d.fractal.registry", "pyjulia4d.pipeline.plan", "pyjulia4d.
 def test_march_method_is_resolved_in_planning_only() -> None:
     calls = {m for m, p in MODULES.items() if re.search(r"\bmarch_method\(", p.read_text())}
     assert calls - PLANNING == set()
+
+
+def test_code_cites_papers_not_source_files() -> None:
+    """Code names a paper by its authors, year and section (docs/bibliography.md keys the
+    source files' names to them), never by a file name a reader cannot follow; and comments
+    say why, not when (no issue numbers)."""
+    roots = [PKG, kernel_dir(), PKG.parent / "tests", PKG.parent / "benchmarks"]
+    bad = []
+    for root in roots:
+        for p in list(root.rglob("*.py")) + list(root.rglob("*.cl")) + list(root.rglob("*.sh")):
+            if "results" in p.parts:
+                continue
+            text = p.read_text(encoding="utf-8")
+            if re.search(r"\b[Ss]eeds? 00\d|\b00\d_[0-9a-f]{16}\.txt|\b[Ii]ssue #?\d+", text):
+                bad.append(p.name)
+    assert bad == []
+
+
+PATH_CITED = re.compile(r"\b((?:pyjulia4d|kernels|benchmarks|tests|docs)/[\w./-]+\.(?:py|cl|md|sh))")
+PACKAGE_PATH = re.compile(r"(?<![\w/])((?:app|fractal|geometry|interop|measure|opencl|pipeline|reference|scene)/[\w/]+\.py)")
+PIECE_PATH = re.compile(r"(?<![\w/])((?:algebra|common|enclose|function|kind|march|mesh|normals|shade)/[\w/]+\.cl)")
+
+
+def test_cited_paths_exist() -> None:
+    """Every file a comment, docstring or page names by its path is there: from the top
+    (pyjulia4d/..., kernels/..., docs/...), within the package (opencl/runner.py) or within
+    kernels/ (march/march.cl)."""
+    top = PKG.parent
+    texts = [p for p in list(PKG.rglob("*.py")) + list(kernel_dir().rglob("*.cl")) + list((top / "tests").glob("*.py"))
+             + list((top / "benchmarks").glob("*.py")) + list((top / "docs").glob("*.md")) + [top / "README.md"]]
+    dead = set()
+    for p in texts:
+        text = p.read_text(encoding="utf-8")
+        dead |= {(p.name, m) for m in PATH_CITED.findall(text) if not (top / m).exists()}
+        dead |= {(p.name, m) for m in PACKAGE_PATH.findall(text) if not (PKG / m).exists() and not (top / m).exists()}
+        dead |= {(p.name, m) for m in PIECE_PATH.findall(text) if not (kernel_dir() / m).exists()}
+    assert dead == set()

@@ -1,4 +1,4 @@
-"""The ground-truth oracles of pyjulia4d/truth.py checked on their own terms:
+"""The ground-truth oracles of pyjulia4d/measure/truth.py checked on their own terms:
 the real-c reduction against direct 4D iteration, the c = 0 depth against the
 analytic ball, the 2D oracle against the analytic ball (c1 = 0), and the
 converged double-precision scan against the 2D oracle."""
@@ -47,7 +47,7 @@ def test_sphere_depth_matches_fixed_scan_with_post_steps():
     R = march_radius(s)
     h = 2 * R / s.march.z_resolution                        # the longest chord's step
     err = np.abs(res.depth.ravel()[both] - t[both])
-    assert err.max() < h / 2 ** 10 + 2e-5                 # seed 000 eq. 12, plus float32
+    assert err.max() < h / 2 ** 10 + 2e-5                 # Ödegaard & Wennergren eq. 12, plus float32
 
 
 def test_real_c_depth_with_c1_zero_is_the_ball():

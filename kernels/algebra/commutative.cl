@@ -1,7 +1,7 @@
-/* algebra/commutative.cl: the naive commutative quaternion rules of seed
- * 000_1dc675fe64448cc1.txt eq. 15: i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j,
+/* algebra/commutative.cl: the naive commutative quaternion rules of
+ * Odegaard & Wennergren eq. 15: i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j,
  * jk = kj = i, extended bilinearly: commutative, not associative ((ii)j = -j but
- * i(ij) = ik = j); "highly irregular shapes" (seed 000 Fig. 7).  The powers and their
+ * i(ij) = ik = j); "highly irregular shapes" (Odegaard & Wennergren Fig. 7).  The powers and their
  * derivatives are algebra/power.cl's. */
 #define ALG_IN(p) (p)
 #define ALG_C(c) (c)

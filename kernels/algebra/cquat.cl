@@ -1,8 +1,8 @@
 /* algebra/cquat.cl: Gintz's complexified quaternions (CQuats), q = q1 + q2 i + q3 j + q4 k
  * with i^2 = -1, j^2 = k^2 = +1, ij = ji = -k, ki = ik = -j, jk = kj = i
- * (seed 000_1dc675fe64448cc1.txt eq. 14), extended bilinearly: commutative, not
+ * (Odegaard & Wennergren eq. 14), extended bilinearly: commutative, not
  * associative ((ii)j = -j but i(ij) = j), with zero divisors ((1 + j)(1 - j) = 0).
- * Its Julia sets have "square angles and often square holes" (seed 000 §8).  The powers
+ * Its Julia sets have "square angles and often square holes" (Odegaard & Wennergren §8).  The powers
  * and their derivatives are algebra/power.cl's. */
 #define ALG_IN(p) (p)
 #define ALG_C(c) (c)

@@ -1,6 +1,6 @@
 /* algebra/hypercomplex.cl: the commutative hypercomplex numbers of Gintz and POV-Ray,
  * h = x + y i + z j + w k with i^2 = j^2 = -1, k^2 = +1, ij = ji = k, jk = kj = -i,
- * ki = ik = -j (seed 000_1dc675fe64448cc1.txt eq. 13; seed 003's basis table, whose
+ * ki = ik = -j (Odegaard & Wennergren eq. 13; POV-Ray 3.6 documentation's basis table, whose
  * "kk = -1" contradicts its own ij = k, ijk = 1: k^2 = ijij = i^2 j^2 = +1).
  *
  * The idempotents e1 = (1 + k)/2, e2 = (1 - k)/2 (e1^2 = e1, e2^2 = e2, e1 e2 = 0) split

@@ -1,6 +1,6 @@
 /* algebra/quaternion.cl: Hamilton's quaternions, q = q1 + q2 i + q3 j + q4 k
  * with i^2 = j^2 = k^2 = -1, ij = -ji = k, jk = -kj = i, ki = -ik = j
- * (seed 000_1dc675fe64448cc1.txt, eq. 3; seed 003 basis table).  Quaternions take the
+ * (Odegaard & Wennergren, eq. 3; POV-Ray 3.6 documentation basis table).  Quaternions take the
  * polynomial functions only (function/sqr.cl, function/cube.cl: FUNC_POWER), as in
  * POV-Ray; the iterate is kept in the point's own coordinates. */
 #ifndef FUNC_POWER
@@ -22,7 +22,7 @@ inline real4 alg_mul(real4 a, real4 b)
                    a.x * b.w + a.y * b.z - a.z * b.y + a.w * b.x);
 }
 
-/* q^2 = (q1^2 - q2^2 - q3^2 - q4^2, 2 q1 q2, 2 q1 q3, 2 q1 q4)  (seed 000, eq. 4), on a
+/* q^2 = (q1^2 - q2^2 - q3^2 - q4^2, 2 q1 q2, 2 q1 q3, 2 q1 q4)  (Odegaard & Wennergren, eq. 4), on a
  * lane type (common/lanes.cl): one ray or a packet of rays. */
 inline quat alg_sqr(quat q)
 {
@@ -31,7 +31,7 @@ inline quat alg_sqr(quat q)
 }
 
 /* Directional derivative of q -> q^2 along h: q h + h q = 2 (q1 h1 - v.hv, q1 hv + h1 v);
- * the cross products cancel, so the Jacobian is the matrix of seed 004, method 3. */
+ * the cross products cancel, so the Jacobian is the matrix of Quilez (n.d.), method 3. */
 inline quat alg_sqr_jvp(quat q, quat h)
 {
     return QUAT((real)2 * (q.x * h.x - q.y * h.y - q.z * h.z - q.w * h.w),
@@ -41,7 +41,7 @@ inline quat alg_sqr_jvp(quat q, quat h)
 }
 
 /* q = (x, v): q^3 = (x^3 - 3 x |v|^2, (3 x^2 - |v|^2) v)  (every power of q lies in the
- * complex plane spanned by 1 and v; seed 004's cubic Julia sets). */
+ * complex plane spanned by 1 and v; Quilez (n.d.)'s cubic Julia sets). */
 inline quat alg_cube(quat q)
 {
     lreal v2 = q.y * q.y + q.z * q.z + q.w * q.w;
@@ -63,7 +63,7 @@ inline quat alg_cube_jvp(quat q, quat h)
 
 /* The map f(q) + c, its derivative along h, and for the distance estimate |f'(q)|^2 as a
  * function of m2 = |q|^2: |q'_{n+1}| = D |q_n|^(D-1) |q'_n|, the quaternion norm being
- * multiplicative (seed 001 §3.1). */
+ * multiplicative (Hart, Sandin & Kauffman 1989 §3.1). */
 #if FUNC_POWER == 2
 inline quat julia_f(quat q, real4 c) { return QADD_UNIFORM(alg_sqr(q), c); }
 inline quat julia_f_jvp(quat q, quat h) { return alg_sqr_jvp(q, h); }

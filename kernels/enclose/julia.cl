@@ -1,7 +1,7 @@
 /* enclose/julia.cl: the Julia set's orbit enclosures, after the algebra's enclosure piece
  * (enclose/ball.cl, enclose/split.cl), for march/proven.cl: the segment's points are q_0
  * (enc_segment), c is the scene's, and a point is outside when |q_n| > bailout at some
- * n = 0 .. max_iter (seed 003_8ca5f9108f52d3d6.txt; iterate.cl julia_inside).  A kind with
+ * n = 0 .. max_iter (POV-Ray 3.6 documentation; iterate.cl julia_inside).  A kind with
  * orbits of its own has a piece of the same four names (enclose/mandelbrot.cl). */
 #define ENC_STEPS(jp) ((jp).max_iter)
 

@@ -1,4 +1,4 @@
-/* function/acos.cl: f(z) = acos z, f'(z) = -1/sqrt(1 - z^2) (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/acos.cl: f(z) = acos z, f'(z) = -1/sqrt(1 - z^2) (POV-Ray 3.6 documentation, the
  * julia_fractal function "acos"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/acosh.cl: f(z) = acosh z, f'(z) = 1/(sqrt(z - 1) sqrt(z + 1)) (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/acosh.cl: f(z) = acosh z, f'(z) = 1/(sqrt(z - 1) sqrt(z + 1)) (POV-Ray 3.6 documentation, the
  * julia_fractal function "acosh"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

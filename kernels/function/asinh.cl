@@ -1,4 +1,4 @@
-/* function/asinh.cl: f(z) = asinh z, f'(z) = 1/sqrt(z^2 + 1) (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/asinh.cl: f(z) = asinh z, f'(z) = 1/sqrt(z^2 + 1) (POV-Ray 3.6 documentation, the
  * julia_fractal function "asinh"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

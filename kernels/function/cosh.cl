@@ -1,4 +1,4 @@
-/* function/cosh.cl: f(z) = cosh z, f'(z) = sinh z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/cosh.cl: f(z) = cosh z, f'(z) = sinh z (POV-Ray 3.6 documentation, the
  * julia_fractal function "cosh"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/cube.cl: f(z) = z^3, f'(z) = 3 z^2 (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/cube.cl: f(z) = z^3, f'(z) = 3 z^2 (POV-Ray 3.6 documentation, the
  * julia_fractal function "cube"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  * FUNC_POWER tells the algebra the map is the polynomial z^3: quaternions use their own

@@ -1,4 +1,4 @@
-/* function/exp.cl: f(z) = e^z, f'(z) = e^z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/exp.cl: f(z) = e^z, f'(z) = e^z (POV-Ray 3.6 documentation, the
  * julia_fractal function "exp"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/ln.cl: f(z) = ln z (principal), f'(z) = 1/z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/ln.cl: f(z) = ln z (principal), f'(z) = 1/z (POV-Ray 3.6 documentation, the
  * julia_fractal function "ln"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/pwr.cl: f(z) = z^p = exp(p log z), f'(z) = p z^(p-1) (seed 003_8ca5f9108f52d3d6.txt,
+/* function/pwr.cl: f(z) = z^p = exp(p log z), f'(z) = p z^(p-1) (POV-Ray 3.6 documentation,
  * the julia_fractal function "pwr(x, y)"; p = x + iy is fractal.exponent, compiled in as
  * -D FUNC_EXPONENT_RE/IM), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).

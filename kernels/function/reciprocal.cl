@@ -1,4 +1,4 @@
-/* function/reciprocal.cl: f(z) = 1/z, f'(z) = -1/z^2 (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/reciprocal.cl: f(z) = 1/z, f'(z) = -1/z^2 (POV-Ray 3.6 documentation, the
  * julia_fractal function "reciprocal"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/sqr.cl: f(z) = z^2, f'(z) = 2 z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/sqr.cl: f(z) = z^2, f'(z) = 2 z (POV-Ray 3.6 documentation, the
  * julia_fractal function "sqr"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  * FUNC_POWER tells the algebra the map is the polynomial z^2: quaternions use their own

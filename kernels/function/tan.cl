@@ -1,4 +1,4 @@
-/* function/tan.cl: f(z) = tan z, f'(z) = 1 + tan^2 z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/tan.cl: f(z) = tan z, f'(z) = 1 + tan^2 z (POV-Ray 3.6 documentation, the
  * julia_fractal function "tan"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

@@ -1,4 +1,4 @@
-/* function/tanh.cl: f(z) = tanh z, f'(z) = 1 - tanh^2 z (seed 003_8ca5f9108f52d3d6.txt, the
+/* function/tanh.cl: f(z) = tanh z, f'(z) = 1 - tanh^2 z (POV-Ray 3.6 documentation, the
  * julia_fractal function "tanh"), on a complex lane value (algebra/complex.cl).  An
  * algebra lifts it to 4D (algebra/hypercomplex.cl: on each idempotent component).
  */

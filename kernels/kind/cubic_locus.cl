@@ -1,5 +1,5 @@
 /* kind/cubic_locus.cl (-D KIND_CUBIC_LOCUS, LOCUS_SIGN, LOCUS_R2; built only for fractal.kind =
- * "cubic_locus"): the cubic connectedness locus of seed 001_01b4b6353b5280e3.txt §5.2, eq. 19,
+ * "cubic_locus"): the cubic connectedness locus of Hart, Sandin & Kauffman 1989 §5.2, eq. 19,
  *     f_{a,b}(z) = z^3 - 3 a^2 z + b,   critical points +a and -a,
  *     C+ = {(a, b) : the orbit of +a stays bounded}  (Definition 4),  C- likewise for -a,
  * a 4D set in the point p = (Re a, Im a, Re b, Im b), seen through the 4D camera and slice
@@ -8,7 +8,7 @@
  * that 4-ball, cut by its sphere) and |z_n| <= bailout for n = 0 .. max_iter, z_0 = LOCUS_SIGN a
  * (+1: C+, -1: C-; fractal.component).  scene/rules.py refuses a bailout below the escape radius of
  * the maps in the ball (|z| > bailout then escapes), so the truncated set tends to C+.
- * No distance estimate is known (seed 001 §5.2): the fixed scan only; ALG_HAS_DE is undefined
+ * No distance estimate is known (Hart, Sandin & Kauffman 1989 §5.2): the fixed scan only; ALG_HAS_DE is undefined
  * (shadows and ambient occlusion test inside points).
  *
  * Compiled after iterate.cl (the pattern of kind/mandelbrot.cl): the set test, level function

@@ -1,6 +1,6 @@
 /* kind/julia_stack.cl (-D KIND_JULIA_STACK, STACK_CM_RE/IM, STACK_CH_RE/IM; built only for
  * fractal.kind = "julia_stack"): a stack of complex Julia sets, the 3D slice of C x C of
- * seed 001_01b4b6353b5280e3.txt §5.1 - "looking at the z-planes and varying some
+ * Hart, Sandin & Kauffman 1989 §5.1 - "looking at the z-planes and varying some
  * single-dimension function of c to define the third dimension".  The point p = (x, y, u, w):
  *     z_0 = x + i y,   c(u) = c_mid + u c_half,   |u| <= 1,   w ignored,
  * c_mid = (c_from + c_to) / 2 and c_half = (c_to - c_from) / 2 (fractal.c_from at u = -1,
@@ -12,7 +12,7 @@
  * Compiled after iterate.cl (the pattern of kind/mandelbrot.cl): the set test, level function
  * and normal below take over julia_inside, julia_level and the Jacobian normal (KIND_NORMAL,
  * defined at the end: normals/jacobian.cl projects its 4D gradient).
- * No distance estimate is proven for a stack (seed 001 §5.1), so by default the estimate of
+ * No distance estimate is proven for a stack (Hart, Sandin & Kauffman 1989 §5.1), so by default the estimate of
  * iterate.cl is switched off (ALG_HAS_DE undefined: shadows and ambient occlusion test inside
  * points); -D STACK_DE (march.method = "de") builds the seed's "empirical formula based on
  * the Mandelbrot set distance estimate" instead (stack_distance_formula). */
@@ -114,8 +114,8 @@ inline quat stack_normal(quat p, julia_params jp, lmask *guard)
 }
 
 #ifdef STACK_DE
-/* The empirical estimate (march.method = "de"; seed 001 §5.1: no proven one): the Julia and
- * Mandelbrot estimates of seed 001 §3.1 eq. 8 in one, d = |z_n| ln|z_n| / (2 G) with
+/* The empirical estimate (march.method = "de"; Hart, Sandin & Kauffman 1989 §5.1: no proven one): the Julia and
+ * Mandelbrot estimates of Hart, Sandin & Kauffman 1989 §3.1 eq. 8 in one, d = |z_n| ln|z_n| / (2 G) with
  * G = sqrt(|A_n|^2 + |B_n|^2) >= the norm of the 2 x 3 Jacobian of z_n in (x, y, u) (A, B as
  * in stack_normal), carried through the bounds |A_{n+1}| = 2 |z_n| |A_n| and
  * |B_{n+1}| <= 2 |z_n| |B_n| + |c_half| as mantissas times a common 2^e (no overflow at any

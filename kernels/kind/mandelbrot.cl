@@ -1,7 +1,7 @@
 /* kind/mandelbrot.cl (-D KIND_MANDELBROT; built only for fractal.kind = "mandelbrot"): the
  * Mandelbrot set of the algebra's q -> f(q) + c, the 4D set of parameters c whose orbit of
- * the critical point 0 stays bounded (seed 001_01b4b6353b5280e3.txt §2.1: "only one critical
- * point ... always 0"; seed 002_6b6c8e6b1cd19649.txt ray traces these with the same
+ * the critical point 0 stays bounded (Hart, Sandin & Kauffman 1989 §2.1: "only one critical
+ * point ... always 0"; Quilez 2002 ray traces these with the same
  * primitive as the Julia sets).  The point p is c (in the algebra's coordinates ALG_IN(p),
  * per lane), q_0 = 0 and q_1 = f(0) + c = c exactly, so the orbit starts there: p is inside
  * when |q_n| <= bailout for n = 1 .. max_iter (q_0 = 0 always is).  fractal.c is unused.
@@ -94,7 +94,7 @@ inline void mandel_inside_pair(quat pa, quat pb, julia_params jp, lmask *inside_
 #endif
 
 #ifdef ALG_HAS_DE
-/* The distance estimate of seed 001 §3.1 eq. 8, d = |q_n| ln|q_n| / (2 |q_n'|), with the
+/* The distance estimate of Hart, Sandin & Kauffman 1989 §3.1 eq. 8, d = |q_n| ln|q_n| / (2 |q_n'|), with the
  * derivative taken with respect to c:  q'_1 = 1,  q'_{n+1} = f'(q_n) q'_n + 1.  Its norm is
  * carried as the bound |q'_{n+1}| <= |f'(q_n)| |q'_n| + 1 (|f'(q)| = sqrt(JULIA_DF2(|q|^2)),
  * the operator norm of q h + h q is at most 2 |q|): a larger |q'|, a smaller - safer - d.

@@ -1,5 +1,5 @@
 /* kind/rotate.cl (-D ROTATE_COS, ROTATE_SIN; built only for fractal.theta != 0): the
- * rotated Julia set of seed 001_01b4b6353b5280e3.txt §2.3.  The seed's eqs. 5-6 are lost
+ * rotated Julia set of Hart, Sandin & Kauffman 1989 §2.3.  The seed's eqs. 5-6 are lost
  * in its text; reconstructed: the rotation of the complex plane g(z) = u z, u = e^(i theta),
  * conjugates the map,
  *     f_theta(q) = g(f(g^-1(q))) = u f(u^-1 q) + u c,

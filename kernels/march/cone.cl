@@ -1,5 +1,5 @@
 /* march/cone.cl: where the camera rays of a block of CONE_BLOCK x CONE_BLOCK pixels can start
- * the distance-estimate march (-D CONE_START, with march/de.cl; seed 000 §4's near plane
+ * the distance-estimate march (-D CONE_START, with march/de.cl; Odegaard & Wennergren §4's near plane
  * from a low-resolution pass, taken along a cone).
  *
  * Every ray of the block leaves the eye o; each passes through its pixel within 2 sqrt(2)

@@ -1,4 +1,4 @@
-/* march/de.cl: distance-estimate marching (seed 001 §3.2, eq. 9), on a lane type
+/* march/de.cl: distance-estimate marching (Hart, Sandin & Kauffman 1989 §3.2, eq. 9), on a lane type
  * (common/lanes.cl):
  *     r_{n+1} = r_n + max(d(r_n), epsilon),
  * until a point is inside the truncated set (d = 0: its orbit never escaped, the
@@ -8,15 +8,15 @@
  * to the max_iter-truncated one the picture shows, and at max_iter 20 points with d <
  * epsilon lie in front of the surface (their orbits escape at iteration 15-18); there
  * the march goes on in steps of epsilon, the smallest step, so parts of the set thinner
- * than epsilon along the ray can be stepped over (seed 001 §3.3's thin objects).  A ray
+ * than epsilon along the ray can be stepped over (Hart, Sandin & Kauffman 1989 §3.3's thin objects).  A ray
  * that came within epsilon by the estimate but found no inside point before the far end
  * is a miss, flagged GUARD_SHELL_MISS and counted - never a hit at an outside point.
- * The march starts at the bounding sphere (seed 001 §3.4) and is capped at max_steps
+ * The march starts at the bounding sphere (Hart, Sandin & Kauffman 1989 §3.4) and is capped at max_steps
  * estimates (STATUS_CAPPED, counted).  Lanes outside ``live`` are left alone.
  *
  * Precision: where max(d, epsilon) is below half the spacing of t, t + step rounds back
  * to t; the step is then one ulp of t (the next representable t), flagged GUARD_ULP_STEP
- * and counted: the effective epsilon becomes the spacing of t (seed 001 §4.2's epsilon
+ * and counted: the effective epsilon becomes the spacing of t (Hart, Sandin & Kauffman 1989 §4.2's epsilon
  * as a function of distance, forced by the number format), and the bracket one ulp. */
 
 /* Over-relaxed steps (Keinert, Schaefer, Korndoerfer, Ganse and Stamminger, "Enhanced Sphere

@@ -1,4 +1,4 @@
-/* march/fixed.cl: fixed z-resolution scan (seed 000 §3), on a lane type (common/lanes.cl).
+/* march/fixed.cl: fixed z-resolution scan (Odegaard & Wennergren §3), on a lane type (common/lanes.cl).
  * Samples t_i = near + i (far - near) / z_resolution, i = 0 .. z_resolution; the first
  * sample inside the set ends a ray's scan, and [t_{i-1}, t_i] - the previous sample
  * verified outside, this one inside - is the certified bracket refined by march/refine.cl.

@@ -3,7 +3,7 @@
  * tile_w wide; -D RAYS_FROM_BUFFERS reads them from origins/dirs instead (the tests' and
  * benchmarks' arbitrary rays).  The ray o + t d (|d| = 1)
  * is clipped to the bounding 4-ball |p| <= radius, which provably holds the set
- * (seed 002, seed 004: bound first, march only inside); rays that miss it do no
+ * (Quilez 2002, Quilez (n.d.): bound first, march only inside); rays that miss it do no
  * iteration.  near/far < 0 mean "the sphere's entry/exit".  flags gets the march's
  * guard flags (common/codes.cl), 0 when none fired; bracket the width of the certified
  * bracket behind each hit's depth (march/refine.cl), +inf where nothing was hit;

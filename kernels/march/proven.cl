@@ -4,7 +4,7 @@
  * A segment [t0, t1] of the ray holds no point of the truncated set when an enclosure of
  * the orbits of all its points (enclose/ball.cl, enclose/split.cl: enc_segment, enc_step)
  * lies outside the bailout ball at some iteration n <= max_iter: every point then has
- * |q_n| > bailout, so none is inside (seed 003_8ca5f9108f52d3d6.txt: inside when |q_n| <=
+ * |q_n| > bailout, so none is inside (POV-Ray 3.6 documentation: inside when |q_n| <=
  * bailout for n = 0 .. max_iter).  This is the interval ray tracing of Knoll, Hijazi,
  * Kensler, Schott, Hansen and Hagen (2009) with circular arithmetic for the enclosure.
  *

@@ -5,13 +5,13 @@
  * within the width behind the depth (a thin part stepped over before a is not covered).
  * On a lane type (common/lanes.cl): lanes outside ``todo`` are left as they are.
  *
- * Bisection (-U REFINE_ITP): seed 000_1dc675fe64448cc1.txt §7.1 eq. 11, post-stepping,
+ * Bisection (-U REFINE_ITP): Odegaard & Wennergren §7.1 eq. 11, post-stepping,
  * each step halves the bracket: after n steps its width is h / 2^n (eq. 12).  Unlike the
  * seed's last step, every point is classified, so the bracket stays certified.
  *
  * ITP (-D REFINE_ITP; Oliveira & Takahashi, ACM TOMS 47(1), 2020): interpolate,
  * truncate, project on the level function F = |q_N|^2 / bailout^2 - 1 (julia_level),
- * which is smooth along the ray near the surface - seed 002_6b6c8e6b1cd19649.txt
+ * which is smooth along the ray near the surface - Quilez 2002
  * differentiates |q_N|^2 - bailout^2 for its normal - so the regula-falsi point
  * converges superlinearly; truncation (delta = 0.2 w^2 / w0) keeps both ends moving and
  * projection (n0 = 1) bounds the worst case by bisection's plus one step: post-

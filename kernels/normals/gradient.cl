@@ -1,5 +1,5 @@
 /* normals/gradient.cl: central-difference gradient of the distance estimate
- * (seed 001 §4.1.2, eq. 15, the 6-point gradient; seed 004 "method 1"), taken
+ * (Hart, Sandin & Kauffman 1989 §4.1.2, eq. 15, the 6-point gradient; Quilez (n.d.) "method 1"), taken
  * along the camera's right, up and forward axes so the result is already the
  * normal of the 3D section the rays see.  It differences the estimate formula
  * without the "0 inside" clamp, which is continuous across the surface. */

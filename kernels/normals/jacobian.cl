@@ -1,4 +1,4 @@
-/* normals/jacobian.cl: the analytic normal (seed 004 "method 3", seed 002).
+/* normals/jacobian.cl: the analytic normal (Quilez (n.d.) "method 3", Quilez 2002).
  * The surface is the level set |q_n|^2 = bailout^2, so the normal is
  *     grad |q_n|^2 = 2 J^T q_n,   J_{k+1} = f'(q_k) J_k,  J_0 = I.
  * The rays see only the 3D space spanned by the camera's right, up and forward, so only

@@ -1,9 +1,9 @@
-/* normals/zbuffer.cl: normals from Z-buffer neighbours (seed 000 §5.1, eqs. 7-9;
- * seed 001 §4.1.1, eqs. 12-14): the normal of the plane through the hit point and
+/* normals/zbuffer.cl: normals from Z-buffer neighbours (Odegaard & Wennergren §5.1, eqs. 7-9;
+ * Hart, Sandin & Kauffman 1989 §4.1.1, eqs. 12-14): the normal of the plane through the hit point and
  * its neighbours' hit points, in camera coordinates (so perspective is handled).
- * Along each image axis: the central difference of seed 000 when both neighbours
+ * Along each image axis: the central difference of Odegaard & Wennergren when both neighbours
  * hit with depth jumps within a factor 2 of each other; at a depth discontinuity
- * the one-sided difference with the smaller jump (seed 001), so silhouettes do not
+ * the one-sided difference with the smaller jump (Hart, Sandin & Kauffman 1989), so silhouettes do not
  * tilt the normal; with no neighbour hit, the image axis itself. */
 
 inline real3 cam_point(__global const real4 *point, size_t i, real4 eye,

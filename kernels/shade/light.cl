@@ -1,13 +1,13 @@
 /* shade/light.cl: the lighting terms of each hit that need the fractal itself, on a lane type
  * (common/lanes.cl; LANES hits per work-item, like the Jacobian normals): visibility of the
- * positioned light (shadows, seed 001 §6's self-shadowing), ambient occlusion, and the
+ * positioned light (shadows, Hart, Sandin & Kauffman 1989 §6's self-shadowing), ambient occlusion, and the
  * value a colour map turns into colour.  Compiled only when the scene uses one of them
  * (-D SHADOW_HARD / SHADOW_SOFT, AO, COLOR_ITERATION / COLOR_TRAP / COLOR_W); output
  * terms = (light visibility, ambient factor, colour value, 0) in [0, 1] each. */
 
 /* Visibility of the light along o + t l, t in (0, tmax], clipped to the bounding ball.
  * With a distance estimate (ALG_HAS_DE): steps of max(d, step), 0 at the first point
- * inside; soft shadows (seed 004's penumbra) take min(k d / t) over the way, d the
+ * inside; soft shadows (Quilez (n.d.)'s penumbra) take min(k d / t) over the way, d the
  * estimate without its 1/2 (Koebe) factor.  Without one: samples every `step` (the
  * scan's own spacing), 0 at the first inside - hard shadows, whichever was asked for.  At most max_steps points: a ray still
  * going there keeps what it has (lit).  Lanes outside ``lit`` trace nothing and get 0: no hit, or
@@ -104,7 +104,7 @@ inline void shadow_ray_pair(const quat *o, const quat *l, const lreal *tmax, con
 #define LIGHT_FACES(nw, lv) (QDOT((nw), (lv)) > (real)0)
 
 /* 1 - strength * occlusion, occlusion = sum_i w_i max(h_i - 2 d(p + h_i n), 0) / h_i / sum w_i
- * at h_i = i dist / 5, w_i = 2^-i (seed 004's ambient occlusion from the estimate; 2 d:
+ * at h_i = i dist / 5, w_i = 2^-i (Quilez (n.d.)'s ambient occlusion from the estimate; 2 d:
  * the estimate without its 1/2 factor); without an estimate, the share of the five points
  * inside the set (w_i-weighted occupancy). */
 #ifdef AO

@@ -1,5 +1,5 @@
 /* shade/reflect.cl (-D REFLECTION): one mirror bounce of each hit, in the set itself and
- * in the background (seed 001 §6: reflection is among what ray tracing gives over earlier
+ * in the background (Hart, Sandin & Kauffman 1989 §6: reflection is among what ray tracing gives over earlier
  * methods).  reflect_rays makes the reflected ray of each hit,
  *     d' = d - 2 (d . n) n,  from p + bias n  (n the 4D unit normal, d the unit view ray),
  * which march.cl (-D RAYS_FROM_BUFFERS) marches like a camera ray; reflect_color lights

@@ -1,6 +1,6 @@
 /* shade/shade.cl: Lambert diffuse with the light at the eye by default, so every visible
- * point is lit (seed 001 §4), or at a positioned light (-D LIGHT_POINT); Blinn-Phong
- * specular (-D SPECULAR; seed 000 §5.2); ambient from the sky; background colour on a miss.
+ * point is lit (Hart, Sandin & Kauffman 1989 §4), or at a positioned light (-D LIGHT_POINT); Blinn-Phong
+ * specular (-D SPECULAR; Odegaard & Wennergren §5.2); ambient from the sky; background colour on a miss.
  *     rgb = base ambient ao sky
  *         + sum over lights k of  color_k (base diffuse vis_k max(n.l_k, 0) + vis_k specular max(n.h_k, 0)^shininess)
  * the first light being shading.light (color light_color), the others shading.lights
@@ -97,7 +97,7 @@ __kernel void shade(const int n_items, __global const int *status, __global cons
     rgb = mix(rgb, refl[i].xyz, reflection);   /* shade/reflect.cl's one bounce */
 #endif
 #ifdef FOG
-    /* depth cueing (seed 001 §4.2): toward the background by exp(-fog (t - fog_start)), t the
+    /* depth cueing (Hart, Sandin & Kauffman 1989 §4.2): toward the background by exp(-fog (t - fog_start)), t the
      * distance from the eye, fog_start where the bounding ball begins */
     float fade = exp(-fog * fmax((float)sqrt(DOT4(pv, pv)) - fog_start, 0.0f));
     rgb = mix(background.xyz, rgb, fade);

@@ -1,6 +1,6 @@
 """Animations: a keyframed scene (keyframes.py) rendered to numbered frames, and a video.
 
-Seed 000_1dc675fe64448cc1.txt §6: morphing c, flying the camera, moving it along w.
+Ödegaard & Wennergren §6: morphing c, flying the camera, moving it along w.
 Frames are whole work units on a Dask cluster or in this process (cluster.py); the
 results come back here, and only this process writes files, each frame once, atomically
 (output.py's temp file and rename); each frame's file - with the frame number, the

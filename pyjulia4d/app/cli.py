@@ -346,7 +346,7 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def _import_pov(args: argparse.Namespace) -> int:
-    """import-pov: FILE.pov -> SCENE.toml (pyjulia4d/povray.py); warnings only on success."""
+    """import-pov: FILE.pov -> SCENE.toml (pyjulia4d/interop/povray/); warnings only on success."""
     from pyjulia4d.interop.povray import check_toml_path, import_pov, write_toml
 
     size = []

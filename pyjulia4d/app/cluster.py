@@ -1,8 +1,8 @@
 """Rendering on a Dask cluster (the ``distributed`` package): whole frames of an animation,
 or tiles of one large frame, as independent work units.
 
-Seed 001_01b4b6353b5280e3.txt §7.1 splits one image between 64 processors, each working
-out which pixels are its own; seed 000_1dc675fe64448cc1.txt §10.1 calls ray tracing
+Hart, Sandin & Kauffman 1989 §7.1 splits one image between 64 processors, each working
+out which pixels are its own; Ödegaard & Wennergren §10.1 calls ray tracing
 "easily parallelized" and its work-pool over network clients unfinished.  Here the pool
 is Dask's: the scheduler hands out units, re-runs on another worker the units of a worker
 that dies, and returns every result to the client, which alone writes files.  A unit is a

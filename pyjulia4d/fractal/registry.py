@@ -4,9 +4,9 @@ entry plus kernels/function/<name>.cl and pyjulia4d/reference/function/<name>.py
 scene's choices, the kernel configuration (pipeline/kernel_config.py), the bounding ball
 (geometry/camera.py) and the reference all read it here.
 
-The algebras and functions are POV-Ray's julia_fractal's (seed 003_8ca5f9108f52d3d6.txt), in
-its order, with Gintz's CQuats and the naive commutative rules (seed 000_1dc675fe64448cc1.txt
-eqs. 14, 15); the kinds are seed 001_01b4b6353b5280e3.txt's (§2, §5).
+The algebras and functions are POV-Ray's julia_fractal's (POV-Ray 3.6 documentation), in
+its order, with Gintz's CQuats and the naive commutative rules (Ödegaard & Wennergren
+eqs. 14, 15); the kinds are Hart, Sandin & Kauffman 1989's (§2, §5).
 """
 from __future__ import annotations
 
@@ -54,7 +54,7 @@ class Algebra(_Entry):
     POV-Ray).  ``norm_bounded``: |q^D| >= |q|^D, so the escape bound holds - quaternions (the
     norm is multiplicative) and the hypercomplex numbers (the power mean of their two complex
     components); CQuats and the commutative rules have zero divisors with |q^2| < |q|^2.
-    ``estimate``: the polynomial maps have a distance estimate (seed 001 §3.1 eq. 8 for
+    ``estimate``: the polynomial maps have a distance estimate (Hart, Sandin & Kauffman 1989 §3.1 eq. 8 for
     quaternions; the product of two complex Julia sets for the hypercomplex numbers).
     ``table``: a multiplication-table algebra whose powers come from algebra/power.cl."""
 

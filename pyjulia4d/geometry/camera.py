@@ -23,7 +23,7 @@ def slice_rotation(normal) -> np.ndarray:
 
     Camera coordinates are mapped to the world by p = R p_cam + distance n/|n|, so a
     3D camera (w = 0, limbo = e_w) looks into the hyperplane n.p = distance: POV-Ray's
-    slice (seed 003_8ca5f9108f52d3d6.txt).  Unlike POV-Ray, which keeps x, y, z and
+    slice (POV-Ray 3.6 documentation).  Unlike POV-Ray, which keeps x, y, z and
     solves for w, this map is an isometry: the section is seen undistorted and a
     normal with zero w-component is allowed.  Read-only, made once per normal (a render's
     plan maps five vectors by it: 0.2 ms made anew each time).
@@ -66,7 +66,7 @@ def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
 
 
 def camera_frame(scene: Scene) -> Frame:
-    """Orthonormal frame of seed 000 §4: forward from position to target; limbo and up
+    """Orthonormal frame of Ödegaard & Wennergren §4: forward from position to target; limbo and up
     made orthogonal to it (Gram-Schmidt); right = 4Dcross(forward, up, limbo), so the
     image plane is perpendicular to limbo.  limbo = e_w with w = 0 everywhere drops the
     fourth dimension; any other choice makes the rays travel in w."""

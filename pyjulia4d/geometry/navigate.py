@@ -1,7 +1,7 @@
 """Moving a 4D camera by hand (the explorer's drag, wheel and w-turn): rotations of the
 camera's own orthonormal frame about its target.
 
-The frame is seed 000_1dc675fe64448cc1.txt §4's (geometry/camera.py): forward f from the
+The frame is Ödegaard & Wennergren §4's (geometry/camera.py): forward f from the
 position to the target, limbo l and up u made orthogonal to it by Gram-Schmidt, right r =
 4Dcross(f, u, l).  Each move is a rotation by an angle a in one plane of that frame, applied
 to the offset of the position from the target, so the distance to the target is kept:
@@ -9,7 +9,7 @@ to the offset of the position from the target, so the distance to the target is 
 - ``orbit``: yaw in the plane (f, r), then pitch in the plane (f, u): the view circles the
   target within the 3D space the camera sees; limbo is untouched.
 - ``turn_w``: the plane (f, l): the view direction turns through the fourth dimension, by the
-  limbo vector, and limbo turns with it (seed 000 §6 moves position and target along w to see
+  limbo vector, and limbo turns with it (Ödegaard & Wennergren §6 moves position and target along w to see
   the set at other 4D angles; this does so keeping the target).
 - ``zoom``: the position slides along f, its distance to the target times a factor.
 

@@ -1,5 +1,5 @@
 """4-vectors: unit vectors scaled safely, the 4D cross product, and the Gram-Schmidt frame
-every 4D camera is built from (seed 000_1dc675fe64448cc1.txt §4) - written once, for the
+every 4D camera is built from (Ödegaard & Wennergren §4) - written once, for the
 camera (geometry/camera.py), the scene's check of it (scene/rules.py) and keyframed
 cameras (scene/keyframes.py)."""
 from __future__ import annotations
@@ -43,7 +43,7 @@ def unit_or_none(v, least: float = 1e-9) -> np.ndarray | None:
 
 
 def cross4(a, b, c) -> np.ndarray:
-    """The 4D cross product of seed 000_1dc675fe64448cc1.txt §4: a vector
+    """The 4D cross product of Ödegaard & Wennergren §4: a vector
     perpendicular to a, b and c (the signed cofactors of the 3x4 matrix [a; b; c])."""
     a1, a2, a3, a4 = a
     b1, b2, b3, b4 = b

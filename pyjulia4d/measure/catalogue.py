@@ -281,11 +281,11 @@ def _build() -> list[Case]:
              small),
         Case("theta_90_cube", ("fractal.function=cube", "fractal.c=0.3,0.4,0,0", "fractal.theta=90",
                                "fractal.max_iter=20"),
-             "the rotated map u (u^-1 q)^3 + u c (seed 001 §2.3) with u = i: cos 90 degrees is "
+             "the rotated map u (u^-1 q)^3 + u c (Hart, Sandin & Kauffman 1989 §2.3) with u = i: cos 90 degrees is "
              "6e-17 in float64 and -4e-8 in float32, not 0",
              "agrees with float64 as the unrotated cube does", 0.02, 1e-4, "", cheap),
         # Julia set stacks (fractal.kind = "julia_stack", kernels/kind/julia_stack.cl); "de" is the
-        # empirical estimate (seed 001 §5.1: none is proven)
+        # empirical estimate (Hart, Sandin & Kauffman 1989 §5.1: none is proven)
         Case("stack_through_boundary", ("fractal.kind=julia_stack", "fractal.c_from=0,0", "fractal.c_to=0.5,0",
                                         "fractal.max_iter=40", "camera.position=1.6,1.9,-3.0,0"),
              "a c-line through the Mandelbrot set's cusp c = 1/4: the sections implode from the "

@@ -4,17 +4,17 @@ not come from the marching method under test.
 Three oracles, from exact to merely converged:
 
 * ``sphere_depth`` - c = 0: |q_n| = |p|^(2^n), so the max_iter-truncated set
-  (|q_n| <= bailout for n = 0..max_iter, seed 000_1dc675fe64448cc1.txt §2.1 eq. 5,
-  seed 003) is the 4-ball of radius bailout^(2^-max_iter); depth is the analytic
+  (|q_n| <= bailout for n = 0..max_iter, Ödegaard & Wennergren §2.1 eq. 5,
+  POV-Ray 3.6 documentation) is the 4-ball of radius bailout^(2^-max_iter); depth is the analytic
   ray-ball entry and the normal is radial.
 * ``real_c_inside`` / ``real_c_depth`` - real c = (c1, 0, 0, 0): for q = x + r u
   with u a unit pure quaternion, u^2 = -1, so span(1, u) is a copy of the complex
-  numbers that q -> q^2 + c1 never leaves (seed 000 eqs. 3-4).  The quaternion set
+  numbers that q -> q^2 + c1 never leaves (Ödegaard & Wennergren eqs. 3-4).  The quaternion set
   is the complex filled Julia set of c1 turned about the real axis: (x, y, z, w) is
   inside exactly when x + i sqrt(y^2 + z^2 + w^2) is.  A float64 2D iteration with
   a fine scan and bisection along each ray gives the depth.
 * ``converged_depth`` - any c: the double-precision kernel (render.float =
-  "double") scanning at fixed z-resolution with many post-steps (seed 000 §3 and
+  "double") scanning at fixed z-resolution with many post-steps (Ödegaard & Wennergren §3 and
   §7.1 eq. 11-12), the z-resolution doubled until a further doubling moves the
   depth by less than ``tol`` on all but ``frac`` of the pixels; the depth is then
   polished in float64 numpy (bisection with ``reference.julia_inside``) because
@@ -33,7 +33,7 @@ Three oracles, from exact to merely converged:
   record counts the pixels each search found first.
 
 Ground-truth normals: radial for c = 0, otherwise the float64 analytic Jacobian
-normal grad |q_n|^2 = 2 J^T q_n (seed 004 "method 3", ``reference.normal_jacobian``)
+normal grad |q_n|^2 = 2 J^T q_n (Quilez (n.d.) "method 3", ``reference.normal_jacobian``)
 at a point verified outside just in front of the ground-truth crossing
 (``outside_points``: n is the iteration at which it escapes), projected to camera
 coordinates exactly like normals/jacobian.cl.
@@ -61,7 +61,7 @@ def sphere_radius(max_iter: int, bailout: float) -> float:
 
 
 def sphere_depth(origins, dirs, radius):
-    """c = 0 (seed 000 eq. 5 with mu = 0; tests/test_sphere.py): distance along each
+    """c = 0 (Ödegaard & Wennergren eq. 5 with mu = 0; tests/test_sphere.py): distance along each
     unit ray o + t d to its entry into the 4-ball |p| <= radius; +inf where the ray
     misses the ball, 0 where it starts inside."""
     o = np.asarray(origins, np.float64)
@@ -81,10 +81,10 @@ def sphere_normals(points, frame):
 # --------------------------------------------------------------- real c
 
 def real_c_inside(points, c1, max_iter, bailout):
-    """Real c = (c1, 0, 0, 0) (seed 000 eqs. 3-5): (x, y, z, w) is inside exactly when
+    """Real c = (c1, 0, 0, 0) (Ödegaard & Wennergren eqs. 3-5): (x, y, z, w) is inside exactly when
     the complex point x + i sqrt(y^2 + z^2 + w^2) stays within ``bailout`` for
     n = 0..max_iter under z -> z^2 + c1 - the same escape rule as
-    ``reference.julia_inside`` (seed 003), iterated in float64 complex arithmetic."""
+    ``reference.julia_inside`` (POV-Ray 3.6 documentation), iterated in float64 complex arithmetic."""
     p = np.asarray(points, np.float64)
     z = p[..., 0] + 1j * np.sqrt(np.sum(p[..., 1:] ** 2, -1))
     return _complex_inside(z, float(c1), int(max_iter), float(bailout))
@@ -289,8 +289,8 @@ def _polish(scene: Scene, depth32, hit, inside_fn=None):
 def converged_depth(scene: Scene, z_start: int = 8000, post_steps: int = 20, tol: float = 1e-6,
                     frac: float = 0.002, max_z: int = 256000, confirm: int = 2,
                     device=None) -> ConvergedDepth:
-    """Any c: depth from the double-precision kernel's fixed scan (seed 000 §3) with
-    ``post_steps`` post-steps (seed 000 §7.1; eq. 12 puts the bracket at
+    """Any c: depth from the double-precision kernel's fixed scan (Ödegaard & Wennergren §3) with
+    ``post_steps`` post-steps (Ödegaard & Wennergren §7.1; eq. 12 puts the bracket at
     h / 2^post_steps), z_resolution doubled from ``z_start`` until ``confirm``
     consecutive doublings each change the result by more than ``tol`` scene units (or
     hit/miss) on at most ``frac`` of the pixels, or ``max_z`` is reached.  The finer render is returned, polished in
@@ -386,7 +386,7 @@ def earliest(o, d, t_scan, t_de, tol: float = 1e-6) -> tuple[np.ndarray, dict]:
 # ------------------------------------------------------------ normals
 
 def jacobian_normals(points, scene: Scene):
-    """Float64 analytic normal (seed 004 method 3; normals/jacobian.cl) at 4D
+    """Float64 analytic normal (Quilez (n.d.) method 3; normals/jacobian.cl) at 4D
     points (..., 4), unit, in camera coordinates; 0 where degenerate or NaN."""
     f = scene.fractal
     fr = camera_frame(scene)

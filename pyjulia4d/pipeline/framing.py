@@ -1,5 +1,5 @@
 """camera.fit: frame the set from a quick low-resolution pass, keeping the view direction
-(seed 000 §4 finds near and far the same way: from what a first pass sees).
+(Ödegaard & Wennergren §4 finds near and far the same way: from what a first pass sees).
 
 The pass looks along the scene's view direction at the whole bounding ball (96 x 72 rays,
 depth and position only); the new target is the centroid of the 4D points it hit and the
@@ -54,7 +54,7 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     half = math.atan(min(tan_v, tan_h))
     d0 = 1.2 * radius / math.sin(half)
     # the bounding ball is about the world origin (camera.march_radius); the camera sees the
-    # 3D hyperplane through its eye spanned by right, up and forward (the slice, seed 000
+    # 3D hyperplane through its eye spanned by right, up and forward (the slice, Ödegaard & Wennergren
     # §4), so the pass looks at the point of that hyperplane nearest the ball's centre
     rel = -np.asarray(fr.position, float)
     centre = np.asarray(fr.position, float) + sum((rel @ v) * v for v in (fr.right, fr.up, fr.forward))

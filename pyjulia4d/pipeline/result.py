@@ -40,7 +40,7 @@ class RenderResult:
     seconds: float = 0.0         # the whole render: set-up, build, kernels, read-back
     kernel_seconds: float = 0.0  # the kernels alone
     guards: dict = field(default_factory=dict)  # pixels each numerical guard fired on (count_guards)
-    lanes: int = 1               # rays per work-item of the march (pyjulia4d/lanes.py)
+    lanes: int = 1               # rays per work-item of the march (pyjulia4d/opencl/lanes.py)
     scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
     march_method: str = ""       # the march that ran: "fixed", "de" or "proven" (the plan's)
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran

@@ -22,7 +22,7 @@ class Formula:
     function: str = "sqr"
     exponent: tuple[float, float] = (2.0, 0.0)
     kind: str = "julia"        # the set (reference/kind/): "julia", "mandelbrot", "julia_stack"
-    theta: float = 0.0         # the rotation of seed 001 §2.3, degrees (reference/kind/rotate.py)
+    theta: float = 0.0         # the rotation of Hart, Sandin & Kauffman 1989 §2.3, degrees (reference/kind/rotate.py)
     c_from: tuple[float, float] = (-1.0, 0.0)   # a Julia set stack's c-line (reference/kind/julia_stack.py)
     c_to: tuple[float, float] = (-0.1, 0.75)
     component: str = "plus"    # the cubic locus's critical point (reference/kind/cubic_locus.py)

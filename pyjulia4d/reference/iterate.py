@@ -19,7 +19,7 @@ def dot4(a, b):
 
 
 def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
-    """|q_n| <= bailout for n = 0..max_iter (seed 003; seed 000 eq. 5)."""
+    """|q_n| <= bailout for n = 0..max_iter (POV-Ray 3.6 documentation; Ödegaard & Wennergren eq. 5)."""
     F = formula
     if F.kind == "mandelbrot":   # kernels/kind/mandelbrot.cl takes the name over
         return _mandelbrot.mandel_inside(p, max_iter, bailout, F)
@@ -43,7 +43,7 @@ def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
 def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """F = |q_N|^2 / bailout^2 - 1 (N = max_iter), <= 0 exactly where julia_inside; an orbit
     escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(D^(N-n)) - 1 (D = the growth
-    degree), capped at 1e30 (iterate.cl; seed 002).  Returns (F, inside)."""
+    degree), capped at 1e30 (iterate.cl; Quilez 2002).  Returns (F, inside)."""
     F = formula
     if F.kind == "mandelbrot":
         return _mandelbrot.mandel_level(p, max_iter, bailout, F)
@@ -70,7 +70,7 @@ def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
 
 
 def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
-    """d = |q_n| ln|q_n| / (2|q_n'|) (seed 001_01b4b6353b5280e3.txt eq. 8) at the last
+    """d = |q_n| ln|q_n| / (2|q_n'|) (Hart, Sandin & Kauffman 1989 eq. 8) at the last
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
     (d, escaped)."""
     F = formula

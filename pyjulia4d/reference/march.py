@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None,
                    formula: Formula = QUATERNION_SQR):
     """Narrow certified brackets [a (outside), b (inside)] on rays o + t d with ``steps``
-    set tests: ITP on the level function julia_level (``itp``) or bisection (seed 000
+    set tests: ITP on the level function julia_level (``itp``) or bisection (Ödegaard & Wennergren
     §7.1 eq. 11-12, every point classified); both stop where the bracket cannot be split.
     Both guarantee width <= (b - a) / 2^steps, ITP with at most one more set test.
     Returns (a, b - a): the outside end is the depth, the crossing lies within the width
@@ -72,7 +72,7 @@ def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None
 
 def march_fixed(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
                 itp=True, formula: Formula = QUATERNION_SQR):
-    """Fixed z-resolution scan (seed 000 §3): the first inside sample and the one before it
+    """Fixed z-resolution scan (Ödegaard & Wennergren §3): the first inside sample and the one before it
     are the certified bracket, refined by refine_bracket; a hit at the first sample is near
     itself, width 0.  Returns (t, status, samples, flags, width)."""
     n = len(o)
@@ -112,7 +112,7 @@ DE_OVER_RELAX = 1.2   # over-relaxed steps (march/de.cl)
 
 def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
              itp=True, formula: Formula = QUATERNION_SQR):
-    """r_{n+1} = r_n + 1.2 max(d(r_n), eps) (seed 001 §3.2 eq. 9, over-relaxed as in Keinert et
+    """r_{n+1} = r_n + 1.2 max(d(r_n), eps) (Hart, Sandin & Kauffman 1989 §3.2 eq. 9, over-relaxed as in Keinert et
     al. 2014 with the step taken back where two spheres leave a gap) until a point is inside (its
     orbit never escaped); with the previous point, the certified bracket refined by
     refine_bracket.  A step that rounds away (t + step == t) becomes one ulp of t

@@ -37,7 +37,7 @@ def to_camera_unit(n, guard=None):
 
 
 def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUATERNION_SQR):
-    """grad |q_n|^2 = 2 J^T q_n with J carried by the chain rule (seed 004 method 3).
+    """grad |q_n|^2 = 2 J^T q_n with J carried by the chain rule (Quilez (n.d.) method 3).
     J is rescaled both ways (no underflow on orbits drawn to an attracting cycle), and the
     iteration stops while q is a normal number, |q|^2 >= sqrt(REAL_MIN): inside points of
     c ~ 0 go to exactly 0 otherwise, and the normal with them (GUARD_JACOBIAN_TINY)."""
@@ -93,7 +93,7 @@ def de_field(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
 
 
 def normal_gradient(p, c, max_iter, bailout, h, frame: Frame, formula: Formula = QUATERNION_SQR):
-    """6-point central difference of the estimate (seed 001 §4.1.2 eq. 15) along the camera axes."""
+    """6-point central difference of the estimate (Hart, Sandin & Kauffman 1989 §4.1.2 eq. 15) along the camera axes."""
     f = lambda x: de_field(x, c, max_iter, bailout, formula)
     r, u, w = frame.right, frame.up, frame.forward
     return np.stack([f(p + h * r) - f(p - h * r), f(p + h * u) - f(p - h * u),
@@ -114,7 +114,7 @@ def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame, guard
 
 
 def normals_zbuffer(point, depth, status, width, height, frame: Frame, guard=None):
-    """Plane through the hit and its neighbours' hits (seed 000 §5.1, seed 001 §4.1.1);
+    """Plane through the hit and its neighbours' hits (Ödegaard & Wennergren §5.1, Hart, Sandin & Kauffman 1989 §4.1.1);
     per axis the central difference where both neighbours' depth jumps are within a
     factor 2, else the one-sided difference with the smaller jump, else the image axis."""
     P = to_camera(np.nan_to_num(point.reshape(height, width, 4)) - frame.position, frame)

@@ -31,7 +31,7 @@ def sample_offset(x, y, k: int, n: int):
 
 def generate_rays(frame: Frame, width: int, height: int, x0: int = 0, y0: int = 0,
                   tile_w: int | None = None, tile_h: int | None = None, sample: int = 0, samples: int = 1):
-    """Pinhole 4D camera (seed 000 §4): returns (origins, dirs), row-major, row 0 on top,
+    """Pinhole 4D camera (Ödegaard & Wennergren §4): returns (origins, dirs), row-major, row 0 on top,
     for the tile of tile_w x tile_h pixels at (x0, y0) (default: the whole image), through
     sample ``sample`` of ``samples`` of each pixel (its centre for one)."""
     tw = width - x0 if tile_w is None else tile_w

@@ -207,7 +207,7 @@ def unit_or(a, fallback):
 
 def shade(status, normal, point, frame: Frame, args: ShadeArgs, terms=None, lut=None, vis_extra=None, refl=None):
     """shade/shade.cl with the same record (``args``: pipeline/plan.ShadeArgs).  Lambert
-    (light at the eye by default, seed 001 §4) + ambient (times the sky) + Blinn-Phong, with
+    (light at the eye by default, Hart, Sandin & Kauffman 1989 §4) + ambient (times the sky) + Blinn-Phong, with
     the light's visibility and ambient occlusion from ``terms`` and the base colour from the
     colour table ``lut`` at terms' colour value; shading.lights (camera.extra_lights)
     likewise, their visibility from ``vis_extra``; the mirror bounce's colour ``refl``

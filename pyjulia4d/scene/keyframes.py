@@ -1,8 +1,8 @@
 """Keyframed scenes: ``[[keyframe]]`` tables and an ``[animation]`` table in a scene file.
 
-Seed 000_1dc675fe64448cc1.txt §6 animates the constant c (a sphere morphed into a Julia
+Ödegaard & Wennergren §6 animates the constant c (a sphere morphed into a Julia
 set), flies the camera in x, y, z and moves position and target along w to see the set
-at other 4D angles; seed 003_8ca5f9108f52d3d6.txt (julia_fractal, slice) animates the
+at other 4D angles; POV-Ray 3.6 documentation (julia_fractal, slice) animates the
 slice distance so that the set grows from nothing and shrinks away.  Here any numeric
 scene key may be keyframed; each keyed value follows its own track through the keyframes
 that set it, and holds its first (last) keyed value before (after) them.  Keys no
@@ -22,7 +22,7 @@ Between keyframes i and i + 1 at frames t_i < t_(i+1), with u = (t - t_i) / (t_(
 
 Integer keys (fractal.max_iter, ...) are rounded to the nearest integer.  When any camera
 vector is keyframed, each frame's camera.limbo and camera.up are re-orthonormalised
-against the view direction f = (target - position) / |target - position| in seed 000 §4's
+against the view direction f = (target - position) / |target - position| in Ödegaard & Wennergren §4's
 order (camera.py): limbo' = unit(limbo - (limbo.f) f), up' = unit(up - (up.f) f -
 (up.limbo') limbo').  Every frame's scene is built and validated before any renders.
 """

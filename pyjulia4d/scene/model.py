@@ -34,8 +34,8 @@ Auto = Literal["auto"]
 @dataclass(frozen=True)
 class Fractal:
     """[fractal]: the Julia set of q -> f(q) + c in a 4D algebra, or (``kind``) its Mandelbrot
-    set, a stack of complex Julia sets or the cubic connectedness locus (seed 001 §5); ``theta``
-    rotates the quaternion map (seed 001 §2.3)."""
+    set, a stack of complex Julia sets or the cubic connectedness locus (Hart, Sandin & Kauffman 1989 §5); ``theta``
+    rotates the quaternion map (Hart, Sandin & Kauffman 1989 §2.3)."""
 
     algebra: str = "quaternion"
     function: str = "sqr"
@@ -46,15 +46,15 @@ class Fractal:
     # "julia": the point is q_0, c the constant; "mandelbrot": the point is c, q_0 = 0 (the
     # critical point of q^2 and q^3), c unused (kernels/kind/mandelbrot.cl)
     kind: str = "julia"
-    # the complex rotation g(q) = e^(i theta) q conjugating the map, in degrees (seed 001
+    # the complex rotation g(q) = e^(i theta) q conjugating the map, in degrees (Hart, Sandin & Kauffman 1989
     # §2.3; kernels/kind/rotate.cl); 0 compiles the rotation out
     theta: float = 0.0
-    # "julia_stack" (seed 001 §5.1; kernels/kind/julia_stack.cl): the complex Julia sets of
+    # "julia_stack" (Hart, Sandin & Kauffman 1989 §5.1; kernels/kind/julia_stack.cl): the complex Julia sets of
     # z^2 + c(s), c(s) = c_from + s (c_to - c_from), stacked along the third coordinate u =
     # 2 s - 1 in [-1, 1] (c_from at u = -1); complex numbers as (re, im)
     c_from: tuple[float, float] = (-1.0, 0.0)
     c_to: tuple[float, float] = (-0.1, 0.75)
-    # "cubic_locus" (seed 001 §5.2; kernels/kind/cubic_locus.cl): the (a, b) = (x + i y, z + i w)
+    # "cubic_locus" (Hart, Sandin & Kauffman 1989 §5.2; kernels/kind/cubic_locus.cl): the (a, b) = (x + i y, z + i w)
     # whose critical point +a ("plus": C+) or -a ("minus": C-) has a bounded orbit under
     # z^3 - 3 a^2 z + b, drawn within the 4-ball |(a, b)| <= locus_radius (C+ is unbounded)
     component: str = "plus"

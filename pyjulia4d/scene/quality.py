@@ -66,7 +66,7 @@ def critical_orbit_bounded(algebra: str, degree: int, c: tuple) -> bool:
     """Whether the orbit of the critical point 0 of q -> q^degree + c stays bounded for
     CONNECTED_ITER iterations, in the complex planes the orbit lives in: a quaternion orbit
     of 0 stays in the plane of 1 and c's imaginary part (powers of a + b u are a' + b' u),
-    where it is z -> z^D + c' with c' = c_x + i |c_yzw| (seed 001 §2); a hypercomplex one
+    where it is z -> z^D + c' with c' = c_x + i |c_yzw| (Hart, Sandin & Kauffman 1989 §2); a hypercomplex one
     splits into its two idempotent components (kernels/algebra/hypercomplex.cl: c_a = (c_x +
     c_w) + i (c_y - c_z), c_b = (c_x - c_w) + i (c_y + c_z)), bounded when both are.  Beyond
     2 + 2|c| every orbit of a polynomial of degree >= 2 escapes."""
@@ -85,9 +85,9 @@ def critical_orbit_bounded(algebra: str, degree: int, c: tuple) -> bool:
 
 
 def estimate_bounds_distance(fractal: Any) -> bool:
-    """Whether the distance estimate d = |q_n| ln|q_n| / (2 |q_n'|) (seed 001 §3.1, eq. 8)
-    may be trusted to step over nothing.  In the complex plane it is the lower bound of seed
-    001 §3.2 (eq. 7) - Koebe's 1/4 theorem on the Boettcher coordinate - where the filled
+    """Whether the distance estimate d = |q_n| ln|q_n| / (2 |q_n'|) (Hart, Sandin & Kauffman 1989 §3.1, eq. 8)
+    may be trusted to step over nothing.  In the complex plane it is the lower bound of
+    Hart, Sandin & Kauffman 1989 §3.2 (eq. 7) - Koebe's 1/4 theorem on the Boettcher coordinate - where the filled
     Julia set is connected, that is where the critical point's orbit is bounded (Douady and
     Hubbard), and on the Mandelbrot set, which is connected.  A hypercomplex set is the
     product of two complex ones, so this carries over; for quaternions there is no such

@@ -52,7 +52,7 @@ def check_locus(scene: Any) -> None:
                          "fractal.c, not the cubic locus's; use flat or w")
     if m.method == "de" and m.quality == "custom":   # a preset's de: refused by name below
         raise SceneError("march.method", "no distance estimate is known for the cubic connectedness locus "
-                         "(seed 001 section 5.2); use fixed or auto")
+                         "(Hart, Sandin & Kauffman 1989 section 5.2); use fixed or auto")
     if scene.normals.method == "gradient":
         raise SceneError("normals.method", "gradient differences a distance estimate, which the cubic locus "
                          "has none of; use jacobian or zbuffer")
@@ -117,7 +117,7 @@ def check_fractal(scene: Any) -> None:
     if f.kind == "cubic_locus":
         check_locus(scene)
     if f.theta != 0 and f.algebra != "quaternion":
-        raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (seed 001 "
+        raise SceneError("fractal.theta", f"the rotation is defined for the quaternion algebra (Hart, Sandin & Kauffman 1989 "
                          f"section 2.3), not {f.algebra}: set 0")
     if has_distance_estimate(f):
         return

@@ -28,7 +28,7 @@ def _wrap(text: str, width: int = 88) -> list[str]:
 
 def to_toml(data: dict, notes: dict, header: list[str], source: str) -> str:
     out = [f"# pyjulia4d scene imported from the POV-Ray scene {source}",
-           "# by `pyjulia4d import-pov` (pyjulia4d/povray.py documents the mapping)."]
+           "# by `pyjulia4d import-pov` (pyjulia4d/interop/povray/mapping.py maps it key by key)."]
     for h in header:
         out.extend(_wrap(h))
     for section, table in data.items():

@@ -1,4 +1,4 @@
-"""float64 twin of kernels/algebra/commutative.cl: the naive commutative rules (seed 000_1dc675fe64448cc1.txt eq. 15):
+"""float64 twin of kernels/algebra/commutative.cl: the naive commutative rules (Ödegaard & Wennergren eq. 15):
 i^2 = j^2 = k^2 = -1, ij = ji = k, ki = ik = j, jk = kj = i; commutative, not associative.
 The product is built from the basis table itself (the kernel writes it out)."""
 from __future__ import annotations

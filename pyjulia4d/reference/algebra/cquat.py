@@ -1,4 +1,4 @@
-"""float64 twin of kernels/algebra/cquat.cl: Gintz's complexified quaternions (seed 000_1dc675fe64448cc1.txt eq. 14):
+"""float64 twin of kernels/algebra/cquat.cl: Gintz's complexified quaternions (Ödegaard & Wennergren eq. 14):
 i^2 = -1, j^2 = k^2 = +1, ij = ji = -k, ki = ik = -j, jk = kj = i; commutative, not associative.
 The product is built from the basis table itself (the kernel writes it out)."""
 from __future__ import annotations

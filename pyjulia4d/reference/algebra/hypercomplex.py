@@ -1,5 +1,5 @@
 """float64 twin of kernels/algebra/hypercomplex.cl: the commutative hypercomplex numbers
-(seed 000_1dc675fe64448cc1.txt eq. 13; seed 003's basis table, with k^2 = +1), iterated
+(Ödegaard & Wennergren eq. 13; POV-Ray 3.6 documentation's basis table, with k^2 = +1), iterated
 split into two complex numbers a, b on the idempotents (1 +- k)/2."""
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 
 from pyjulia4d.reference.algebra.table import product
 
-# seed 003's table: ij = ji = k, jk = kj = -i, ki = ik = -j, ii = jj = -1, kk = +1
+# POV-Ray 3.6 documentation's table: ij = ji = k, jk = kj = -i, ki = ik = -j, ii = jj = -1, kk = +1
 SIGN = [[1, 1, 1, 1], [1, -1, 1, -1], [1, 1, -1, -1], [1, -1, -1, 1]]
 # the product by the basis table itself (the tests hold the split to it)
 alg_mul = product(SIGN)

@@ -1,5 +1,5 @@
 """float64 twin of kernels/algebra/quaternion.cl: Hamilton's quaternions
-(seed 000_1dc675fe64448cc1.txt eq. 3; seed 003's basis table), sqr and cube only."""
+(Ödegaard & Wennergren eq. 3; POV-Ray 3.6 documentation's basis table), sqr and cube only."""
 from __future__ import annotations
 
 import numpy as np
@@ -27,7 +27,7 @@ def ALG_DOT(a, b):
 
 
 def alg_mul(a, b):
-    """Hamilton product (seed 000 eq. 3)."""
+    """Hamilton product (Ödegaard & Wennergren eq. 3)."""
     a1, a2, a3, a4 = np.moveaxis(a, -1, 0)
     b1, b2, b3, b4 = np.moveaxis(b, -1, 0)
     return np.stack([a1 * b1 - a2 * b2 - a3 * b3 - a4 * b4,
@@ -37,7 +37,7 @@ def alg_mul(a, b):
 
 
 def alg_sqr(q):
-    """q^2 (seed 000 eq. 4)."""
+    """q^2 (Ödegaard & Wennergren eq. 4)."""
     x, y, z, w = np.moveaxis(q, -1, 0)
     return np.stack([x * x - y * y - z * z - w * w, 2 * x * y, 2 * x * z, 2 * x * w], axis=-1)
 

@@ -1,4 +1,4 @@
-"""Algebras given by their basis multiplication table (seed 000 eqs. 13-15, seed 003):
+"""Algebras given by their basis multiplication table (Ödegaard & Wennergren eqs. 13-15, POV-Ray 3.6 documentation):
 the bilinear product of e_i e_j = SIGN[i][j] e_INDEX[i][j] over the basis 1, i, j, k, and
 the coordinates of algebras iterated in the point's own (cquat.py, commutative.py)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""float64 twin of kernels/function/asin.cl: f(z) = asin z (seed 003_8ca5f9108f52d3d6.txt,
+"""float64 twin of kernels/function/asin.cl: f(z) = asin z (POV-Ray 3.6 documentation,
 "asin"), numpy's complex function (its branch cuts)."""
 import numpy as np
 

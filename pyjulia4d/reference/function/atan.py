@@ -1,4 +1,4 @@
-"""float64 twin of kernels/function/atan.cl: f(z) = atan z (seed 003_8ca5f9108f52d3d6.txt,
+"""float64 twin of kernels/function/atan.cl: f(z) = atan z (POV-Ray 3.6 documentation,
 "atan"), numpy's complex function (its branch cuts)."""
 import numpy as np
 

@@ -1,4 +1,4 @@
-"""float64 twin of kernels/function/cube.cl: f(z) = z^3 (seed 003_8ca5f9108f52d3d6.txt,
+"""float64 twin of kernels/function/cube.cl: f(z) = z^3 (POV-Ray 3.6 documentation,
 "cube"), numpy's complex function (its branch cuts)."""
 import numpy as np
 

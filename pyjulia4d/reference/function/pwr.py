@@ -1,5 +1,5 @@
 """float64 twin of kernels/function/pwr.cl: f(z) = z^p = exp(p log z), p = x + iy the
-scene's fractal.exponent (seed 003_8ca5f9108f52d3d6.txt, "pwr(x, y)"); 0^p = 0, as the kernel."""
+scene's fractal.exponent (POV-Ray 3.6 documentation, "pwr(x, y)"); 0^p = 0, as the kernel."""
 import numpy as np
 
 from pyjulia4d.reference.enclose import disc as D

@@ -1,4 +1,4 @@
-"""float64 twin of kernels/function/sqr.cl: f(z) = z^2 (seed 003_8ca5f9108f52d3d6.txt,
+"""float64 twin of kernels/function/sqr.cl: f(z) = z^2 (POV-Ray 3.6 documentation,
 "sqr"), numpy's complex function (its branch cuts)."""
 import numpy as np
 

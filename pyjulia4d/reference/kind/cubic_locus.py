@@ -1,5 +1,5 @@
-"""float64 twin of kernels/kind/cubic_locus.cl: the cubic connectedness locus of seed
-001_01b4b6353b5280e3.txt §5.2 (eq. 19, Definitions 4-5).  The point p = (Re a, Im a, Re b,
+"""float64 twin of kernels/kind/cubic_locus.cl: the cubic connectedness locus of
+Hart, Sandin & Kauffman 1989 §5.2 (eq. 19, Definitions 4-5).  The point p = (Re a, Im a, Re b,
 Im b); inside when |p| <= locus_radius and |z_n| <= bailout for n = 0 .. max_iter under
 z <- z^3 - 3 a^2 z + b, z_0 = +a (component "plus", C+) or -a ("minus", C-)."""
 from __future__ import annotations

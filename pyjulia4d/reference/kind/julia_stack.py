@@ -1,5 +1,5 @@
-"""float64 twin of kernels/kind/julia_stack.cl: a stack of complex Julia sets (seed
-001_01b4b6353b5280e3.txt §5.1).  The point p = (x, y, u, w): z_0 = x + i y,
+"""float64 twin of kernels/kind/julia_stack.cl: a stack of complex Julia sets (
+Hart, Sandin & Kauffman 1989 §5.1).  The point p = (x, y, u, w): z_0 = x + i y,
 c(u) = c_mid + u c_half (c_from at u = -1, c_to at u = +1), |u| <= 1, w ignored; inside when
 |z_n| <= bailout for n = 0 .. max_iter under z <- z^2 + c(u)."""
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """float64 twin of kernels/kind/mandelbrot.cl: the Mandelbrot set of q -> f(q) + c, the
 parameters c (the point, in the algebra's coordinates) whose orbit of the critical point 0
-stays within the bailout for n = 1 .. max_iter (q_1 = c); seed 001_01b4b6353b5280e3.txt §2.1,
-§3.1 eq. 8 with the derivative taken with respect to c; seed 002_6b6c8e6b1cd19649.txt."""
+stays within the bailout for n = 1 .. max_iter (q_1 = c); Hart, Sandin & Kauffman 1989 §2.1,
+§3.1 eq. 8 with the derivative taken with respect to c; Quilez 2002."""
 from __future__ import annotations
 
 import numpy as np

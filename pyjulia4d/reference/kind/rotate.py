@@ -1,5 +1,5 @@
-"""float64 twin of kernels/kind/rotate.cl: the rotated Julia set of seed
-001_01b4b6353b5280e3.txt §2.3, f_theta(q) = u f(u^-1 q) + u c with u = e^(i theta), the
+"""float64 twin of kernels/kind/rotate.cl: the rotated Julia set of
+Hart, Sandin & Kauffman 1989 §2.3, f_theta(q) = u f(u^-1 q) + u c with u = e^(i theta), the
 map conjugated by the rotation g(z) = u z of the complex plane (the seed's eqs. 5-6,
 reconstructed)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-// POV-Ray's documentation example (seed 003, "A simple example of a julia fractal
+// POV-Ray's documentation example (POV-Ray 3.6 documentation, "A simple example of a julia fractal
 // object"), with a camera and a light added so that it can be seen.
 // doc_example_alpha.png: POV-Ray 3.7.0.10 (Debian) rendered this file with
 //   povray +Idoc_example.pov +Odoc_example_alpha.png +W64 +H48 -D -A +UA
