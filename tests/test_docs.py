@@ -59,7 +59,19 @@ def test_links_resolve(doc: Path) -> None:
 
 
 def test_readme_is_a_front_door() -> None:
-    assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 250
+    """Short, and no run log: figures come with the command that measures them, and the
+    commits of runs belong in benchmarks/results/."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 250
+    hashes = [w for w in re.findall(r"\b[0-9a-f]{7,40}\b", _strip_code(text)) if re.search(r"[a-f]", w)
+              and re.search(r"[0-9]", w)]
+    assert hashes == []
+
+
+def test_performance_page_keeps_to_todays_figures() -> None:
+    """docs/performance.md holds today's figures and targets; the run-by-run record is
+    benchmarks/results/history.md."""
+    assert len((ROOT / "docs" / "performance.md").read_text(encoding="utf-8").splitlines()) <= 300
 
 
 @pytest.mark.parametrize("doc", DOCS, ids=lambda p: p.name)
