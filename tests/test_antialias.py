@@ -203,11 +203,11 @@ def test_progress_total_is_the_adaptive_work(monkeypatch):
 
 
 def test_antialias_benchmark_runs(tmp_path):
-    """benchmarks/antialias_error.py, tiny, so that it cannot rot."""
+    """benchmarks/accuracy/antialias_error.py, tiny, so that it cannot rot."""
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parent.parent / "benchmarks" / "antialias_error.py"
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "accuracy" / "antialias_error.py"
     spec = importlib.util.spec_from_file_location("antialias_error", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

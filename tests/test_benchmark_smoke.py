@@ -1,4 +1,4 @@
-"""CI smoke run of benchmarks/error_vs_time.py --quick, so the benchmark cannot rot."""
+"""CI smoke run of benchmarks/accuracy/error_vs_time.py --quick, so the benchmark cannot rot."""
 import csv
 import importlib.util
 import subprocess
@@ -10,8 +10,14 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 
+def script(name: str) -> Path:
+    """A benchmark script by name, in whichever family's folder it sits (benchmarks/<family>/)."""
+    (path,) = (ROOT / "benchmarks").glob(f"*/{name}.py")
+    return path
+
+
 def load_benchmark():
-    spec = importlib.util.spec_from_file_location("error_vs_time", ROOT / "benchmarks" / "error_vs_time.py")
+    spec = importlib.util.spec_from_file_location("error_vs_time", script("error_vs_time"))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
@@ -46,8 +52,8 @@ def test_quick_run_writes_sane_results(tmp_path):
 
 
 def test_extreme_cases_report_runs(tmp_path):
-    """benchmarks/extreme_cases.py on two catalogue cases, tiny, so the report cannot rot."""
-    spec = importlib.util.spec_from_file_location("extreme_cases", ROOT / "benchmarks" / "extreme_cases.py")
+    """benchmarks/accuracy/extreme_cases.py on two catalogue cases, tiny, so the report cannot rot."""
+    spec = importlib.util.spec_from_file_location("extreme_cases", script("extreme_cases"))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     assert mod.main(["--only", "c_zero", "epsilon_below_ulp", "--scale", "1", "--repeats", "1",
@@ -62,8 +68,8 @@ def test_extreme_cases_report_runs(tmp_path):
 
 
 def test_preset_check_runs(tmp_path):
-    """benchmarks/preset_check.py on two unseen scenes, tiny, so the check cannot rot."""
-    spec = importlib.util.spec_from_file_location("preset_check", ROOT / "benchmarks" / "preset_check.py")
+    """benchmarks/accuracy/preset_check.py on two unseen scenes, tiny, so the check cannot rot."""
+    spec = importlib.util.spec_from_file_location("preset_check", script("preset_check"))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     assert mod.main(["--n", "2", "--seeds", "2027", "--width", "16", "--height", "12", "--z-start", "1000", "--time-default", "0",
@@ -82,14 +88,14 @@ def test_preset_check_runs(tmp_path):
 
 
 def load(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(name, script(name))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
 
 
 def test_iteration_counter_counts_exactly():
-    """benchmarks/throughput.py's -D COUNT_ITERATIONS build: with the eye inside the c = 0
+    """benchmarks/speed/throughput.py's -D COUNT_ITERATIONS build: with the eye inside the c = 0
     set every ray's first set test is inside, after exactly max_iter iterations of f."""
     from harness import device
     from pyjulia4d.scene.model import Scene
@@ -111,7 +117,7 @@ def test_throughput_report_runs(tmp_path):
 
 
 def test_peers_report_runs(tmp_path, monkeypatch):
-    """benchmarks/peers.py, tiny: POV-Ray where installed (skipped with a message otherwise),
+    """benchmarks/peers/peers.py, tiny: POV-Ray where installed (skipped with a message otherwise),
     pyjulia4d always; the POV-Ray scene is the default scene.  Mandelbulber2 is left out
     here (its OpenCL warm-ups took most of this test's 13 s from cold caches); `-m slow`
     runs it in test_peers_report_runs_with_mandelbulber."""
@@ -126,7 +132,7 @@ def test_peers_report_runs(tmp_path, monkeypatch):
 
 
 def test_peer_error_counts_wrong_pixels():
-    """benchmarks/peer_error.py's error of a row, on hand-made depths: a silhouette
+    """benchmarks/peers/peer_error.py's error of a row, on hand-made depths: a silhouette
     disagreement is wrong at any tolerance, a depth error is wrong past its share of a pixel."""
     import numpy as np
 
@@ -167,7 +173,7 @@ def test_peer_error_settings_follow_the_pair():
 
 
 def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
-    """POV-Ray's depth as benchmarks/peer_error.py reads it (a distance pigment in two 16-bit
+    """POV-Ray's depth as benchmarks/peers/peer_error.py reads it (a distance pigment in two 16-bit
     channels) against the float64 brute force of the same set: at precision 1000 POV-Ray
     steps over nothing at this size, so every pixel both hit agrees to 1e-6 (its bisection
     polishes to within the readout's 2e-7) - which checks the encoding, the decoding and the view mapping."""
@@ -232,9 +238,9 @@ def test_peers_report_runs_with_mandelbulber(tmp_path):
 
 @pytest.mark.slow   # a child per CPU runtime, each building from cold: the longest test of the default run
 def test_cpu_runtimes_benchmark_runs(tmp_path, capsys):
-    """benchmarks/cpu_runtimes.py on one pair, tiny: a table row per pair with every CPU
+    """benchmarks/speed/cpu_runtimes.py on one pair, tiny: a table row per pair with every CPU
     device that compiles, and the results file with its commit and devices."""
-    spec = importlib.util.spec_from_file_location("cpu_runtimes", ROOT / "benchmarks" / "cpu_runtimes.py")
+    spec = importlib.util.spec_from_file_location("cpu_runtimes", script("cpu_runtimes"))
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
     assert bench.main(["--only", "quaternion_sqr", "--size", "24x18", "--repeats", "1", "--out", str(tmp_path)]) == 0
@@ -250,9 +256,9 @@ def test_cpu_runtimes_benchmark_runs(tmp_path, capsys):
 
 
 def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
-    """benchmarks/pair_accuracy.py on one pair, tiny: its row, and the verdict for the c = 0
+    """benchmarks/accuracy/pair_accuracy.py on one pair, tiny: its row, and the verdict for the c = 0
     ball, whose every number is known (a ball is as accurate as any render reports)."""
-    spec = importlib.util.spec_from_file_location("pair_accuracy", ROOT / "benchmarks" / "pair_accuracy.py")
+    spec = importlib.util.spec_from_file_location("pair_accuracy", script("pair_accuracy"))
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
     assert len(bench.pairs()) == 24
@@ -265,9 +271,9 @@ def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
 
 
 def test_proven_speed_benchmark_runs(tmp_path, capsys):
-    """benchmarks/proven_speed.py on the quaternion default, tiny: a row per march, the fixed
+    """benchmarks/speed/proven_speed.py on the quaternion default, tiny: a row per march, the fixed
     scan its own unit, the proven march's share of proofs given."""
-    spec = importlib.util.spec_from_file_location("proven_speed", ROOT / "benchmarks" / "proven_speed.py")
+    spec = importlib.util.spec_from_file_location("proven_speed", script("proven_speed"))
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
     assert bench.main(["--only", "quaternion sqr (default)", "--size", "24x18", "--repeats", "1",
@@ -281,10 +287,10 @@ def test_proven_speed_benchmark_runs(tmp_path, capsys):
 
 
 def test_pair_error_vs_time_benchmark_runs(tmp_path, capsys):
-    """benchmarks/pair_error_vs_time.py on the c = 0 ball, tiny: a row per setting (the
+    """benchmarks/accuracy/pair_error_vs_time.py on the c = 0 ball, tiny: a row per setting (the
     estimate too, which quaternions have), the fixed scan at 1000 its own unit, the proven
     presets stating less than the whole ray, and the csv and plot written."""
-    spec = importlib.util.spec_from_file_location("pair_error_vs_time", ROOT / "benchmarks" / "pair_error_vs_time.py")
+    spec = importlib.util.spec_from_file_location("pair_error_vs_time", script("pair_error_vs_time"))
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
     assert bench.settings_for({"algebra": "hypercomplex", "function": "sin"}, bench.SETTINGS) == [
@@ -304,7 +310,7 @@ def test_pair_error_vs_time_benchmark_runs(tmp_path, capsys):
 
 @pytest.mark.slow   # a server, a headless browser and renders: the explorer's own tests cover the page
 def test_explore_latency_report_runs(tmp_path):
-    """benchmarks/explore_latency.py, tiny, with the caches as they are: the table with every
+    """benchmarks/speed/explore_latency.py, tiny, with the caches as they are: the table with every
     measure of a start, and the results file with its commit (skipped where no browser is)."""
     from pyjulia4d.app.explore.drive import HOW_TO_GET, browser_paths
 
@@ -320,7 +326,7 @@ def test_explore_latency_report_runs(tmp_path):
 
 
 def test_refill_trial_report_runs(tmp_path):
-    """benchmarks/refill_trial.py, tiny: every queue's row, the same results as one block's."""
+    """benchmarks/studies/refill_trial.py, tiny: every queue's row, the same results as one block's."""
     assert load("refill_trial").main(["--size", "64x48", "--queues", "1,4", "--repeats", "1",
                                       "--out", str(tmp_path)]) == 0
     if not (tmp_path / "refill_trial.md").exists():
@@ -330,7 +336,7 @@ def test_refill_trial_report_runs(tmp_path):
 
 
 def test_march_levers_schedules_count_rounds_exactly():
-    """benchmarks/march_levers.py's schedules on one packet worked by hand: lane 0 takes 3 then
+    """benchmarks/studies/march_levers.py's schedules on one packet worked by hand: lane 0 takes 3 then
     1 iterations, lane 1 1 then 3, the other lanes 1 and 1.  The blocks wait for each step's
     slowest lane (3 + 3 rounds); at its own pace every lane is done after 4 rounds, and an
     orbit ends at rounds 1, 2, 3 and 4; every lane busy would take (4 + 4 + 14 x 2) / 16."""
@@ -346,7 +352,7 @@ def test_march_levers_schedules_count_rounds_exactly():
 
 
 def test_march_levers_report_runs(tmp_path):
-    """benchmarks/march_levers.py, tiny (the float64 twin, no OpenCL): every schedule's row."""
+    """benchmarks/studies/march_levers.py, tiny (the float64 twin, no OpenCL): every schedule's row."""
     assert load("march_levers").main(["--size", "32x24", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "march_levers.md").read_text()
     assert "commit" in md and md.count("| each lane at its own pace") == 2
@@ -387,7 +393,7 @@ def test_commit_ratio_report_runs(tmp_path):
     assert "| kernel march |" in md and "| CPU-s of a render |" in md and "keeping a PNG's outputs" in md
 
 
-@pytest.mark.parametrize("script,args", [
+@pytest.mark.parametrize("name,args", [
     ("peers.py", ["--size", "640x"]),
     ("commit_ratio.py", ["--rev", "no-such-commit"]),
     ("command_cost.py", ["--big", "0x480"]),
@@ -399,18 +405,18 @@ def test_commit_ratio_report_runs(tmp_path):
     ("peer_error.py", ["--scenes", "nothing"]),
     ("peer_error.py", ["--look", "default", "--scenes", "hypercomplex"]),
 ])
-def test_bad_flags_are_one_line_and_exit_2(script, args, tmp_path):
-    # benchmarks/bench_args.py: a bad flag is one line naming it, exit status 2, no traceback
+def test_bad_flags_are_one_line_and_exit_2(name, args, tmp_path):
+    # benchmarks/lib/args.py: a bad flag is one line naming it, exit status 2, no traceback
     # and nothing written
-    p = subprocess.run([sys.executable, str(ROOT / "benchmarks" / script), *args, "--out", str(tmp_path)],
+    p = subprocess.run([sys.executable, str(script(name[:-3])), *args, "--out", str(tmp_path)],
                        capture_output=True, text=True, timeout=120, cwd=tmp_path)
     lines = p.stderr.strip().splitlines()
-    assert p.returncode == 2 and len(lines) == 1 and script in lines[0], p.stderr
+    assert p.returncode == 2 and len(lines) == 1 and name in lines[0], p.stderr
     assert "Traceback" not in p.stderr and not list(tmp_path.iterdir())
 
 
 def test_mandelbulber_depth_reads_to_the_mathematics(tmp_path):
-    """Mandelbulber2's depth as benchmarks/mb_depth.py reads it (its log-scaled 16-bit
+    """Mandelbulber2's depth as benchmarks/peers/mb_depth.py reads it (its log-scaled 16-bit
     z-buffer, fixed by a near sphere and an empty sphere about the camera) on a third sphere
     in the set's depth range, against the exact depth where each ray meets that sphere grown
     by the threshold: within 0.05 of a pixel's footprint at the default threshold and at a
@@ -420,11 +426,7 @@ def test_mandelbulber_depth_reads_to_the_mathematics(tmp_path):
 
     if shutil.which("mandelbulber2") is None:
         pytest.skip("mandelbulber2 not installed (Debian: apt-get install mandelbulber2)")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    try:
-        mb = load("mb_depth")
-    finally:
-        sys.path.remove(str(ROOT / "benchmarks"))
+    mb = load("mb_depth")
     from pyjulia4d.scene.model import Scene
 
     w, h = 160, 120
@@ -441,7 +443,7 @@ def test_mandelbulber_depth_reads_to_the_mathematics(tmp_path):
 
 
 def test_gpu_check_stops_without_a_gpu(tmp_path):
-    # benchmarks/gpu_check.sh on a machine with no OpenCL GPU: the devices listed, one line
+    # benchmarks/speed/gpu_check.sh on a machine with no OpenCL GPU: the devices listed, one line
     # saying why nothing ran, status 3 (a GPU machine runs the checks instead)
     import os
     import pyopencl as cl
@@ -449,7 +451,7 @@ def test_gpu_check_stops_without_a_gpu(tmp_path):
     if any(d.type & cl.device_type.GPU for p in cl.get_platforms() for d in p.get_devices()):
         pytest.skip("an OpenCL GPU is here: the script would run its checks")
     env = dict(os.environ, PY=sys.executable, OUT=str(tmp_path))
-    p = subprocess.run(["bash", str(ROOT / "benchmarks" / "gpu_check.sh")], env=env, capture_output=True,
+    p = subprocess.run(["bash", str(ROOT / "benchmarks" / "speed" / "gpu_check.sh")], env=env, capture_output=True,
                        text=True, timeout=120)
     assert p.returncode == 3, p.stdout + p.stderr
     assert "gpu_check: no OpenCL GPU found" in p.stdout

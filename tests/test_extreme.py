@@ -3,7 +3,7 @@
 Every case must terminate within its step caps, leak no NaN or infinity into the
 outputs, count every guard that fired, and agree with the float64 render of the same
 scene within the case's stated tolerance - or be a documented precision limit, whose
-measured error benchmarks/extreme_cases.py reports.  The float64 renders are the
+measured error benchmarks/accuracy/extreme_cases.py reports.  The float64 renders are the
 double kernels, held here to the numpy reference on the cases cheap enough for it.
 Plus: the distance estimate and the normals stay finite at max_iter 10000 and
 bailout 1e6 in float32; overflowing bailouts and hopeless workloads are refused
@@ -94,7 +94,7 @@ def errors(case, method):
 def test_single_agrees_with_double(case, method):
     mism, err, nboth = errors(case, method)
     if case.limit:
-        # a documented precision limit: measured and reported (benchmarks/extreme_cases.py),
+        # a documented precision limit: measured and reported (benchmarks/accuracy/extreme_cases.py),
         # not held to a tolerance; it must still be finite and terminated (test above)
         assert np.all(np.isfinite(err))
         return

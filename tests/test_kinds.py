@@ -323,13 +323,13 @@ def test_new_keys_refused_with_the_key(over, key):
 
 @pytest.mark.slow   # builds every kind's configuration (~25 s from cold); the benchmark is the sweep
 def test_kinds_gallery_runs(tmp_path):
-    # benchmarks/kinds_gallery.py end to end on tiny images: every picture, the sheet, and an
+    # benchmarks/galleries/kinds_gallery.py end to end on tiny images: every picture, the sheet, and an
     # error row per scene and setting, each with a finite time and a silhouette error in [0, 1]
     import csv
     import importlib.util
     from pathlib import Path
     root = Path(__file__).resolve().parent.parent
-    spec = importlib.util.spec_from_file_location("kinds_gallery", root / "benchmarks" / "kinds_gallery.py")
+    spec = importlib.util.spec_from_file_location("kinds_gallery", root / "benchmarks" / "galleries" / "kinds_gallery.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     assert mod.main(["--size", "16x12", "--picture", "32x24", "--repeats", "1", "--out", str(tmp_path)]) == 0

@@ -271,7 +271,7 @@ def test_cited_paths_exist() -> None:
     kernels/ (march/march.cl)."""
     top = PKG.parent
     texts = [p for p in list(PKG.rglob("*.py")) + list(kernel_dir().rglob("*.cl")) + list((top / "tests").glob("*.py"))
-             + list((top / "benchmarks").glob("*.py")) + list((top / "docs").glob("*.md")) + [top / "README.md"]]
+             + list((top / "benchmarks").rglob("*.py")) + list((top / "docs").glob("*.md")) + [top / "README.md"]]
     dead = set()
     for p in texts:
         text = p.read_text(encoding="utf-8")

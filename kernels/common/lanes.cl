@@ -29,7 +29,7 @@ typedef struct {
     real epsilon;    /* distance-estimate hit threshold */
     int max_iter;
 #if defined(COUNT_ITERATIONS) && LANES == 1
-    __global int *count;   /* this ray's iterations of f (benchmarks/throughput.py); 0: none */
+    __global int *count;   /* this ray's iterations of f (benchmarks/speed/throughput.py); 0: none */
 #endif
 } julia_params;
 
@@ -182,7 +182,7 @@ inline quat QSEL(quat a, quat b, lmask m)
  * vec_type_hint says that it is vectorized by hand, so Intel's CPU compiler spends no time on
  * vectorizing it again across work-items: the default scene's march program of 16 lanes
  * built in 1.0-1.2 s instead of 1.8-2.1 s on Intel's CPU runtime, and every kernel ran as fast
- * as before there and on PoCL 3.1 (benchmarks/commit_ratio.py).  One ray per work-item keeps
+ * as before there and on PoCL 3.1 (benchmarks/speed/commit_ratio.py).  One ray per work-item keeps
  * the plain kernel: there the runtime's vectorizing across work-items is what makes it fast. */
 #if LANES > 1
 #define PACKET_KERNEL __kernel __attribute__((vec_type_hint(LREAL_TYPE)))

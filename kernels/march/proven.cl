@@ -68,7 +68,7 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
 /* the points a floor segment that is not proven is tested at, evenly to its far end: a set
  * test costs a few per cent of an enclosure, and a part of the set thinner than the floor
  * is found unless it is thinner than floor / FLOOR_POINTS (with 2, the hypercomplex sin
- * stepped over such parts on 0.1 % of its pixels: benchmarks/pair_accuracy.py) */
+ * stepped over such parts on 0.1 % of its pixels: benchmarks/accuracy/pair_accuracy.py) */
 #define FLOOR_POINTS 8
 /* a stretch where no proof succeeds (a branch cut or pole the enclosures meet on every
  * segment, a ray grazing the surface) is crossed at a floor that doubles after every

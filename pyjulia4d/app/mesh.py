@@ -33,7 +33,7 @@ from pyjulia4d.scene.model import Scene
 FORMATS = {".stl": "stl", ".ply": "ply", ".obj": "obj", ".glb": "glb"}
 MAX_SMOOTH = 1000
 # iterations a second the sampling is assumed to reach for the work estimate: below what
-# benchmarks/mesh_scale.py measured on this project's 2-core CPU, so the estimate errs long
+# benchmarks/speed/mesh_scale.py measured on this project's 2-core CPU, so the estimate errs long
 ESTIMATE_RATE = 3e8
 WARN_SECONDS, REFUSE_SECONDS = 120.0, 6 * 3600.0
 # thinnest_wall: grid points within this many spacings of the outside are measured exactly in a

@@ -8,7 +8,7 @@ its march methods (``scene(case, "fixed" | "de", "single" | "double")``; the
 hypercomplex cases have no distance estimate, so the fixed scan only).  Images
 are tiny (the costly cases a handful of pixels) so that tests/test_extreme.py runs
 the whole catalogue, both methods and both precisions, in well under a minute;
-benchmarks/extreme_cases.py runs the same scenes and writes the error table.
+benchmarks/accuracy/extreme_cases.py runs the same scenes and writes the error table.
 
 Tolerances are against the float64 render of the same scene (the double-precision
 kernels, themselves held to the numpy reference by tests/test_march.py and

@@ -205,7 +205,7 @@ def describe_devices() -> str:
 
 # CPU runtimes by preference when more than one compiles, by platform name: Intel's CPU
 # runtime ran the kernels of every algebra x function pair faster than PoCL on the
-# development machine (AMD EPYC Zen 5; benchmarks/cpu_runtimes.py, results in
+# development machine (AMD EPYC Zen 5; benchmarks/speed/cpu_runtimes.py, results in
 # benchmarks/results/cpu_runtimes.md), and built them faster from cold caches.  Others
 # follow in platform order.
 CPU_PREFERENCE = ("Intel(R) OpenCL",)
@@ -233,7 +233,7 @@ def default_reason(dev: cl.Device) -> str:
     passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
     if kind == "CPU" and passed and runtime_rank(dev) < len(CPU_PREFERENCE):
         why = f"{idx}, the default: no GPU; of the CPU runtimes that compile, {dev.platform.name.strip()} " \
-              f"is preferred (faster on every pair measured: benchmarks/cpu_runtimes.py) over {', '.join(passed)}"
+              f"is preferred (faster on every pair measured: benchmarks/speed/cpu_runtimes.py) over {', '.join(passed)}"
     elif kind == "CPU" and passed:
         why = f"{idx}, the default: no GPU; the first of the CPU runtimes that compile ({idx}, {', '.join(passed)})"
     else:

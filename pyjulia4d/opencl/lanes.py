@@ -120,7 +120,7 @@ def packet_pairs(device: cl.Device, lanes: int, double: bool) -> bool:
     march is a single chain of dependent operations that leaves the vector units waiting, and two
     side by side took 0.83x the march's time and 0.78x the light terms' on the default scene;
     with AVX2's 8-float registers a packet of 16 is already two chains, and pairs took 1.02x
-    (benchmarks/commit_ratio.py, docs/performance.md)."""
+    (benchmarks/speed/commit_ratio.py, docs/performance.md)."""
     if lanes <= 1:
         return False
     try:

@@ -9,7 +9,7 @@ The rule (reference.flag_edges is its float64 twin, tests/test_antialias.py chec
   step is judged alike in the darks and the lights (a linear step of 1/64 is 33 of 255
   sRGB codes up from black and under 2 near white).  8 neighbours, not 4: a fractal's
   silhouette has corners and filaments that run diagonally between pixel centres, which a
-  diagonal neighbour sees first; the extra cost is a one-pixel ring (benchmarks/antialias_error.py
+  diagonal neighbour sees first; the extra cost is a one-pixel ring (benchmarks/accuracy/antialias_error.py
   measures the flagged share);
 - the sample passes run over the BLOCK x BLOCK blocks of the image that hold a flagged
   pixel (a row's consecutive blocks merged into one tile: fewer launches);

@@ -31,7 +31,7 @@ REFUSE_SECONDS = 6 * 3600.0    # refuse (unless forced) when it is longer than t
 # No probe where even the upper bound (workload.estimate) is shorter than this and than
 # WARN_SECONDS: there is nothing to refuse or warn about, and the default tiles stay.  The
 # probe's 35 launches of 8x8 blocks cost 0.19 of a 640x480 render's 0.49 CPU-s on Intel's
-# runtime (0.09 of 0.57 on PoCL; benchmarks/peers.py's plain look); that render's bound is
+# runtime (0.09 of 0.57 on PoCL; benchmarks/peers/peers.py's plain look); that render's bound is
 # 12 s, its truth 0.1 s, so Ctrl-C, honoured between tiles, still comes within a tile.
 SKIP_BELOW_SECONDS = 20.0
 TILE_SECONDS = 0.1             # the work of one tile: the latency of Ctrl-C

@@ -29,7 +29,7 @@ from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method
 
-# Set-test throughput, iterations of f per second, measured by benchmarks/throughput.py
+# Set-test throughput, iterations of f per second, measured by benchmarks/speed/throughput.py
 # (benchmarks/results/throughput.md, commit 19393ea) inside the march of the default scene on
 # the 2-core AMD EPYC development machine with Debian's PoCL: float32 in packets of 16 rays
 # 1.29e9, float64 (one ray per work-item) 1.6e8.  Other CPUs and PyPI's PoCL can be several

@@ -19,7 +19,7 @@ proving segments; below that a finer floor only adds unproven segments in front 
 surface (at 1/200000 the default scene's stated p50 rose from 2.4e-7 to 1.4e-5 while its p99
 fell from 1.9e-4 to 5.5e-5).  draft at 1/2000 stated 0.02-0.03, above its target, so its
 floor is 1/5000 (3.6e-3 to 3.7e-3).  On all 24 algebra x function pairs at their defaults
-(benchmarks/pair_accuracy.py --set march.quality=normal, 80x60;
+(benchmarks/accuracy/pair_accuracy.py --set march.quality=normal, 80x60;
 benchmarks/results/pair_accuracy.md) the real p99 error is within twice the stated one,
 the silhouette wrong on at most 0.08 % of the pixels, and the share of pixels where the
 truth lies in front of all the render states (a part of the set thinner than the floor,

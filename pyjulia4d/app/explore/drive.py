@@ -1,6 +1,6 @@
 """Driving the explorer from a script: ``pyjulia4d explore`` in a child process, and headless
 Chromium on its page (selenium; Debian's chromium and chromium-driver) - what the browser tests
-and benchmarks/explore_latency.py use."""
+and benchmarks/speed/explore_latency.py use."""
 from __future__ import annotations
 
 import queue

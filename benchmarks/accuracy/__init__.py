@@ -1,0 +1,1 @@
+"""Error against a float64 brute force, and against run time."""

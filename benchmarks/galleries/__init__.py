@@ -1,0 +1,1 @@
+"""The gallery sheets README and the docs show."""

@@ -1,0 +1,1 @@
+"""What the benchmark scripts share: their command lines and their results files."""

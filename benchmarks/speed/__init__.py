@@ -1,0 +1,1 @@
+"""Run time, start-up, memory, scaling and throughput; the GPU check."""

@@ -1,0 +1,1 @@
+"""Levers tried on the march and measured, kept so their numbers reproduce."""
