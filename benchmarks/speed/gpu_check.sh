@@ -59,9 +59,9 @@ export PYJULIA4D_DEVICE=$DEVICE
 status=0
 # each kernel stage against its float64 twin, the variants, whole renders and the bit-for-bit
 # checks, on the GPU (each test file picks the device from PYJULIA4D_DEVICE)
-timeout 300 "$PY" -m pytest -q -n "${JOBS:-8}" -p no:cacheprovider tests/test_rays.py tests/test_iterate.py \
-    tests/test_march.py tests/test_cone.py tests/test_normals.py tests/test_shade.py tests/test_variants.py \
-    tests/test_algebras.py tests/test_kinds.py tests/test_render.py tests/test_bit_identity.py 2>&1 \
+timeout 300 "$PY" -m pytest -q -n "${JOBS:-8}" -p no:cacheprovider tests/kernels/test_rays.py tests/kernels/test_iterate.py \
+    tests/kernels/test_march.py tests/kernels/test_cone.py tests/kernels/test_normals.py tests/kernels/test_shade.py tests/kernels/test_variants.py \
+    tests/kernels/test_algebras.py tests/kernels/test_kinds.py tests/render/test_render.py tests/render/test_bit_identity.py 2>&1 \
     | tee "$OUT/tests.txt" | tail -25 || status=1
 for size in 640x480 3840x2160; do
     timeout 120 "$PY" benchmarks/speed/render_time.py --device "$DEVICE" --repeats 10 --out "$OUT" \

@@ -6,13 +6,13 @@ and how close the float32 render must come to the float64 one.
 Every case is a list of scene overrides on top of the default scene, runnable with
 its march methods (``scene(case, "fixed" | "de", "single" | "double")``; the
 hypercomplex cases have no distance estimate, so the fixed scan only).  Images
-are tiny (the costly cases a handful of pixels) so that tests/test_extreme.py runs
+are tiny (the costly cases a handful of pixels) so that tests/accuracy/test_extreme.py runs
 the whole catalogue, both methods and both precisions, in well under a minute;
 benchmarks/accuracy/extreme_cases.py runs the same scenes and writes the error table.
 
 Tolerances are against the float64 render of the same scene (the double-precision
-kernels, themselves held to the numpy reference by tests/test_march.py and
-tests/test_extreme.py): ``status_tol`` bounds the fraction of pixels whose status
+kernels, themselves held to the numpy reference by tests/kernels/test_march.py and
+tests/accuracy/test_extreme.py): ``status_tol`` bounds the fraction of pixels whose status
 (miss / hit / capped) differs, and ``depth_tol`` the depth error on pixels both
 renders hit (the median must be below it, and at most ``status_tol`` of those
 pixels above it).  A case whose float32 error is inherently larger is marked with
@@ -314,7 +314,7 @@ def _build() -> list[Case]:
                                     "fractal.max_iter=30"),
              "C- seen along a = 0: the same set as C+ there (both critical points are 0), mirrored "
              "(a -> -a) elsewhere",
-             "as locus_a_zero_plus; tests/test_stack_locus.py checks the mirror and the a = 0 section",
+             "as locus_a_zero_plus; tests/kernels/test_stack_locus.py checks the mirror and the a = 0 section",
              0.03, 1e-4, "", (25, 19), methods=("fixed",)),
     ]
     return cases

@@ -61,7 +61,7 @@ def sphere_radius(max_iter: int, bailout: float) -> float:
 
 
 def sphere_depth(origins, dirs, radius):
-    """c = 0 (Ödegaard & Wennergren eq. 5 with mu = 0; tests/test_sphere.py): distance along each
+    """c = 0 (Ödegaard & Wennergren eq. 5 with mu = 0; tests/accuracy/test_ball.py): distance along each
     unit ray o + t d to its entry into the 4-ball |p| <= radius; +inf where the ray
     misses the ball, 0 where it starts inside."""
     o = np.asarray(origins, np.float64)

@@ -1,7 +1,7 @@
 """Adaptive antialiasing (image.adaptive = true with image.samples = N > 1): the N sample
 passes run only where the centre pass shows an edge.
 
-The rule (reference.flag_edges is its float64 twin, tests/test_antialias.py checks both):
+The rule (reference.flag_edges is its float64 twin, tests/render/test_antialias.py checks both):
 
 - a pixel is *flagged* when one of its 8 neighbours differs from it in alpha (hit/miss or
   partial cover) or in any colour channel by more than THRESHOLD, colour compared

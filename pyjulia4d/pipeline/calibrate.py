@@ -6,7 +6,7 @@ distance-estimate march the bound is 50-100x the truth, and for the fixed scan i
 ignores where the rays stop.  So before the render proper, ``predict`` runs the render's own
 kernels on about PROBE_RAYS of its pixels (blocks spread evenly over the image) and
 scales their kernel time per pixel to the image and its passes.  Measured on the development machine
-(tests/test_calibrate.py, README "Performance"): within a factor of 2 of the kernel time
+(tests/render/test_calibrate.py, README "Performance"): within a factor of 2 of the kernel time
 of the render proper on scenes of every method.  The prediction then
 
 - refuses above REFUSE_SECONDS and warns above WARN_SECONDS (``judge``), naming the key

@@ -8,7 +8,7 @@ the launch gives by name (the tile's place, a buffer).  Mandelbulber2 declares e
 kernel's parameters once, as one struct shared by host and device; pbrt-v4 declares each
 stage's records once.  OpenCL 1.2 kernels take no structs of vectors portably across
 devices, so the host's one declaration is checked against the device's instead:
-tests/test_signatures.py builds every kernel with ``-cl-kernel-arg-info`` under the
+tests/kernels/test_signatures.py builds every kernel with ``-cl-kernel-arg-info`` under the
 switches real plans use and compares names, types and order with these tables.  Adding a
 parameter touches its ``.cl`` piece, its row here and its float64 twin; the test holds the
 three together.

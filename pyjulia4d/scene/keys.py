@@ -2,7 +2,7 @@
 (as Mandelbulber2's ``-L`` lists its parameters).  The defaults come from the scene
 dataclasses and the ranges from the checkers (scene/model.CHECKS via valid_range), so the
 list cannot drift from what is accepted; docs/scene-keys.md holds the long form, and
-tests/test_scene.py holds both to the checkers."""
+tests/interfaces/test_scene.py holds both to the checkers."""
 from __future__ import annotations
 
 from pyjulia4d.scene.checks import fmt

@@ -222,7 +222,7 @@ class Render:
 
 
 # Colour maps shading.colormap accepts: matplotlib's, named here so that a scene is checked
-# without importing matplotlib (tests/test_shade.py checks each exists there).
+# without importing matplotlib (tests/kernels/test_shade.py checks each exists there).
 COLORMAPS = ("viridis", "plasma", "inferno", "magma", "cividis", "twilight", "twilight_shifted", "turbo",
              "cubehelix", "Spectral", "coolwarm", "RdYlBu", "copper", "bone", "hot", "afmhot", "ocean",
              "terrain", "gist_earth", "gnuplot2", "CMRmap", "YlOrBr", "PuBuGn", "BuPu")

@@ -1,4 +1,4 @@
-// tests/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)
+// tests/kernels/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)
 typedef float real;
 typedef float4 real4;
 typedef float3 real3;

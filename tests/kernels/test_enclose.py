@@ -13,7 +13,7 @@ reference/enclose/ and reference/march.py), held to the mathematics:
 
 Tolerances: the enclosures are checked exactly (float64 samples against float64 radii, with
 a relative 1e-12 for the samples' own rounding); kernel against twin with the float32
-classification slack of test_march.py."""
+classification slack of tests/kernels/test_march.py."""
 from __future__ import annotations
 
 import numpy as np

@@ -14,7 +14,7 @@ from pyjulia4d.app.output import write_image
 from pyjulia4d.scene.model import Scene
 
 W, H = 48, 36
-BALL_RADIUS = 4.0 ** (1.0 / 2 ** 12)   # c = 0, 12 iterations, bailout 4 (tests/test_mesh.py)
+BALL_RADIUS = 4.0 ** (1.0 / 2 ** 12)   # c = 0, 12 iterations, bailout 4 (tests/outputs/test_mesh.py)
 
 
 def ball(**keys):

@@ -207,7 +207,7 @@ def test_antialias_benchmark_runs(tmp_path):
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parent.parent / "benchmarks" / "accuracy" / "antialias_error.py"
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "accuracy" / "antialias_error.py"
     spec = importlib.util.spec_from_file_location("antialias_error", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

@@ -270,7 +270,7 @@ def test_cited_paths_exist() -> None:
     (pyjulia4d/..., kernels/..., docs/...), within the package (opencl/runner.py) or within
     kernels/ (march/march.cl)."""
     top = PKG.parent
-    texts = [p for p in list(PKG.rglob("*.py")) + list(kernel_dir().rglob("*.cl")) + list((top / "tests").glob("*.py"))
+    texts = [p for p in list(PKG.rglob("*.py")) + list(kernel_dir().rglob("*.cl")) + list((top / "tests").rglob("*.py"))
              + list((top / "benchmarks").rglob("*.py")) + list((top / "docs").glob("*.md")) + [top / "README.md"]]
     dead = set()
     for p in texts:

@@ -272,7 +272,7 @@ def test_error_single_argument_form() -> None:
 def _readme_key_rows() -> dict[str, list[str]]:
     """docs/scene-keys.md's table of scene keys: key -> its cells, backticks and escapes
     removed."""
-    readme = Path(__file__).resolve().parent.parent / "docs" / "scene-keys.md"
+    readme = Path(__file__).resolve().parents[2] / "docs" / "scene-keys.md"
     if not readme.exists():
         pytest.skip("docs/scene-keys.md is not beside the tests (installed package)")
     text = readme.read_text(encoding="utf-8")

@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 BASE = "2dc6e4bb26fb15efd307b833a74e9ee90d3091cd"
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 SCENES = {
     "default": [],

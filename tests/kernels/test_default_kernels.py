@@ -13,7 +13,7 @@ every token does.  The ray generation (rays.cl), the march kernel's entry point
 (march/march.cl) and the shading are left out: the kinds never touch them and they change
 with features of their own.  If a change to these pieces is meant to change the default
 scene (not a kind), rewrite the reference with
-    .venv/bin/python tests/test_default_kernels.py --write
+    .venv/bin/python tests/kernels/test_default_kernels.py --write
 and say why in the change."""
 import difflib
 import shutil
@@ -26,10 +26,10 @@ import pytest
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.scene.model import Scene
 
-REFERENCE = Path(__file__).resolve().parent / "data" / "default_kernels.i"
+REFERENCE = Path(__file__).resolve().parents[1] / "data" / "default_kernels.i"
 PIECES = ("common/codes", "common/lanes", "algebra/complex", "function/sqr", "algebra/quaternion", "iterate", "march/refine",
           "march/de", "normals/jacobian")
-HEADER = "// tests/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)\n"
+HEADER = "// tests/kernels/test_default_kernels.py: the default scene's preprocessed kernels (see its docstring)\n"
 
 
 def default_config() -> kernel_config.KernelConfig:

@@ -27,7 +27,7 @@ from pyjulia4d.geometry.camera import camera_frame, to_world
 from pyjulia4d.interop.povray import import_pov, pov_escape_radius, tokenize
 from pyjulia4d.scene.model import Scene
 
-DATA = Path(__file__).parent / "data" / "pov"
+DATA = Path(__file__).resolve().parents[1] / "data" / "pov"
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 
 DOC_JULIA = """julia_fractal {

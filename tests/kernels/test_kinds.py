@@ -328,7 +328,7 @@ def test_kinds_gallery_runs(tmp_path):
     import csv
     import importlib.util
     from pathlib import Path
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     spec = importlib.util.spec_from_file_location("kinds_gallery", root / "benchmarks" / "galleries" / "kinds_gallery.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

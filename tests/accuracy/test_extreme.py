@@ -261,7 +261,7 @@ def test_workload_warns_and_names_the_key():
     with pytest.raises(SceneError, match=r"^fractal\.max_iter: "):
         workload.check(s)
     # the bound alone never warns: the 4K default's is ~5 min, its render a few seconds
-    # (the probe render judges it: tests/test_calibrate.py)
+    # (the probe render judges it: tests/render/test_calibrate.py)
     s = Scene.default().with_overrides(["image.width=3840", "image.height=2160", "fractal.max_iter=12"])
     with warnings.catch_warnings():
         warnings.simplefilter("error")
