@@ -263,11 +263,11 @@ def colouring_values(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.n
     from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
 
     sh, f = scene.shading, scene.fractal
-    F, mandelbrot = formula_of(f), f.kind == "mandelbrot"
+    F = formula_of(f)
     if sh.coloring == "iteration":
-        return orbit_iteration(inner, f.c, f.max_iter, f.bailout, F, mandelbrot)
+        return orbit_iteration(inner, f.c, f.max_iter, f.bailout, F)
     if sh.coloring == "trap":
-        return orbit_trap(inner, f.c, f.max_iter, f.bailout, to_world(scene, sh.trap), F, mandelbrot)
+        return orbit_trap(inner, f.c, f.max_iter, f.bailout, to_world(scene, sh.trap), F)
     if sh.coloring == "w":
         return np.clip(0.5 + world[:, 3] / march_radius(scene), 0.0, 1.0)
     return None

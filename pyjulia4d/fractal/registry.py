@@ -10,6 +10,7 @@ eqs. 14, 15); the kinds are Hart, Sandin & Kauffman 1989's (§2, §5).
 """
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -75,18 +76,34 @@ class Algebra(_Entry):
 
 @dataclass(frozen=True)
 class Kind:
-    """A kind of set a [fractal] table describes.  ``piece``: its set test after iterate.cl
-    (kernels/kind/<name>.cl, with kind/level.cl), None for the Julia set itself.
-    ``estimate``: whether a proven distance estimate exists for it (the stack's "de" is an
-    empirical one).  ``enclosure``: its orbits' enclosures (enclose/<enclosure>.cl), which
-    every kind has, so the proven march and the quality presets exist for every set.  ``own_map``: it iterates a complex map of its own, not
-    the algebra's, so its enclosure piece is the whole enclosure (no algebra piece)."""
+    """A kind of set a [fractal] table describes, plugged in as a function is: an entry here,
+    its pieces and its twin.  ``piece``: its set test after iterate.cl (kernels/kind/<name>.cl,
+    with kind/level.cl), None for the Julia set itself.  ``estimate``: whether a proven
+    distance estimate exists for it (the stack's "de" is an empirical one).  ``enclosure``: its
+    orbits' enclosures (enclose/<enclosure>.cl), which every kind has, so the proven march and
+    the quality presets exist for every set.  ``own_map``: it iterates a complex map of its
+    own, not the algebra's, so its enclosure piece is the whole enclosure (no algebra piece).
+    ``packet_pairs``: its estimate runs two packets side by side (kernel_config.march_packets).
+    ``host``: the module of its host-side hooks - its -D switches, the radius of a ball that
+    holds it, its rules (fractal/kinds/<name>.py: kind_hooks).  ``twin``: its float64 twin's
+    module (reference/kind/<name>.py: inside, level, normal and, where it has them,
+    distance_formula and orbit_start), None where iterate.cl's own Julia set test is the set's."""
 
     name: str
     enclosure: str
     piece: str | None = None
     estimate: bool = True
     own_map: bool = False
+    packet_pairs: bool = False
+    empirical_estimate: bool = False   # march.method "de" takes an empirical estimate where no proven one exists
+
+    @property
+    def host(self) -> str:
+        return f"pyjulia4d.fractal.kinds.{self.name}"
+
+    @property
+    def twin(self) -> str | None:
+        return f"pyjulia4d.reference.kind.{self.name}" if self.piece else None
 
     @property
     def enclosure_piece(self) -> str:
@@ -128,9 +145,10 @@ ALGEBRAS_TABLE: dict[str, Algebra] = {a.name: a for a in (
 ALGEBRAS = tuple(ALGEBRAS_TABLE)
 
 KINDS_TABLE: dict[str, Kind] = {k.name: k for k in (
-    Kind("julia", enclosure="julia"),
-    Kind("mandelbrot", piece="kind/mandelbrot", enclosure="mandelbrot"),
-    Kind("julia_stack", piece="kind/julia_stack", estimate=False, enclosure="julia_stack", own_map=True),
+    Kind("julia", enclosure="julia", packet_pairs=True),
+    Kind("mandelbrot", piece="kind/mandelbrot", enclosure="mandelbrot", packet_pairs=True),
+    Kind("julia_stack", piece="kind/julia_stack", estimate=False, enclosure="julia_stack", own_map=True,
+         empirical_estimate=True),
     Kind("cubic_locus", piece="kind/cubic_locus", estimate=False, enclosure="cubic_locus", own_map=True),
 )}
 
@@ -144,7 +162,7 @@ NORM_BOUNDED = tuple(a.name for a in ALGEBRAS_TABLE.values() if a.norm_bounded)
 
 
 def escape_degree(f: Any) -> int | None:
-    """D where |f(q)| >= |q|^D - |c| (camera.bounding_radius), else None; ``f`` a [fractal]."""
+    """D where |f(q)| >= |q|^D - |c| (bounds.bounding_radius), else None; ``f`` a [fractal]."""
     return POLYNOMIAL_DEGREE.get(f.function) if ALGEBRAS_TABLE[f.algebra].norm_bounded else None
 
 
@@ -154,6 +172,13 @@ def has_distance_estimate(f: Any) -> bool:
     scan (march.method = "auto")."""
     return (KINDS_TABLE[f.kind].estimate and ALGEBRAS_TABLE[f.algebra].estimate
             and FUNCTIONS_TABLE[f.function].degree is not None)
+
+
+def kind_hooks(name: str) -> Any:
+    """The host-side hooks of kind ``name`` (its entry's ``host`` module): ``defines(scene)``,
+    its -D switches; ``set_radius(scene)``, the radius of a ball about the origin that holds
+    the set; ``check(scene)``, its rules (a SceneError naming the key to change)."""
+    return importlib.import_module(KINDS_TABLE[name].host)
 
 
 def march_method(scene: Any) -> str:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyjulia4d.geometry.vec4 import Degenerate, cross4, orthonormalise, unit
-from pyjulia4d.fractal.registry import MANDELBROT_START, escape_degree, march_method
+from pyjulia4d.fractal.registry import kind_hooks, march_method
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError
 
@@ -113,85 +113,6 @@ def extra_lights(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     return geo, rgb
 
 
-def bounding_radius(c, bailout: float, max_iter: int, degree: int | None = 2) -> float:
-    """Radius of a 4-ball that provably holds every point with |q_n| <= bailout for
-    n = 0..max_iter (the set the fixed scan finds), for q -> q^degree + c.
-
-    With R the root of r^D - |c| = r, |q| = r > R gives |q^D + c| >= r^D - |c| > r, so
-    |q_n| >= g^n(r), g(r) = r^D - |c|.  A point that stays within the bailout b after N
-    steps therefore has |q_0| <= g^-N(b) = h^N(b), h(s) = (s + |c|)^(1/D), and also
-    |q_0| <= b.  The bound shrinks from b towards R as N grows.  |q^D| >= |q|^D holds for
-    quaternions (|q^D| = |q|^D) and for the hypercomplex numbers (the power mean of the
-    split components, algebra/hypercomplex.cl).  ``degree`` None (a function that is no
-    polynomial): the bailout itself, the n = 0 test, widened by 2^-20 (far above float32's
-    rounding of a point's norm): such sets can fill the ball up to its sphere (tan, asin,
-    reciprocal stay bounded almost everywhere), and a scan must start outside them, so that
-    the hit on the sphere is bracketed and its normal is the sphere's.
-    """
-    if degree is None:
-        return float(bailout) * (1.0 + 2.0 ** -20)
-    cabs = float(np.linalg.norm(c))
-    s = float(bailout)
-    for _ in range(min(int(max_iter), 200)):  # h^N converges to R geometrically
-        s_next = (s + cabs) ** (1.0 / degree) if degree != 2 else math.sqrt(s + cabs)
-        if abs(s_next - s) < 1e-15:
-            break
-        s = s_next
-    return min(float(bailout), s)
-
-
-def mandelbrot_radius(bailout: float, max_iter: int, degree: int | None = 2, start: float = 0.0) -> float:
-    """Radius of a 4-ball that provably holds every c with |q_n| <= bailout for n = 1..max_iter,
-    q_1 = c, q_{n+1} = q_n^degree + c (kernels/kind/mandelbrot.cl).
-
-    |q_1| = |c| = r <= b is needed.  With s_1 = r, s_{n+1} = s_n^D - r a lower bound of |q_n|
-    (|q^D + c| >= |q|^D - |c|), and r > R = 2^(1/(D-1)) (where R^D - R = R), s_n grows with n
-    and with r (ds_{n+1}/dr = D s_n^(D-1) ds_n/dr - 1 >= 1); so the c that stay within b for N
-    steps have r <= max(R, r*), r* the least r >= R with some s_n > b, found by bisection
-    (widened by 1e-9 relative).  ``degree`` None (no norm bound): |q_1| = |v + c| <= b
-    alone, so b + |v| (``start``, the critical value's norm), widened as in bounding_radius."""
-    b = float(bailout)
-    if degree is None:
-        return (b + float(start)) * (1.0 + 2.0 ** -20)
-    R = 2.0 ** (1.0 / (degree - 1))
-    if b <= R:
-        return b
-
-    def escapes(r: float) -> bool:
-        s = r
-        for _ in range(int(max_iter) - 1):
-            s = s ** degree - r
-            if s > b:
-                return True
-        return False
-
-    if not escapes(b):
-        return b
-    lo, hi = R, b                    # lo stays within b (or is R), hi escapes
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        if escapes(mid):
-            hi = mid
-        else:
-            lo = mid
-    return min(b, hi * (1.0 + 1e-9))
-
-
-def stack_radius(scene: Scene) -> float:
-    """Radius of a 4-ball about the origin that holds a Julia set stack (kernels/kind/
-    julia_stack.cl) in the hyperplane w = w0 the view keeps to (scene/rules.check_stack): there
-    |z| <= bounding_radius(max |c(u)|) (|c(u)| <= the larger end point's: the segment is
-    convex), |u| <= 1 and w = w0, widened by 2^-20 so that a scan starts outside."""
-    f, cam = scene.fractal, scene.camera
-    cmax = max(math.hypot(*f.c_from), math.hypot(*f.c_to))
-    rz = bounding_radius((cmax, 0.0, 0.0, 0.0), f.bailout, f.max_iter, 2)
-    w0 = float(to_world(scene, tuple(cam.position[:3]) + ((cam.position[3],) if len(cam.position) == 4
-                                                              else (0.0,)))[3])
-    return math.sqrt(rz * rz + 1.0 + w0 * w0) * (1.0 + 2.0 ** -20)
-
-
 def march_radius(scene: Scene) -> float:
     """Bounding radius for the march: the set's (set_radius), plus 4 epsilon for the
     distance-estimate method, whose d < epsilon shell lies outside the set and whose
@@ -204,18 +125,9 @@ def march_radius(scene: Scene) -> float:
 
 def set_radius(scene: Scene) -> float:
     """Radius of a 4-ball about the origin that holds the scene's set: the escape-time bound of
-    its kind (what a mesh of the set samples; the march widens it, march_radius)."""
-    f = scene.fractal
-    if f.kind == "mandelbrot":
-        r = mandelbrot_radius(f.bailout, f.max_iter, escape_degree(f),
-                              float(np.linalg.norm(MANDELBROT_START[f.function])))
-    elif f.kind == "julia_stack":
-        r = stack_radius(scene)
-    elif f.kind == "cubic_locus":   # kernels/kind/cubic_locus.cl: drawn within |p| <= locus_radius,
-        r = f.locus_radius * (1.0 + 2.0 ** -20)   # widened so that a scan starts outside
-    else:
-        r = bounding_radius(f.c, f.bailout, f.max_iter, escape_degree(f))
-    return r
+    its kind (fractal/kinds/<kind>.py set_radius; what a mesh of the set samples; the march
+    widens it, march_radius)."""
+    return kind_hooks(scene.fractal.kind).set_radius(scene)
 
 
 def clip_planes(scene: Scene) -> list[tuple[np.ndarray, float]]:

@@ -46,7 +46,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import bounding_radius, camera_frame
+from pyjulia4d.geometry.bounds import bounding_radius
+from pyjulia4d.geometry.camera import camera_frame
 from pyjulia4d.opencl.executor import render
 from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
@@ -159,7 +160,7 @@ def real_c_depth(origins, dirs, c1, max_iter, bailout, near=None, far=None,
 
     Each ray is scanned at ``n_scan`` equal steps between ``near`` and ``far`` (default:
     its entry into and exit from the provably bounding 4-ball of
-    ``camera.bounding_radius``, the interval the march kernel scans), then the bracket
+    ``bounds.bounding_radius``, the interval the march kernel scans), then the bracket
     [last outside sample, first inside sample] is bisected 60 times in float64.  The
     scan is repeated at 2 n_scan; where the two differ (a strand thinner than a step
     found only by the finer scan) the finer answer is kept, and ``record`` (a dict, if
@@ -497,7 +498,7 @@ def brute_force_depth(scene: Scene, origins, dirs, chord: float = 2e-4, fine: fl
     """The first crossing of each unit ray o + t d into the scene's truncated set (inside
     when |q_n| <= bailout for n = 0..max_iter, its float64 twin ``reference.julia_inside``
     with the scene's algebra, function and kind), +inf where none: a chord scan at spacing
-    at most ``chord`` through the bounding ball (camera.bounding_radius, ``radius``), then a
+    at most ``chord`` through the bounding ball (bounds.bounding_radius, ``radius``), then a
     scan at ``fine`` back over the chord before the first inside sample, then bisection to
     float64 resolution.  It steps over parts of the set thinner than ``chord`` along a ray
     that the fine scan does not reach: a truth for the thickness it resolves, whatever

@@ -32,7 +32,7 @@ def to_scene(scene: Scene, x) -> np.ndarray:
 def _within_reach(scene: Scene, eye: np.ndarray, radius: float, what: str) -> None:
     """A camera at ``eye`` (world coordinates) must be a valid camera.position (every
     component within +-COORD): else the set is too large to frame, which comes of its
-    bound - the bailout where the pair has no polynomial escape bound (camera.bounding_radius)
+    bound - the bailout where the pair has no polynomial escape bound (bounds.bounding_radius)
     - not of a key the user set; refused with one line naming fractal.bailout."""
     pos = to_scene(scene, eye)
     if np.all(np.abs(pos) <= COORD):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, KINDS_TABLE, MANDELBROT_START, march_method
+from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, KINDS_TABLE, kind_hooks, march_method
 from pyjulia4d.resources import kernel_dir
 from pyjulia4d.scene.model import Scene
 
@@ -43,8 +43,8 @@ def iteration_pieces(scene: Scene) -> tuple[str, ...]:
 
 def fractal_defines(scene: Scene) -> tuple[str, ...]:
     """pwr's complex exponent, compiled in (function/pwr.cl); the rotation's cos and sin
-    (kind/rotate.cl); the kind's switch (KIND_MANDELBROT: normals/jacobian.cl); a stack's
-    c-line and its empirical estimate's switch (kind/julia_stack.cl)."""
+    (kind/rotate.cl); the kind's switches (fractal/kinds/<kind>.py defines: KIND_MANDELBROT for
+    normals/jacobian.cl, a stack's c-line, the locus's critical point)."""
     f = scene.fractal
     out = ()
     if f.function == "pwr":
@@ -54,19 +54,7 @@ def fractal_defines(scene: Scene) -> tuple[str, ...]:
     if f.theta != 0:
         t = math.radians(f.theta)
         out += (f"ROTATE_COS={math.cos(t)!r}", f"ROTATE_SIN={math.sin(t)!r}")
-    if f.kind != "julia":
-        out += (f"KIND_{f.kind.upper()}",)
-    if f.kind == "mandelbrot" and any(MANDELBROT_START[f.function]):   # q_1 = v + c (kind/mandelbrot.cl)
-        out += tuple(f"MANDEL_V_{a}={v!r}" for a, v in zip("XYZW", MANDELBROT_START[f.function]))
-    if f.kind == "julia_stack":   # c(u) = c_mid + u c_half (kind/julia_stack.cl), in float64 here
-        (r0, i0), (r1, i1) = f.c_from, f.c_to
-        out += (f"STACK_CM_RE={(r0 + r1) / 2!r}", f"STACK_CM_IM={(i0 + i1) / 2!r}",
-                f"STACK_CH_RE={(r1 - r0) / 2!r}", f"STACK_CH_IM={(i1 - i0) / 2!r}")
-        if scene.march.method == "de":   # the empirical estimate, on request only
-            out += ("STACK_DE",)
-    if f.kind == "cubic_locus":   # the critical point +a or -a, the ball (kind/cubic_locus.cl)
-        out += (f"LOCUS_SIGN={1 if f.component == 'plus' else -1}", f"LOCUS_R2={f.locus_radius ** 2!r}")
-    return out
+    return out + kind_hooks(f.kind).defines(scene)   # the kind's own (fractal/kinds/<kind>.py)
 
 
 def precision_defines(scene: Scene) -> tuple[str, ...]:
@@ -202,7 +190,7 @@ def march_packets(scene: Scene, lanes: int, pairs: bool = True) -> int:
     julia_level_pair: iterate.cl, kind/mandelbrot.cl); one otherwise, and with one ray per
     work-item."""
     f = scene.fractal
-    both = pairs and lanes > 1 and march_method(scene) == "de" and f.kind in ("julia", "mandelbrot")
+    both = pairs and lanes > 1 and march_method(scene) == "de" and KINDS_TABLE[f.kind].packet_pairs
     return 2 if both else 1
 
 

@@ -198,7 +198,7 @@ def march_args(scene: Scene, radius: float | None = None, **changes) -> MarchArg
 def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     """The argument records of every kernel of ``scene`` (Plan's march, clip, normals,
     light_args, shade)."""
-    f, m, sh = scene.fractal, scene.march, scene.shading
+    sh = scene.shading
     lp = light_position(scene)
     light = light_parameters(scene, radius)
     geo, rgb = extra_lights(scene)

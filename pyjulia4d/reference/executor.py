@@ -79,8 +79,7 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
             n2 = clip_normals(g2, s2, frame, planes, normals(p2, None, s2, g2))
             refl = reflect_color(s2, n2, p2, d2, frame, sa)
         la = plan.light_args
-        terms = (light_terms(point, normal, status, bracket, frame, ma, la, sa.light, F, plan.fractal.kind == "mandelbrot")
-                 if la.used else None)
+        terms = light_terms(point, normal, status, bracket, frame, ma, la, sa.light, F) if la.used else None
         vis_extra = extra_visibility(point, normal, status, frame, ma, la, sa, F) if la.extra_shadow != "none" else None
         lut = colormap.table(sa.colormap) if sa.colormap is not None else None
         rgba = shade(status, normal, point, frame, sa, terms, lut, vis_extra, refl)

@@ -88,6 +88,13 @@ class Formula:
         return importlib.import_module("pyjulia4d.reference." + KINDS_TABLE[self.kind].enclosure_piece.replace("/", "."))
 
     @property
+    def kind_twin(self):
+        """The kind's twin module (reference/kind/<kind>.py: inside, level, normal, and where it
+        has them distance_formula and orbit_start), None for the Julia set itself."""
+        twin = KINDS_TABLE[self.kind].twin
+        return importlib.import_module(twin) if twin else None
+
+    @property
     def own_map(self) -> bool:
         """The kind iterates a complex map of its own, not the algebra's (registry Kind.own_map)."""
         return KINDS_TABLE[self.kind].own_map

@@ -5,9 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
-from pyjulia4d.reference.kind import cubic_locus as _locus
-from pyjulia4d.reference.kind import julia_stack as _stack
-from pyjulia4d.reference.kind import mandelbrot as _mandelbrot
 from pyjulia4d.reference.kind.level import kind_level
 
 REAL_MIN = np.finfo(np.float64).tiny
@@ -21,12 +18,9 @@ def dot4(a, b):
 def julia_inside(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     """|q_n| <= bailout for n = 0..max_iter (POV-Ray 3.6 documentation; Ödegaard & Wennergren eq. 5)."""
     F = formula
-    if F.kind == "mandelbrot":   # kernels/kind/mandelbrot.cl takes the name over
-        return _mandelbrot.mandel_inside(p, max_iter, bailout, F)
-    if F.kind == "julia_stack":  # kernels/kind/julia_stack.cl likewise
-        return _stack.stack_inside(p, max_iter, bailout, F)
-    if F.kind == "cubic_locus":  # kernels/kind/cubic_locus.cl likewise
-        return _locus.locus_inside(p, max_iter, bailout, F)
+    kind = F.kind_twin
+    if kind is not None:   # its kernels/kind/<kind>.cl takes the name over
+        return kind.inside(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     out = np.ones(q.shape[:-1], bool)
@@ -45,12 +39,9 @@ def julia_level(p, c, max_iter, bailout, formula: Formula = QUATERNION_SQR):
     escaping at n < N is extrapolated as (|q_n|^2 / b^2)^(D^(N-n)) - 1 (D = the growth
     degree), capped at 1e30 (iterate.cl; Quilez 2002).  Returns (F, inside)."""
     F = formula
-    if F.kind == "mandelbrot":
-        return _mandelbrot.mandel_level(p, max_iter, bailout, F)
-    if F.kind == "julia_stack":
-        return _stack.stack_level(p, max_iter, bailout, F)
-    if F.kind == "cubic_locus":
-        return _locus.locus_level(p, max_iter, bailout, F)
+    kind = F.kind_twin
+    if kind is not None:
+        return kind.level(p, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     b2 = bailout * bailout
@@ -74,10 +65,9 @@ def julia_distance_formula(p, c, max_iter, bailout, formula: Formula = QUATERNIO
     iterate, derivative carried squared and rescaled as mantissa * 2^e; returns
     (d, escaped)."""
     F = formula
-    if F.kind == "mandelbrot":
-        return _mandelbrot.mandel_distance_formula(p, max_iter, bailout, F)
-    if F.kind == "julia_stack":   # the empirical estimate (-D STACK_DE)
-        return _stack.stack_distance_formula(p, max_iter, bailout, F)
+    kind_estimate = getattr(F.kind_twin, "distance_formula", None)
+    if kind_estimate is not None:   # a kind's own (the stack's: the empirical one, -D STACK_DE)
+        return kind_estimate(p, max_iter, bailout, F)
     if F.split:
         return _split_distance_formula(p, c, max_iter, bailout, F)
     q = F.ALG_IN(np.array(p, dtype=np.float64)).copy()

@@ -8,9 +8,6 @@ from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, STATUS_HIT
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula
-from pyjulia4d.reference.kind import cubic_locus as _locus
-from pyjulia4d.reference.kind import julia_stack as _stack
-from pyjulia4d.reference.kind import mandelbrot as _mandelbrot
 from pyjulia4d.reference.kind.level import rescale_columns
 
 def to_camera(g, frame: Frame):
@@ -42,12 +39,9 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
     iteration stops while q is a normal number, |q|^2 >= sqrt(REAL_MIN): inside points of
     c ~ 0 go to exactly 0 otherwise, and the normal with them (GUARD_JACOBIAN_TINY)."""
     F = formula
-    if F.kind == "mandelbrot":   # normals/jacobian.cl, -D KIND_MANDELBROT
-        return _mandelbrot.mandel_normal_jacobian(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
-    if F.kind == "julia_stack":  # KIND_NORMAL: kind/julia_stack.cl stack_normal
-        return _stack.stack_normal(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
-    if F.kind == "cubic_locus":  # KIND_NORMAL: kind/cubic_locus.cl locus_normal
-        return _locus.locus_normal(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
+    kind = F.kind_twin
+    if kind is not None:   # normals/jacobian.cl under the kind's switch (KIND_MANDELBROT, KIND_NORMAL)
+        return kind.normal(p, max_iter, bailout, F, guard, GUARD_JACOBIAN_TINY)
     q = F.ALG_IN(np.array(p, np.float64)).copy()
     c = F.ALG_C(np.asarray(c, np.float64))
     # J[..., k, :] = column k, in the algebra's coordinates: ALG_IN of the unit vectors

@@ -74,21 +74,20 @@ def ambient_occlusion(p, nw, c, max_iter, bailout, dist, strength, F: Formula = 
     return np.clip(1 - strength * occ / wsum, 0.0, 1.0)
 
 
-def _orbit_start(p, c, F: Formula, mandelbrot: bool):
+def _orbit_start(p, c, F: Formula):
     """(q_start, step(q, live) -> f(q) + c on the live points, first index): the Julia orbit
-    of p, or for a Mandelbrot set that of 0 with c = p from q_1 = c (shade/light.cl ORBIT_*)."""
-    if mandelbrot:
-        from pyjulia4d.reference.kind.mandelbrot import mandel_f, mandel_start
-        cp = F.ALG_IN(np.asarray(p, np.float64))
-        return mandel_start(F, cp), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
+    of p, or the kind's own (its twin's orbit_start: a Mandelbrot set's, of v with c = p; shade/light.cl ORBIT_*)."""
+    kind_start = getattr(F.kind_twin, "orbit_start", None)
+    if kind_start is not None:
+        return kind_start(F, p)
     cc = F.ALG_C(np.asarray(c, np.float64))
     return F.ALG_IN(p).copy(), (lambda q, live: F.julia_f(q[live], cc)), 0
 
 
-def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
+def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR):
     """Smooth escape count of p iterated up to 4 max_iter, as (nu - max_iter) / (3 max_iter);
     1 where it never escapes (shade/light.cl orbit_value, COLOR_ITERATION)."""
-    q, step, n0 = _orbit_start(p, c, F, mandelbrot)
+    q, step, n0 = _orbit_start(p, c, F)
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
     n = np.full(len(q), float(n0))
@@ -107,9 +106,9 @@ def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR, mandel
     return np.where(m2 > b2, v, 1.0)
 
 
-def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
+def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR):
     """1 - exp(-3 min_n |q_n - trap|) over the orbit while inside the bailout (COLOR_TRAP)."""
-    q, step, n0 = _orbit_start(p, c, F, mandelbrot)
+    q, step, n0 = _orbit_start(p, c, F)
     tq = F.ALG_IN(np.asarray(trap, np.float64))
     b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
@@ -127,7 +126,7 @@ def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR, mande
 
 
 def light_terms(point, normal, status, bracket, frame: Frame, march: MarchArgs, light: LightArgs, light_pos,
-                F: Formula = QUATERNION_SQR, mandelbrot: bool = False):
+                F: Formula = QUATERNION_SQR):
     """shade/light.cl light_terms with the same records (``march``, ``light``:
     pipeline/plan.MarchArgs, LightArgs; ``light_pos`` the positioned light, ShadeArgs.light):
     (visibility, ambient factor, colour value, 0) per item, (1, 1, 0, 0) off hits."""
@@ -156,9 +155,9 @@ def light_terms(point, normal, status, bracket, frame: Frame, march: MarchArgs, 
     if coloring == "iteration":
         dirs = p - np.asarray(eye, np.float64)
         dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
-        out[k, 2] = orbit_iteration(p + bracket[k, None] * dirs, c, max_iter, bailout, F, mandelbrot)
+        out[k, 2] = orbit_iteration(p + bracket[k, None] * dirs, c, max_iter, bailout, F)
     elif coloring == "trap":
-        out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F, mandelbrot)
+        out[k, 2] = orbit_trap(p, c, max_iter, bailout, trap, F)
     elif coloring == "w":
         out[k, 2] = np.clip(0.5 + p[:, 3] / radius, 0.0, 1.0)
     return out

@@ -261,7 +261,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "c_to": Vector((2,), -4.0, 4.0),
         "component": Choice("plus", "minus"),
         # the ball the unbounded C+ is drawn in; fractal.bailout must reach its maps' escape
-        # radius (scene/rules.check_locus: 4 does up to 2.19)
+        # radius (fractal/kinds/cubic_locus.check: 4 does up to 2.19)
         "locus_radius": Real(0.05, 16.0),
     },
     "camera": {

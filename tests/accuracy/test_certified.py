@@ -50,7 +50,7 @@ def brute_force(s: Scene, n=6000):
     """First inside sample of an n-step scan over the march's interval, then 60 bisections
     (the set's own test, reference.julia_inside)."""
     from pyjulia4d.measure.truth import _bisect, _first_inside, _ray_interval
-    from pyjulia4d.geometry.camera import bounding_radius
+    from pyjulia4d.geometry.bounds import bounding_radius
 
     f = s.fractal
     o, d = ref.generate_rays(camera_frame(s), W, H)

@@ -8,7 +8,7 @@ import pytest
 from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d import reference as ref
-from pyjulia4d.geometry.camera import mandelbrot_radius
+from pyjulia4d.geometry.bounds import mandelbrot_radius
 from pyjulia4d.reference.formula import Formula, formula_of
 from pyjulia4d.reference.kind import rotate
 from pyjulia4d.opencl.executor import render

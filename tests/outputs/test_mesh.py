@@ -96,7 +96,7 @@ def test_the_c0_set_meshes_to_its_ball():
 
 def test_the_ball_cuts_a_set_that_fills_it():
     """A set reaching its bounding ball (hypercomplex reciprocal stays bounded almost everywhere,
-    camera.bounding_radius): closed by the sphere, those vertices exactly on it."""
+    bounds.bounding_radius): closed by the sphere, those vertices exactly on it."""
     scene = Scene.default().replace(**{"fractal.algebra": "hypercomplex", "fractal.function": "reciprocal",
                                        "fractal.c": [0.1, 0.2, 0.0, 0.0], "fractal.max_iter": 6})
     r = mesh_mod.build_mesh(scene, 32, harness.device())

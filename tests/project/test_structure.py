@@ -150,6 +150,12 @@ def test_registry_names_pieces_and_twins_that_exist() -> None:
     for kind in registry.KINDS_TABLE.values():
         if kind.piece:
             assert (kd / f"{kind.piece}.cl").is_file(), kind
+        # a kind plugs in as a function does: its host hooks and its twin's interface
+        hooks = registry.kind_hooks(kind.name)
+        assert all(callable(getattr(hooks, h, None)) for h in ("defines", "set_radius", "check")), kind
+        if kind.twin:
+            twin = importlib.import_module(kind.twin)
+            assert all(callable(getattr(twin, h, None)) for h in ("inside", "level", "normal")), kind
     # every piece of algebra/ and function/ has its entry (power.cl and complex.cl are shared)
     assert {p.stem for p in (kd / "function").glob("*.cl")} == set(registry.FUNCTIONS_TABLE)
     assert {p.stem for p in (kd / "algebra").glob("*.cl")} - {"power", "complex"} == set(registry.ALGEBRAS_TABLE)
@@ -279,3 +285,13 @@ def test_cited_paths_exist() -> None:
         dead |= {(p.name, m) for m in PACKAGE_PATH.findall(text) if not (PKG / m).exists() and not (top / m).exists()}
         dead |= {(p.name, m) for m in PIECE_PATH.findall(text) if not (kernel_dir() / m).exists()}
     assert dead == set()
+
+
+def test_no_branch_on_a_kinds_name() -> None:
+    """A kind is an entry, its piece, its host hooks (fractal/kinds/) and its twin
+    (reference/kind/): nothing else compares the scene's kind with another kind's name."""
+    other = "|".join(k for k in registry.KINDS_TABLE if k != "julia")
+    pattern = re.compile(rf"""kind\s*(?:==|!=)\s*["'](?:{other})["']|["'](?:{other})["']\s*(?:==|!=)\s*\w*kind""")
+    bad = [m for m, p in MODULES.items() if not m.startswith(("pyjulia4d.fractal.kinds", "pyjulia4d.reference.kind"))
+           and pattern.search(p.read_text())]
+    assert bad == []

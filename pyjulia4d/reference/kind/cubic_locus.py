@@ -86,3 +86,8 @@ def locus_normal(p, max_iter, bailout, F, guard=None, tiny_flag=0):
     g = np.stack([(zc * A).real, (zc * 1j * A).real, (zc * B).real, (zc * 1j * B).real], axis=-1)
     cut = (z.real ** 2 + z.imag ** 2 <= b2) & ~ball
     return np.where(cut[..., None], np.asarray(p, np.float64), g)
+
+
+# The twin interface the registry names (Kind.twin; reference/formula.Formula.kind_twin): what
+# iterate.py, normals.py and shade.py ask of a kind.
+inside, level, normal = locus_inside, locus_level, locus_normal

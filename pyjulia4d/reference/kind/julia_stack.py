@@ -122,3 +122,8 @@ def stack_distance_formula(p, max_iter, bailout, F):
     du = np.abs(u) - 1.0
     out = np.where(slab & zout, d, np.maximum(np.where(zout, d, 0.0), du))
     return out, zout | ~slab
+
+
+# The twin interface the registry names (Kind.twin; reference/formula.Formula.kind_twin): what
+# iterate.py, normals.py and shade.py ask of a kind.
+inside, level, distance_formula, normal = stack_inside, stack_level, stack_distance_formula, stack_normal

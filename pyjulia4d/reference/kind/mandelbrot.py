@@ -134,3 +134,15 @@ def mandel_normal_jacobian(p, max_iter, bailout, F, guard=None, tiny_flag=0):
         guard |= np.where(tiny, tiny_flag, 0)
     with np.errstate(all="ignore"):
         return F.ALG_DOT(J, q[..., None, :])
+
+
+# The twin interface the registry names (Kind.twin; reference/formula.Formula.kind_twin): what
+# iterate.py, normals.py and shade.py ask of a kind.
+inside, level, distance_formula, normal = mandel_inside, mandel_level, mandel_distance_formula, mandel_normal_jacobian
+
+
+def orbit_start(F, p):
+    """The orbit the colourings follow (shade/light.cl ORBIT_*): that of v with c = p, from
+    q_1 = v + c: (q_1, step(q, live) -> f(q) + c on the live points, first index 1)."""
+    cp = F.ALG_IN(np.asarray(p, np.float64))
+    return mandel_start(F, cp), (lambda q, live: mandel_f(F, q[live], cp[live])), 1
