@@ -175,6 +175,20 @@ inline quat QSEL(quat a, quat b, lmask m)
 }
 #endif
 
+/* Lane k of a packet, read or written: LANE of an lreal (an lvalue), MASK_LANE of an lmask,
+ * LANE_QUAT of a quat as a
+ * real4, SET_LANE_QUAT to store one - the one place the packet's structure-of-arrays layout
+ * (its vectors' lanes addressed as an array of reals) is spelled out.  With one ray per
+ * work-item lane 0 is the value itself. */
+#define LANE(v, k) (((real *)&(v))[k])
+#define MASK_LANE(m, k) (((mask_t *)&(m))[k])
+#define LANE_QUAT(q, k) ((real4)(LANE((q).x, k), LANE((q).y, k), LANE((q).z, k), LANE((q).w, k)))
+#define SET_LANE_QUAT(q, k, v) do { \
+        real4 lane_q_ = (v); \
+        LANE((q).x, k) = lane_q_.x; LANE((q).y, k) = lane_q_.y; LANE((q).z, k) = lane_q_.z; \
+        LANE((q).w, k) = lane_q_.w; \
+    } while (0)
+
 /* a uniform 4D vector (a real4 or float4) in every lane */
 #define QUAT_UNIFORM(v) QUAT((lreal)((v).x), (lreal)((v).y), (lreal)((v).z), (lreal)((v).w))
 

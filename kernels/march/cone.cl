@@ -35,7 +35,7 @@ inline quat cone_dirs(size_t i0, size_t first, int n_items, int blocks_w, int bx
         size_t i = i0 + first + j < (size_t)n_items ? i0 + first + j : i0;
         int bx = bx0 + (int)(i % (size_t)blocks_w), by = by0 + (int)(i / (size_t)blocks_w);
         camera_uv(bx * CONE_BLOCK, by * CONE_BLOCK, (real)(CONE_BLOCK / 2), (real)(CONE_BLOCK / 2), tan_half_fov,
-                  image_w, image_h, &((real *)&u)[j], &((real *)&v)[j]);
+                  image_w, image_h, &LANE(u, j), &LANE(v, j));
     }
     return camera_dirs(u, v, forward, right, up);
 #endif
@@ -103,6 +103,6 @@ PACKET_KERNEL void cone_starts(const int n_items, const int blocks_w, const int 
 #else
     for (int p = 0; p < PACKETS; ++p)
         for (int j = 0; j < LANES && i0 + p * LANES + j < (size_t)n_items; ++j)   /* scatter */
-            cone[i0 + p * LANES + j] = (real2)(((real *)&t_lo[p])[j], ((real *)&t_last[p])[j]);
+            cone[i0 + p * LANES + j] = (real2)(LANE(t_lo[p], j), LANE(t_last[p], j));
 #endif
 }

@@ -102,18 +102,16 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
             size_t i = lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0;
             real4 ok, dk;
             RAY_AT(i, ok, dk);
-            ((real *)&o[p].x)[k] = ok.x; ((real *)&o[p].y)[k] = ok.y;
-            ((real *)&o[p].z)[k] = ok.z; ((real *)&o[p].w)[k] = ok.w;
-            ((real *)&d[p].x)[k] = dk.x; ((real *)&d[p].y)[k] = dk.y;
-            ((real *)&d[p].z)[k] = dk.z; ((real *)&d[p].w)[k] = dk.w;
-            ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
+            SET_LANE_QUAT(o[p], k, ok);
+            SET_LANE_QUAT(d[p], k, dk);
+            MASK_LANE(valid, k) = lane_index[p][k] < (size_t)n_items ? -1 : 0;
         }
 #else
         lreal u, v;
         for (int k = 0; k < LANES; ++k) {  /* each lane's place on the image plane */
             size_t i = lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0;
-            RAY_UV(i, ((real *)&u)[k], ((real *)&v)[k]);
-            ((mask_t *)&valid)[k] = lane_index[p][k] < (size_t)n_items ? -1 : 0;
+            RAY_UV(i, LANE(u, k), LANE(v, k));
+            MASK_LANE(valid, k) = lane_index[p][k] < (size_t)n_items ? -1 : 0;
         }
         o[p] = QUAT_UNIFORM(eye);
         d[p] = camera_dirs(u, v, forward, right, up);
@@ -144,8 +142,8 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
 #else
         for (int k = 0; k < LANES; ++k) {
             real2 cv = cone[CONE_AT(lane_index[p][k] < (size_t)n_items ? lane_index[p][k] : i0)];
-            ((real *)&t_lo)[k] = cv.x;
-            ((real *)&t_last)[k] = cv.y;
+            LANE(t_lo, k) = cv.x;
+            LANE(t_last, k) = cv.y;
         }
 #endif
         coned[p] = live[p] & (t_last > near[p]) & (near[p] >= t_lo) & (t_last < far[p]);
@@ -197,19 +195,17 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
             size_t i = lane_index[p][k];
             if (i >= (size_t)n_items)
                 continue;
-            real tk = ((real *)&t[p])[k];
-            int sk = ((mask_t *)&st[p])[k];
-            real4 ok = (real4)(((real *)&o[p].x)[k], ((real *)&o[p].y)[k], ((real *)&o[p].z)[k],
-                               ((real *)&o[p].w)[k]);
-            real4 dk = (real4)(((real *)&d[p].x)[k], ((real *)&d[p].y)[k], ((real *)&d[p].z)[k],
-                               ((real *)&d[p].w)[k]);
+            real tk = LANE(t[p], k);
+            int sk = MASK_LANE(st[p], k);
+            real4 ok = LANE_QUAT(o[p], k);
+            real4 dk = LANE_QUAT(d[p], k);
             depth[i] = tk;
             point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
             status[i] = sk;
-            samples[i] = ((mask_t *)&n[p])[k];
-            flags[i] = ((mask_t *)&fl[p])[k];
-            bracket[i] = sk == STATUS_HIT ? ((real *)&width[p])[k] : INFINITY;
-            unresolved[i] = ((real *)&unres[p])[k];
+            samples[i] = MASK_LANE(n[p], k);
+            flags[i] = MASK_LANE(fl[p], k);
+            bracket[i] = sk == STATUS_HIT ? LANE(width[p], k) : INFINITY;
+            unresolved[i] = LANE(unres[p], k);
         }
 #endif
     }

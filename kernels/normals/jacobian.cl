@@ -141,8 +141,7 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
         int hit = status[i] == STATUS_HIT;
         any_hit |= hit;
         real4 pk = hit ? point[i] : (real4)(0);
-        ((real *)&p.x)[k] = pk.x; ((real *)&p.y)[k] = pk.y;
-        ((real *)&p.z)[k] = pk.z; ((real *)&p.w)[k] = pk.w;
+        SET_LANE_QUAT(p, k, pk);
     }
     lmask guard = 0;
     lreal nx = 0, ny = 0, nz = 0;
@@ -151,8 +150,8 @@ PACKET_KERNEL void normals_jacobian(const int n_items, __global const real4 *poi
     for (int k = 0; k < LANES && i0 + k < (size_t)n_items; ++k) {   /* scatter */
         size_t i = i0 + k;
         int hit = status[i] == STATUS_HIT;
-        normal[i] = hit ? (real4)(((real *)&nx)[k], ((real *)&ny)[k], ((real *)&nz)[k], 0) : (real4)(0);
-        int g = (int)((mask_t *)&guard)[k];
+        normal[i] = hit ? (real4)(LANE(nx, k), LANE(ny, k), LANE(nz, k), 0) : (real4)(0);
+        int g = (int)MASK_LANE(guard, k);
         if (hit && g)
             flags[i] |= g;
     }

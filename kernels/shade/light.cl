@@ -260,12 +260,10 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
             real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
             real4 nk = nc.x * right + nc.y * up - nc.z * forward;
             real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
-            ((real *)&pin[b].x)[k] = ik.x; ((real *)&pin[b].y)[k] = ik.y;
-            ((real *)&pin[b].z)[k] = ik.z; ((real *)&pin[b].w)[k] = ik.w;
-            ((real *)&p[b].x)[k] = pk.x; ((real *)&p[b].y)[k] = pk.y; ((real *)&p[b].z)[k] = pk.z; ((real *)&p[b].w)[k] = pk.w;
-            ((real *)&nw[b].x)[k] = nk.x; ((real *)&nw[b].y)[k] = nk.y;
-            ((real *)&nw[b].z)[k] = nk.z; ((real *)&nw[b].w)[k] = nk.w;
-            ((mask_t *)&hit[b])[k] = h ? -1 : 0;
+            SET_LANE_QUAT(pin[b], k, ik);
+            SET_LANE_QUAT(p[b], k, pk);
+            SET_LANE_QUAT(nw[b], k, nk);
+            MASK_LANE(hit[b], k) = h ? -1 : 0;
         }
     }
 #endif
@@ -372,13 +370,13 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
             if (i >= (size_t)n_items)
                 continue;
             terms[i] = status[i] == STATUS_HIT
-                           ? (float4)((float)((real *)&vis[b])[k], (float)((real *)&amb[b])[k],
-                                      (float)((real *)&val[b])[k], 0.0f)
+                           ? (float4)((float)LANE(vis[b], k), (float)LANE(amb[b], k),
+                                      (float)LANE(val[b], k), 0.0f)
                            : (float4)(1, 1, 0, 0);
 #ifdef EXTRA_SHADOWS
             vis_extra[i] = status[i] == STATUS_HIT
-                           ? (float4)((float)((real *)&ve[0][b])[k], (float)((real *)&ve[1][b])[k],
-                                      (float)((real *)&ve[2][b])[k], 0.0f)
+                           ? (float4)((float)LANE(ve[0][b], k), (float)LANE(ve[1][b], k),
+                                      (float)LANE(ve[2][b], k), 0.0f)
                            : (float4)(1, 1, 1, 0);
 #endif
         }
