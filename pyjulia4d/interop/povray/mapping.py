@@ -64,8 +64,28 @@ def _vec(v) -> list[float]:
     return [_num(x) for x in v]
 
 
+class Converted:
+    """What ``convert`` builds: the scene dict, a comment per dotted key, the header's notes
+    and the warnings."""
+
+    def __init__(self, warnings):
+        self.data: dict[str, dict[str, Any]] = {}
+        self.notes: dict[str, str] = {}
+        self.header: list[str] = []
+        self.warns = list(warnings)
+
+    def put(self, key: str, value: Any, note: str | None = None) -> None:
+        section, _, k = key.partition(".")
+        self.data.setdefault(section, {})[k] = value
+        if note:
+            self.notes[key] = note
+
+
 def convert(r: SceneReader, width: int, height: int) -> tuple[dict, dict, list[str], list[str]]:
-    """The scene dict, comments per dotted key, header notes and warnings."""
+    """The scene dict, comments per dotted key, header notes and warnings: the julia_fractal's
+    fractal, the camera in fractal space then in pyjulia4d's camera coordinates (through the
+    object's inverse transform and the slice), the march from POV-Ray's precision, and the
+    shading from its pigment, finish and light."""
     where = r.where
     if not r.julias:
         declared = [n for n, s in r.symbols.items() if s[0] == "julia_fractal"]
@@ -76,56 +96,65 @@ def convert(r: SceneReader, width: int, height: int) -> tuple[dict, dict, list[s
         raise PovError(f"{where}:{r.julias[1].line}: a second julia_fractal (the first is at line "
                        f"{r.julias[0].line}): pyjulia4d renders one")
     j = r.julias[0]
-    data: dict[str, dict[str, Any]] = {}
-    notes: dict[str, str] = {}
-    header: list[str] = []
-    warns = list(r.warnings)
+    out = Converted(r.warnings)
+    inv, smap = j.transform.inverse(), SliceMap(j.slice_normal, j.slice_distance)
+    map_fractal(j, where, out)
+    map_camera(r, j, inv, smap, width, height, out)
+    map_march(j, out)
+    map_shading(r, j, inv, smap, out)
+    out.put("image.width", width)
+    out.put("image.height", height)
+    if r.ignored:
+        out.header.append("Not read: " + ", ".join(r.ignored) + ".")
+    if r.includes:
+        out.header.append("#include files not read: " + ", ".join(r.includes) + ".")
+    return out.data, out.notes, out.header, out.warns
 
-    def put(key: str, value: Any, note: str | None = None) -> None:
-        section, _, k = key.partition(".")
-        data.setdefault(section, {})[k] = value
-        if note:
-            notes[key] = note
 
-    # -- fractal
-    put("fractal.algebra", j.algebra)
+def map_fractal(j, where: str, out: Converted) -> None:
+    """The algebra, function, c, iterations (POV-Ray tests n = 0..max_iteration - 1) and
+    POV-Ray's own escape radius."""
+    out.put("fractal.algebra", j.algebra)
     if j.function not in ("sqr", "cube") and j.algebra == "quaternion":
         raise PovError(f"{where}:{j.line}: julia_fractal: quaternion takes sqr and cube only (POV-Ray: "
                        f"\"Illegal function\"); add hypercomplex for {j.function}")
-    put("fractal.function", j.function)
+    out.put("fractal.function", j.function)
     if j.function == "pwr":
-        put("fractal.exponent", _vec(j.exponent), f"pwr({j.exponent[0]:g}, {j.exponent[1]:g})")
-    put("fractal.c", _vec(j.c))
+        out.put("fractal.exponent", _vec(j.exponent), f"pwr({j.exponent[0]:g}, {j.exponent[1]:g})")
+    out.put("fractal.c", _vec(j.c))
     n = j.max_iteration
     if n < 2:
         raise PovError(f"{where}:{j.line}: max_iteration {n}: POV-Ray then tests the start point only "
                        f"(a ball); pyjulia4d iterates at least once, which is POV-Ray's max_iteration 2")
-    put("fractal.max_iter", n - 1,
+    out.put("fractal.max_iter", n - 1,
         f"max_iteration {n}{'' if 'max_iteration' in j.given else ' (POV-Ray default)'}: POV-Ray tests "
         f"|q_n| for n = 0..{n - 1}, pyjulia4d for n = 0..max_iter")
     bail = pov_escape_radius(j.algebra, j.c)
-    put("fractal.bailout", bail,
+    out.put("fractal.bailout", bail,
         "POV-Ray's escape radius: 4 for hypercomplex" if j.algebra == "hypercomplex" else
         "POV-Ray's quaternion escape radius sqrt(R^2 + 1e-7), R = min(2, 1 + |c| + 1e-7) "
         "(fractal.cpp), not the documented 4")
 
-    # -- the camera, in fractal space, then in pyjulia4d camera coordinates
-    inv = j.transform.inverse()
-    smap = SliceMap(j.slice_normal, j.slice_distance)
+
+def map_camera(r: SceneReader, j, inv, smap: SliceMap, width: int, height: int, out: Converted) -> None:
+    """The slice, and the last camera statement's location, direction, up and right in fractal
+    space, then in pyjulia4d's camera coordinates: position, target, up, limbo (which way
+    right points) and the vertical field of view."""
+    where = r.where
     if j.slice_normal != (0.0, 0.0, 0.0, 1.0) or j.slice_distance != 0:
-        put("slice.normal", _vec(j.slice_normal), f"slice {j.given.get('slice', '')} (normalised, as POV-Ray does)")
-        put("slice.distance", _num(j.slice_distance))
+        out.put("slice.normal", _vec(j.slice_normal), f"slice {j.given.get('slice', '')} (normalised, as POV-Ray does)")
+        out.put("slice.distance", _num(j.slice_distance))
         if not smap.exact:
-            warns.append(f"{where}:{j.line}: slice normal with x/y/z components: POV-Ray draws the section "
+            out.warns.append(f"{where}:{j.line}: slice normal with x/y/z components: POV-Ray draws the section "
                          f"sheared (its 3D point X is the 4D point (X, (d - n.X)/n_t)); pyjulia4d draws it "
                          f"undistorted, seen from the same 4D eye and target: the pictures differ by that shear")
-            header.append("The slice normal has x/y/z components: the hyperplane, eye, target and light are "
+            out.header.append("The slice normal has x/y/z components: the hyperplane, eye, target and light are "
                           "POV-Ray's; POV-Ray's picture is the section sheared by its projection along w, "
                           "this one is undistorted.")
     cam = r.cameras[-1] if r.cameras else Camera(0, np.zeros(3), np.array([0.0, 0, 1]), np.array([0.0, 1, 0]),
                                                  np.array([POV_DEFAULT_RIGHT, 0, 0]))
     if len(r.cameras) > 1:
-        header.append(f"{len(r.cameras)} camera statements: the last one (line {cam.line}) is used, as in POV-Ray.")
+        out.header.append(f"{len(r.cameras)} camera statements: the last one (line {cam.line}) is used, as in POV-Ray.")
     loc = smap.point(inv.point(cam.location))
     dirv = smap.direction(inv.direction(cam.direction))
     up = smap.direction(inv.direction(cam.up))
@@ -139,12 +168,12 @@ def convert(r: SceneReader, width: int, height: int) -> tuple[dict, dict, list[s
         raise PovError(f"{where}:{cam.line}: camera: up is parallel to the view direction")
     cosines = [abs(a @ b) / (np.linalg.norm(a) * np.linalg.norm(b)) for a, b in ((dirv, up), (dirv, right), (up, right))]
     if max(cosines) > 1e-6 and smap.exact:
-        warns.append(f"{where}:{cam.line}: camera vectors are not perpendicular: POV-Ray's picture is skewed; "
+        out.warns.append(f"{where}:{cam.line}: camera vectors are not perpendicular: POV-Ray's picture is skewed; "
                      f"pyjulia4d's frame is made orthonormal (up is kept, right follows)")
     fov = math.degrees(2 * math.atan(np.linalg.norm(up_perp) / (2 * np.linalg.norm(dirv))))
     aspect = np.linalg.norm(right - (right @ dn) * dn) / np.linalg.norm(up_perp)
     if abs(aspect / (width / height) - 1) > 0.01:
-        warns.append(f"{where}:{cam.line}: camera |right|/|up| = {aspect:.4g} but the image is {width}x{height} "
+        out.warns.append(f"{where}:{cam.line}: camera |right|/|up| = {aspect:.4g} but the image is {width}x{height} "
                      f"({width / height:.4g}): POV-Ray would stretch its pixels; pyjulia4d's are square (the "
                      f"vertical field of view matches; give --width/--height in the ratio {aspect:.4g})")
     # which way pyjulia4d's right = cross4(forward, up, limbo) points, in world coordinates
@@ -155,71 +184,71 @@ def convert(r: SceneReader, width: int, height: int) -> tuple[dict, dict, list[s
     f_w, u_w, r_w = (smap.lift(inv.direction(v), False) for v in (cam.direction, cam.up, cam.right))
     handed = float(cross4(f_w, u_w, smap.n) @ r_w)
     src = f"line {cam.line}" if cam.line else "POV-Ray's default camera: location 0, looking along +z, right 1.33 x"
-    put("camera.position", _vec(loc), f"location ({src})")
-    put("camera.target", _vec(loc + dirv), "location + direction (after look_at)")
-    put("camera.up", _vec(up))
+    out.put("camera.position", _vec(loc), f"location ({src})")
+    out.put("camera.target", _vec(loc + dirv), "location + direction (after look_at)")
+    out.put("camera.up", _vec(up))
     if handed <= 0:
-        put("camera.limbo", [0.0, 0.0, 0.0, -1.0], "so that POV-Ray's right vector is pyjulia4d's right "
+        out.put("camera.limbo", [0.0, 0.0, 0.0, -1.0], "so that POV-Ray's right vector is pyjulia4d's right "
             "(a left-handed right vector, or a slice normal with negative w)")
-    put("camera.fov", fov, "full vertical angle: 2 atan(|up| / (2 |direction|)); POV-Ray's angle is horizontal")
+    out.put("camera.fov", fov, "full vertical angle: 2 atan(|up| / (2 |direction|)); POV-Ray's angle is horizontal")
     if not (np.array_equal(j.transform.a, np.eye(3)) and np.array_equal(j.transform.t, np.zeros(3))):
-        header.append("The julia_fractal's transform is applied inversely to the camera and the light.")
+        out.header.append("The julia_fractal's transform is applied inversely to the camera and the light.")
 
-    # -- march: POV-Ray's precision P steps at least 1/P
+
+def map_march(j, out: Converted) -> None:
+    """POV-Ray's precision P steps at least 1/P: the estimate's epsilon or the fixed scan's
+    resolution made no coarser than that."""
     from pyjulia4d.geometry.camera import march_radius
 
     step = 1.0 / j.precision
     prec = f"precision {j.given.get('precision', '20 (POV-Ray default)')}"
-    probe = Scene.from_dict({k: dict(v) for k, v in data.items()})
+    probe = Scene.from_dict({k: dict(v) for k, v in out.data.items()})
     if probe.fractal.algebra == "quaternion":
         if step < probe.march.epsilon:
-            put("march.epsilon", step, f"{prec}: POV-Ray's minimum step 1/P, finer than the default")
+            out.put("march.epsilon", step, f"{prec}: POV-Ray's minimum step 1/P, finer than the default")
         else:
-            header.append(f"{prec}: POV-Ray's march steps at least 1/P = {step:.4g}; pyjulia4d's default "
+            out.header.append(f"{prec}: POV-Ray's march steps at least 1/P = {step:.4g}; pyjulia4d's default "
                           f"march (distance estimate, minimum step march.epsilon = {probe.march.epsilon:g}, "
                           f"certified depth) is no coarser and is kept.")
     else:
         zres = math.ceil(2 * march_radius(probe) * j.precision)
         if zres > probe.march.z_resolution:
-            put("march.z_resolution", zres, f"{prec}: samples no farther apart than POV-Ray's step 1/P")
+            out.put("march.z_resolution", zres, f"{prec}: samples no farther apart than POV-Ray's step 1/P")
         else:
-            header.append(f"{prec}: POV-Ray's march steps at least 1/P = {step:.4g}; pyjulia4d's fixed "
+            out.header.append(f"{prec}: POV-Ray's march steps at least 1/P = {step:.4g}; pyjulia4d's fixed "
                           f"scan ({probe.march.z_resolution} samples across the bounding ball, at most "
                           f"{2 * march_radius(probe) / probe.march.z_resolution:.3g} apart, certified depth) "
                           f"is no coarser and is kept.")
 
-    # -- shading
+
+def map_shading(r: SceneReader, j, inv, smap: SliceMap, out: Converted) -> None:
+    """The pigment, the finish (POV-Ray 3.7's defaults for what it leaves out), the first light
+    source and its shadows, and the background."""
+    where = r.where
     if j.color is not None:
-        put("shading.color", _vec(j.color), "pigment")
+        out.put("shading.color", _vec(j.color), "pigment")
     else:
-        header.append("No pigment: POV-Ray would draw the object black; pyjulia4d's default colour is kept.")
+        out.header.append("No pigment: POV-Ray would draw the object black; pyjulia4d's default colour is kept.")
     if j.finish is not None:
         f = {**POV_FINISH, **j.finish}
-        put("shading.ambient", f["ambient"], "finish (POV-Ray 3.7 defaults for what it leaves out)")
-        put("shading.diffuse", f["diffuse"])
-        put("shading.specular", f["specular"])
-        put("shading.shininess", 1.0 / f["roughness"], "1 / roughness")
+        out.put("shading.ambient", f["ambient"], "finish (POV-Ray 3.7 defaults for what it leaves out)")
+        out.put("shading.diffuse", f["diffuse"])
+        out.put("shading.specular", f["specular"])
+        out.put("shading.shininess", 1.0 / f["roughness"], "1 / roughness")
     if r.lights:
         lt = r.lights[0]
         if len(r.lights) > 1:
-            warns.append(f"{where}:{r.lights[1].line}: {len(r.lights)} light sources: pyjulia4d has one light, "
+            out.warns.append(f"{where}:{r.lights[1].line}: {len(r.lights)} light sources: pyjulia4d has one light, "
                          f"the first (line {lt.line}) is used")
-        put("shading.light", _vec(smap.point(inv.point(lt.position))), f"light_source (line {lt.line})")
-        put("shading.light_color", _vec(lt.color))
+        out.put("shading.light", _vec(smap.point(inv.point(lt.position))), f"light_source (line {lt.line})")
+        out.put("shading.light_color", _vec(lt.color))
         if lt.shadowless or j.no_shadow:
-            put("shading.shadow", "none", "shadowless" if lt.shadowless else "no_shadow on the julia_fractal")
+            out.put("shading.shadow", "none", "shadowless" if lt.shadowless else "no_shadow on the julia_fractal")
         else:
-            put("shading.shadow", "hard", "POV-Ray's point light casts hard shadows")
-        put("shading.ao", 0.0, "POV-Ray has no ambient occlusion (without radiosity)")
+            out.put("shading.shadow", "hard", "POV-Ray's point light casts hard shadows")
+        out.put("shading.ao", 0.0, "POV-Ray has no ambient occlusion (without radiosity)")
     else:
-        header.append("No light_source: POV-Ray would show ambient light only; pyjulia4d's default lighting "
+        out.header.append("No light_source: POV-Ray would show ambient light only; pyjulia4d's default lighting "
                       "(its light, shadows and ambient occlusion) is kept.")
     if r.background is not None:
-        put("shading.background", _vec(r.background[:3]), "background")
-    put("image.width", width)
-    put("image.height", height)
-    if r.ignored:
-        header.append("Not read: " + ", ".join(r.ignored) + ".")
-    if r.includes:
-        header.append("#include files not read: " + ", ".join(r.includes) + ".")
-    return data, notes, header, warns
+        out.put("shading.background", _vec(r.background[:3]), "background")
