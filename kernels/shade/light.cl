@@ -216,6 +216,151 @@ inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 }
 #endif
 
+#if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
+/* vis: the positioned light's visibility from each packet's points o (off the surface,
+ * outside), a hit facing away from it its own shadow */
+inline void key_light_shadows(const quat *o, const quat *p, const quat *nw, const lmask *hit, real4 light_pos,
+                              julia_params jp, real radius, real step, real softness, int max_steps, lreal *vis)
+{
+    quat lp = QUAT_UNIFORM(light_pos);
+    quat l[PACKETS];
+    lreal dist[PACKETS];
+    lmask facing[PACKETS];
+    for (int b = 0; b < PACKETS; ++b) {
+        quat lv = QADD(lp, QSCALE((lreal)-1, o[b]));
+        dist[b] = QLEN(lv);
+        l[b] = QSCALE((real)1 / fmax(dist[b], REAL_MIN), lv);
+        facing[b] = hit[b] & LIGHT_FACES(nw[b], QADD(lp, QSCALE((lreal)-1, p[b])));
+    }
+#ifdef LIGHT_PAIRS
+    shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, vis);
+#else
+    for (int b = 0; b < PACKETS; ++b)
+        vis[b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
+#endif
+}
+#endif
+
+#ifdef EXTRA_SHADOWS
+/* ve[j]: shading.lights' visibility, the same shadow ray towards each (a distant one: along
+ * its direction, out of the bounding ball) */
+inline void extra_light_shadows(const quat *o, const quat *p, const quat *nw, const lmask *hit,
+                                __global const real4 *lights_geo, __global const float4 *lights_rgb, real4 right,
+                                real4 up, real4 forward, julia_params jp, real radius, real step, real softness,
+                                int max_steps, lreal (*ve)[PACKETS])
+{
+    for (int j = 0; j < EXTRA_LIGHTS; ++j) {
+        real4 g = lights_geo[j];
+        quat gq = QUAT_UNIFORM(g);
+        quat l[PACKETS];
+        lreal dist[PACKETS];
+        lmask facing[PACKETS];
+        for (int b = 0; b < PACKETS; ++b) {
+            quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
+            if (lights_rgb[j].w != 0.0f) {
+                lv = to = gq;
+                dist[b] = (lreal)INFINITY;
+            } else {
+                lv = QADD(gq, QSCALE((lreal)-1, o[b]));
+                to = QADD(gq, QSCALE((lreal)-1, p[b]));
+                dist[b] = QLEN(lv);
+            }
+            l[b] = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
+            /* a light with no direction in the rays' 3D space: shade.cl lights along the
+             * view instead, which every hit faces */
+            lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
+                         (QDOT_UNIFORM(to, forward) == (real)0);
+            facing[b] = hit[b] & (LIGHT_FACES(nw[b], to) | flat);
+        }
+#ifdef LIGHT_PAIRS
+        shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, ve[j]);
+#else
+        for (int b = 0; b < PACKETS; ++b)
+            ve[j][b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
+#endif
+    }
+}
+#endif
+
+/* val: the colour map's value (shading.coloring): the smooth escape count of the bracket's
+ * inside end, the orbit trap, or w over [-R/2, R/2] (the visible range) */
+inline void colour_values(const quat *p, const quat *pin, julia_params jp, real radius, real4 trap, lreal *val)
+{
+    for (int b = 0; b < PACKETS; ++b) {
+#if defined(COLOR_ITERATION)
+        val[b] = orbit_value(pin[b], jp);
+#elif defined(COLOR_TRAP)
+        val[b] = orbit_value(p[b], jp, trap);
+#elif defined(COLOR_W)
+        val[b] = clamp((real)0.5 + p[b].w / radius, (real)0, (real)1);
+#endif
+    }
+}
+
+#if LANES > 1
+/* The hits of a work-item's packets, lane by lane: the point, its camera normal turned back
+ * into 4D with the camera frame, the inside end of its bracket (point + bracket along the ray
+ * from the eye), and whether it is one.  A miss or a lane past the edge takes ``away``, a
+ * point whose orbit leaves the bailout ball at once, as do its occlusion points: at the
+ * origin (inside many sets) its estimates ran to max_iter and held its packet's loops that long. */
+inline void light_gather(const size_t (*lane_index)[LANES], int n_items, __global const real4 *point,
+                         __global const real4 *normal, __global const int *status, __global const real *bracket,
+                         real4 eye, real4 right, real4 up, real4 forward, real4 away, quat *p, quat *nw, quat *pin,
+                         lmask *hit)
+{
+    for (int b = 0; b < PACKETS; ++b) {
+        for (int k = 0; k < LANES; ++k) {
+            size_t i = lane_index[b][k];
+            int h = i < (size_t)n_items && status[i] == STATUS_HIT;
+            real4 pk = h ? point[i] : away;
+            real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
+            real4 nk = nc.x * right + nc.y * up - nc.z * forward;
+            real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
+            SET_LANE_QUAT(pin[b], k, ik);
+            SET_LANE_QUAT(p[b], k, pk);
+            SET_LANE_QUAT(nw[b], k, nk);
+            MASK_LANE(hit[b], k) = h ? -1 : 0;
+        }
+    }
+}
+
+/* Each lane's terms written to its pixel: (1, 1, 0, 0) off hits */
+inline void light_scatter(const size_t (*lane_index)[LANES], int n_items, __global const int *status,
+                          const lreal *vis, const lreal *amb, const lreal *val, __global float4 *terms)
+{
+    for (int b = 0; b < PACKETS; ++b) {
+        for (int k = 0; k < LANES; ++k) {
+            size_t i = lane_index[b][k];
+            if (i >= (size_t)n_items)
+                continue;
+            terms[i] = status[i] == STATUS_HIT
+                           ? (float4)((float)LANE(vis[b], k), (float)LANE(amb[b], k),
+                                      (float)LANE(val[b], k), 0.0f)
+                           : (float4)(1, 1, 0, 0);
+        }
+    }
+}
+
+#ifdef EXTRA_SHADOWS
+/* Each lane's visibility of shading.lights written to its pixel: (1, 1, 1, 0) off hits */
+inline void extra_scatter(const size_t (*lane_index)[LANES], int n_items, __global const int *status,
+                          lreal (*ve)[PACKETS], __global float4 *vis_extra)
+{
+    for (int b = 0; b < PACKETS; ++b) {
+        for (int k = 0; k < LANES; ++k) {
+            size_t i = lane_index[b][k];
+            if (i >= (size_t)n_items)
+                continue;
+            vis_extra[i] = status[i] == STATUS_HIT
+                           ? (float4)((float)LANE(ve[0][b], k), (float)LANE(ve[1][b], k),
+                                      (float)LANE(ve[2][b], k), 0.0f)
+                           : (float4)(1, 1, 1, 0);
+        }
+    }
+}
+#endif
+#endif
+
 /* terms[i] = (visibility, ambient factor, colour value, 0) of hit i (normal in camera
  * coordinates: right, up, towards the eye; turned back into 4D with the camera frame;
  * the inside end of the bracket is point + bracket along the ray from the eye). */
@@ -248,24 +393,8 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     nw[0] = nc.x * right + nc.y * up - nc.z * forward;
     pin[0] = p[0] + bracket[i0] * normalize(p[0] - eye);
 #else
-    /* a miss or a lane past the edge takes a point whose orbit leaves the bailout ball at once,
-     * as do its occlusion points: at the origin (inside many sets) its estimates ran to max_iter
-     * and held its packet's loops that long */
-    real4 away = (real4)((real)4 * (bailout + radius + ao_distance), 0, 0, 0);
-    for (int b = 0; b < PACKETS; ++b) {
-        for (int k = 0; k < LANES; ++k) {   /* gather */
-            size_t i = lane_index[b][k];
-            int h = i < (size_t)n_items && status[i] == STATUS_HIT;
-            real4 pk = h ? point[i] : away;
-            real4 nc = h ? normal[i] : (real4)(0, 0, 1, 0);
-            real4 nk = nc.x * right + nc.y * up - nc.z * forward;
-            real4 ik = h ? pk + bracket[i] * normalize(pk - eye) : pk;
-            SET_LANE_QUAT(pin[b], k, ik);
-            SET_LANE_QUAT(p[b], k, pk);
-            SET_LANE_QUAT(nw[b], k, nk);
-            MASK_LANE(hit[b], k) = h ? -1 : 0;
-        }
-    }
+    light_gather(lane_index, n_items, point, normal, status, bracket, eye, right, up, forward,
+                 (real4)((real)4 * (bailout + radius + ao_distance), 0, 0, 0), p, nw, pin, hit);
 #endif
     lreal vis[PACKETS], amb[PACKETS], val[PACKETS];
 #ifdef EXTRA_SHADOWS
@@ -285,60 +414,11 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
         for (int b = 0; b < PACKETS; ++b)
             o[b] = QRAY(p[b], nw[b], (lreal)bias);
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
-        {
-            quat lp = QUAT_UNIFORM(light_pos);
-            quat l[PACKETS];
-            lreal dist[PACKETS];
-            lmask facing[PACKETS];
-            for (int b = 0; b < PACKETS; ++b) {
-                quat lv = QADD(lp, QSCALE((lreal)-1, o[b]));
-                dist[b] = QLEN(lv);
-                l[b] = QSCALE((real)1 / fmax(dist[b], REAL_MIN), lv);
-                facing[b] = hit[b] & LIGHT_FACES(nw[b], QADD(lp, QSCALE((lreal)-1, p[b])));
-            }
-#ifdef LIGHT_PAIRS
-            shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, vis);
-#else
-            for (int b = 0; b < PACKETS; ++b)
-                vis[b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
-#endif
-        }
+        key_light_shadows(o, p, nw, hit, light_pos, jp, radius, step, softness, max_steps, vis);
 #endif
 #ifdef EXTRA_SHADOWS
-        /* shading.lights: the same shadow ray towards each (a distant one: along its direction,
-         * out of the bounding ball) */
-        {
-            for (int j = 0; j < EXTRA_LIGHTS; ++j) {
-                real4 g = lights_geo[j];
-                quat gq = QUAT_UNIFORM(g);
-                quat l[PACKETS];
-                lreal dist[PACKETS];
-                lmask facing[PACKETS];
-                for (int b = 0; b < PACKETS; ++b) {
-                    quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
-                    if (lights_rgb[j].w != 0.0f) {
-                        lv = to = gq;
-                        dist[b] = (lreal)INFINITY;
-                    } else {
-                        lv = QADD(gq, QSCALE((lreal)-1, o[b]));
-                        to = QADD(gq, QSCALE((lreal)-1, p[b]));
-                        dist[b] = QLEN(lv);
-                    }
-                    l[b] = QSCALE((real)1 / fmax(QLEN(lv), REAL_MIN), lv);
-                    /* a light with no direction in the rays' 3D space: shade.cl lights along the
-                     * view instead, which every hit faces */
-                    lmask flat = (QDOT_UNIFORM(to, right) == (real)0) & (QDOT_UNIFORM(to, up) == (real)0) &
-                                 (QDOT_UNIFORM(to, forward) == (real)0);
-                    facing[b] = hit[b] & (LIGHT_FACES(nw[b], to) | flat);
-                }
-#ifdef LIGHT_PAIRS
-                shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, ve[j]);
-#else
-                for (int b = 0; b < PACKETS; ++b)
-                    ve[j][b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
-#endif
-            }
-        }
+        extra_light_shadows(o, p, nw, hit, lights_geo, lights_rgb, right, up, forward, jp, radius, step, softness,
+                            max_steps, ve);
 #endif
 #ifdef AO
 #ifdef LIGHT_PAIRS
@@ -348,15 +428,7 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
             amb[b] = ambient_occlusion(o[b], nw[b], jp, ao_distance, ao_strength);
 #endif
 #endif
-        for (int b = 0; b < PACKETS; ++b) {
-#if defined(COLOR_ITERATION)
-            val[b] = orbit_value(pin[b], jp);
-#elif defined(COLOR_TRAP)
-            val[b] = orbit_value(p[b], jp, trap);
-#elif defined(COLOR_W)
-            val[b] = clamp((real)0.5 + p[b].w / radius, (real)0, (real)1);   /* w over [-R/2, R/2]: the visible range */
-#endif
-        }
+        colour_values(p, pin, jp, radius, trap, val);
     }
 #if LANES == 1
     terms[i0] = (float4)((float)vis[0], (float)amb[0], (float)val[0], 0.0f);
@@ -364,22 +436,9 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     vis_extra[i0] = (float4)((float)ve[0][0], (float)ve[1][0], (float)ve[2][0], 0.0f);
 #endif
 #else
-    for (int b = 0; b < PACKETS; ++b) {
-        for (int k = 0; k < LANES; ++k) {   /* scatter */
-            size_t i = lane_index[b][k];
-            if (i >= (size_t)n_items)
-                continue;
-            terms[i] = status[i] == STATUS_HIT
-                           ? (float4)((float)LANE(vis[b], k), (float)LANE(amb[b], k),
-                                      (float)LANE(val[b], k), 0.0f)
-                           : (float4)(1, 1, 0, 0);
+    light_scatter(lane_index, n_items, status, vis, amb, val, terms);
 #ifdef EXTRA_SHADOWS
-            vis_extra[i] = status[i] == STATUS_HIT
-                           ? (float4)((float)LANE(ve[0][b], k), (float)LANE(ve[1][b], k),
-                                      (float)LANE(ve[2][b], k), 0.0f)
-                           : (float4)(1, 1, 1, 0);
+    extra_scatter(lane_index, n_items, status, ve, vis_extra);
 #endif
-        }
-    }
 #endif
 }
