@@ -56,6 +56,57 @@
 #define CONE_ARGS
 #endif
 
+#ifdef CLIP
+/* Each half-space clip_n[k] . p <= clip_off[k] (k < n_clip) clips the ray's [near, far]; a ray
+ * parallel to a plane and outside it is dead.  Returns 1 + the plane that set near, 0 where the
+ * ball did (a hit there lies on that plane's cut face). */
+inline lmask clip_span(quat o, quat d, int n_clip, real4 clip_n0, real4 clip_n1, real4 clip_n2, real4 clip_n3,
+                       real4 clip_off, lreal *near, lreal *far, lmask *live)
+{
+    lmask cut = 0;
+    for (int k = 0; k < n_clip; ++k) {
+        real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
+        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
+        lreal dn = QDOT_UNIFORM(d, nk), on = QDOT_UNIFORM(o, nk) - off;
+        lreal tp = -on / dn;
+        *far = L_SEL(*far, fmin(*far, tp), dn > (real)0);
+        lmask raise = (dn < (real)0) & (tp > *near);
+        *near = L_SEL(*near, tp, raise);
+        cut = L_SEL(cut, (lmask)(k + 1), raise);
+        *live &= !((dn == (real)0) & (on > (real)0));
+    }
+    return cut;
+}
+#endif
+
+#if LANES > 1
+/* A packet's results written to its lanes' pixels (lane_index; a lane past the tile's edge is
+ * not written): depth, the hit point (NaN off hits), status, samples, guard flags, the
+ * certified bracket (+inf off hits) and the unresolved width. */
+inline void march_scatter(const size_t *lane_index, int n_items, quat o, quat d, lreal t, lmask st, lmask n,
+                          lmask fl, lreal width, lreal unres, __global real *depth, __global real4 *point,
+                          __global int *status, __global int *samples, __global int *flags,
+                          __global real *bracket, __global real *unresolved)
+{
+    for (int k = 0; k < LANES; ++k) {
+        size_t i = lane_index[k];
+        if (i >= (size_t)n_items)
+            continue;
+        real tk = LANE(t, k);
+        int sk = MASK_LANE(st, k);
+        real4 ok = LANE_QUAT(o, k);
+        real4 dk = LANE_QUAT(d, k);
+        depth[i] = tk;
+        point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
+        status[i] = sk;
+        samples[i] = MASK_LANE(n, k);
+        flags[i] = MASK_LANE(fl, k);
+        bracket[i] = sk == STATUS_HIT ? LANE(width, k) : INFINITY;
+        unresolved[i] = LANE(unres, k);
+    }
+}
+#endif
+
 /* -D PACKET_PAIRS (common/lanes.cl PACKETS; march/de.cl only): each work-item marches two
  * neighbouring blocks, their estimates side by side (march_ray_pair). */
 PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
@@ -118,18 +169,8 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
 #endif
         live[p] = valid & ball_span(o[p], d[p], radius, near_set, far_set, &near[p], &far[p]);
 #ifdef CLIP
-        cut[p] = 0;
-        for (int k = 0; k < n_clip; ++k) {
-            real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
-            real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
-            lreal dn = QDOT_UNIFORM(d[p], nk), on = QDOT_UNIFORM(o[p], nk) - off;
-            lreal tp = -on / dn;
-            far[p] = L_SEL(far[p], fmin(far[p], tp), dn > (real)0);
-            lmask raise = (dn < (real)0) & (tp > near[p]);
-            near[p] = L_SEL(near[p], tp, raise);
-            cut[p] = L_SEL(cut[p], (lmask)(k + 1), raise);
-            live[p] &= !((dn == (real)0) & (on > (real)0));
-        }
+        cut[p] = clip_span(o[p], d[p], n_clip, clip_n0, clip_n1, clip_n2, clip_n3, clip_off, &near[p], &far[p],
+                           &live[p]);
 #endif
         live[p] &= far[p] >= near[p];
         start[p] = near[p];
@@ -191,22 +232,8 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
         bracket[i0] = st[p] == STATUS_HIT ? width[p] : INFINITY;
         unresolved[i0] = unres[p];
 #else
-        for (int k = 0; k < LANES; ++k) {   /* scatter */
-            size_t i = lane_index[p][k];
-            if (i >= (size_t)n_items)
-                continue;
-            real tk = LANE(t[p], k);
-            int sk = MASK_LANE(st[p], k);
-            real4 ok = LANE_QUAT(o[p], k);
-            real4 dk = LANE_QUAT(d[p], k);
-            depth[i] = tk;
-            point[i] = sk == STATUS_HIT ? ok + tk * dk : (real4)(NAN);
-            status[i] = sk;
-            samples[i] = MASK_LANE(n[p], k);
-            flags[i] = MASK_LANE(fl[p], k);
-            bracket[i] = sk == STATUS_HIT ? LANE(width[p], k) : INFINITY;
-            unresolved[i] = LANE(unres[p], k);
-        }
+        march_scatter(lane_index[p], n_items, o[p], d[p], t[p], st[p], n[p], fl[p], width[p], unres[p], depth, point,
+                      status, samples, flags, bracket, unresolved);
 #endif
     }
 }
