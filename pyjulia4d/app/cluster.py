@@ -29,6 +29,7 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
+from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
 from pyjulia4d.scene.model import Scene
@@ -359,7 +360,6 @@ def fitted(client: Any, scene: Scene, device: str | None = None, force: bool = F
     return client.submit(fit_unit, scene, device, force, pure=False).result()
 
 
-_SHAPED = ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket", "unresolved")
 
 
 def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=None,
@@ -389,7 +389,7 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
         bar.close()
     first = next(iter(parts.values()))
     arrays = {}
-    for name in _SHAPED:
+    for name in OUTPUTS:   # every array a render can keep (workload.OUTPUTS_TABLE)
         a = getattr(first, name)
         if a is None:
             arrays[name] = None

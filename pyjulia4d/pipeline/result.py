@@ -12,6 +12,7 @@ import numpy as np
 
 from pyjulia4d.pipeline.codes import GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, \
     STATUS_HIT
+from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.scene.model import Scene
 
 if TYPE_CHECKING:
@@ -47,8 +48,7 @@ class RenderResult:
 
     def __repr__(self) -> str:
         h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
-        kept = [k for k in ("color", "alpha", "depth", "normal", "position", "status", "samples", "bracket")
-                if getattr(self, k) is not None]
+        kept = [k for k in OUTPUTS if getattr(self, k) is not None]
         return (f"RenderResult({w}x{h}, {100 * self.hit_fraction:.1f}% hit, {self.seconds:.3f} s on "
                 f"{self.device_name or '?'}, {self.lanes} rays per work-item, outputs {', '.join(kept)})")
 

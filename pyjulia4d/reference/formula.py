@@ -5,28 +5,37 @@ from __future__ import annotations
 
 import functools
 import importlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
 from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, KINDS_TABLE
+from pyjulia4d.scene.model import Fractal
+
+
+# The [fractal] keys that choose the map and the set (scene/model.Fractal: their meaning and
+# defaults, one source for both); c, max_iter and bailout are the march's record's
+# (pipeline/plan.MarchArgs), as the kernels take them.
+FORMULA_KEYS = ("algebra", "function", "exponent", "kind", "theta", "c_from", "c_to", "component", "locus_radius")
+_DEFAULT = {f.name: f.default for f in fields(Fractal) if f.name in FORMULA_KEYS}
 
 
 @dataclass(frozen=True)
 class Formula:
     """q -> f(q) + c in an algebra, with the interface iterate.cl uses: ALG_IN, ALG_C,
     ALG_NORM2, ALG_DOT, julia_f, julia_f_jvp and, where a distance estimate exists,
-    JULIA_DF2."""
-    algebra: str = "quaternion"
-    function: str = "sqr"
-    exponent: tuple[float, float] = (2.0, 0.0)
-    kind: str = "julia"        # the set (reference/kind/): "julia", "mandelbrot", "julia_stack"
-    theta: float = 0.0         # the rotation of Hart, Sandin & Kauffman 1989 §2.3, degrees (reference/kind/rotate.py)
-    c_from: tuple[float, float] = (-1.0, 0.0)   # a Julia set stack's c-line (reference/kind/julia_stack.py)
-    c_to: tuple[float, float] = (-0.1, 0.75)
-    component: str = "plus"    # the cubic locus's critical point (reference/kind/cubic_locus.py)
-    locus_radius: float = 2.0
+    JULIA_DF2; the kind's twin (kind_twin) and enclosures.  Its fields are the [fractal]
+    table's FORMULA_KEYS, with that table's defaults."""
+    algebra: str = _DEFAULT["algebra"]
+    function: str = _DEFAULT["function"]
+    exponent: tuple[float, float] = _DEFAULT["exponent"]
+    kind: str = _DEFAULT["kind"]
+    theta: float = _DEFAULT["theta"]
+    c_from: tuple[float, float] = _DEFAULT["c_from"]
+    c_to: tuple[float, float] = _DEFAULT["c_to"]
+    component: str = _DEFAULT["component"]
+    locus_radius: float = _DEFAULT["locus_radius"]
     alg: Any = field(init=False, repr=False, compare=False)
     fn: Any = field(init=False, repr=False, compare=False)
 
@@ -127,11 +136,12 @@ QUATERNION_SQR = Formula()
 
 
 def formula_of(fractal) -> Formula:
-    """The Formula of a scene's [fractal] table."""
-    return Formula(fractal.algebra, fractal.function, tuple(float(x) for x in fractal.exponent),
-                   fractal.kind, float(fractal.theta),
-                   c_from=tuple(float(x) for x in fractal.c_from), c_to=tuple(float(x) for x in fractal.c_to),
-                   component=fractal.component, locus_radius=float(fractal.locus_radius))
+    """The Formula of a scene's [fractal] table: its FORMULA_KEYS, numbers as floats."""
+    def plain(v):
+        if isinstance(v, str):
+            return v
+        return tuple(float(x) for x in v) if isinstance(v, (tuple, list)) else float(v)
+    return Formula(**{k: plain(getattr(fractal, k)) for k in FORMULA_KEYS})
 
 
 def complex_value(fn_name: str, z, exponent=(2.0, 0.0)):
