@@ -286,7 +286,7 @@ def measure(scene: Scene, res, tr: truth.Truth, normals: dict[str, np.ndarray]) 
     row.update(bracket_p50=bs["p50"], bracket_p99=bs["p99"], bracket_max=bs["max"])
     # the certified bracket against the truth: the crossing should lie in [depth, depth + bracket]
     br = res.bracket.astype(np.float64)[both]
-    slack = SLACK_ULPS * truth._ulp32(dep)
+    slack = SLACK_ULPS * truth.ulp32(dep)
     over = signed > slack                             # truth in front of the depth: stepped over
     after = -signed > br + slack                      # truth behind the bracket's inside end
     row["stepped_over"] = int(over.sum())

@@ -1,6 +1,6 @@
 """Is every algebra x function pair as accurate as it reports?  Each pair rendered at its
 defaults (camera.fit, the pair's own march) and every pixel's first crossing compared with
-a float64 brute force of the set (measure/truth.brute_force_depth: a chord scan at 2e-4,
+a float64 brute force of the set (measure/brute_force.brute_force_depth: a chord scan at 2e-4,
 a 2e-6 scan before each first inside sample, bisection).  The render's own inside ends, and
 points within four float32 spacings of them, are more samples for it (refine_truth): where the float64 set test finds one inside in front of
 the brute force's crossing, the chord scan stepped over a part there (the cubic locus's
@@ -41,7 +41,7 @@ if str(ROOT) not in sys.path:   # the checkout: its pyjulia4d, and benchmarks/ a
 from pyjulia4d import Scene, reference as ref, render  # noqa: E402
 from pyjulia4d.fractal.registry import FUNCTIONS_OF, march_method  # noqa: E402
 from pyjulia4d.geometry.camera import camera_frame  # noqa: E402
-from pyjulia4d.measure.truth import brute_force_depth, refine_depth  # noqa: E402
+from pyjulia4d.measure.brute_force import brute_force_depth, refine_depth  # noqa: E402
 from pyjulia4d.opencl.devices import select_device  # noqa: E402
 from benchmarks.lib.runlog import append_run, git_commit, utc_now  # noqa: E402
 from benchmarks.lib.args import Parser, size_of  # noqa: E402
@@ -81,7 +81,7 @@ END_SPACINGS = np.arange(-32, 33) / 8
 
 def refine_truth(s: Scene, truth: np.ndarray, results) -> tuple[np.ndarray, int]:
     """The truth with the renders' inside ends (depth + bracket of each hit, and points
-    within END_SPACINGS float32 spacings of it) as more samples (measure/truth.refine_depth:
+    within END_SPACINGS float32 spacings of it) as more samples (measure/brute_force.refine_depth:
     where the float64 set test finds one inside in front of the truth, the chord scan
     stepped over a part, and the crossing is searched again before it).  Returns (the truth,
     the pixels it moved)."""

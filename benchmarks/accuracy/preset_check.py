@@ -131,7 +131,7 @@ def measure(res, tr: truth.Truth) -> dict:
     signed = dep - tr.depth[both]
     err = np.abs(signed)
     br = res.bracket.astype(np.float64)[both]
-    slack = SLACK_ULPS * truth._ulp32(dep)
+    slack = SLACK_ULPS * truth.ulp32(dep)
     over = signed > slack
     bs = res.bracket_stats()
     return dict(n_both=int(both.sum()), silhouette_err=float(np.mean(hit != tr.hit)),

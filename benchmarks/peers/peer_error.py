@@ -14,7 +14,7 @@ each renderer runs at several settings, and each setting's error is measured:
   ``sin``, ``ln`` and ``pwr(2, 0.5)`` (settings_for: where a pair has no distance estimate,
   the scans and the proven march, with coarser scans besides).  pyjulia4d renders what ``import-pov`` makes of
   each, so both render the same truncated set (POV-Ray's escape radius and iteration count).
-* The truth: ``measure.truth.brute_force_depth`` (float64, a chord scan at 2e-4 through the
+* The truth: ``measure.brute_force.brute_force_depth`` (float64, a chord scan at 2e-4 through the
   bounding ball, a scan at 2e-6 over the chord before the first inside sample, bisection) on
   ``--samples`` pixels drawn at random, the same pixels for every row.
 * POV-Ray's depth: the same scene with the fractal's pigment replaced by a function of the
@@ -302,7 +302,7 @@ def run_scene(name: str, w: int, h: int, samples: int, repeats: int, renders: in
     from pyjulia4d import reference as ref
     from pyjulia4d.geometry.camera import camera_frame
     from pyjulia4d.interop.povray import import_pov
-    from pyjulia4d.measure.truth import brute_force_depth
+    from pyjulia4d.measure.brute_force import brute_force_depth
 
     toml = tmp / "scene.toml"
     if name in mb_depth.SCENES:

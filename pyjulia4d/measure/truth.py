@@ -52,6 +52,7 @@ from pyjulia4d.opencl.executor import render
 from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.fractal.registry import has_distance_estimate
+from pyjulia4d.measure.ray_scan import bisect, first_inside, ray_interval
 
 
 # ------------------------------------------------------------------ c = 0
@@ -111,48 +112,6 @@ def _complex_inside(z, c1, max_iter, bailout):
     return out.reshape(shape)
 
 
-def _ray_interval(o, d, radius):
-    b = np.sum(o * d, -1)
-    disc = b * b - (np.sum(o * o, -1) - radius ** 2)
-    s = np.sqrt(np.maximum(disc, 0.0))
-    near = np.maximum(-b - s, 0.0)
-    far = -b + s
-    live = (disc >= 0) & (far >= near)
-    return near, far, live
-
-
-def _first_inside(inside_fn, o, d, near, far, n_scan, chunk=512):
-    """Index of the first sample t_i = near + i (far - near)/n_scan, i = 0..n_scan,
-    for which inside_fn is true; -1 if none.  Vectorised over rays, in chunks of
-    samples, so rays that hit stop early."""
-    n = len(o)
-    first = np.full(n, -1, np.int64)
-    h = (far - near) / n_scan
-    active = np.arange(n)
-    for i0 in range(0, n_scan + 1, chunk):
-        if active.size == 0:
-            break
-        i = np.arange(i0, min(i0 + chunk, n_scan + 1))
-        t = near[active, None] + i[None, :] * h[active, None]
-        p = o[active, None, :] + t[..., None] * d[active, None, :]
-        ins = inside_fn(p)
-        got = ins.any(1)
-        first[active[got]] = i0 + np.argmax(ins[got], 1)
-        active = active[~got]
-    return first
-
-
-def _bisect(inside_fn, o, d, t_out, t_in, steps=60):
-    """Shrink brackets [t_out (outside), t_in (inside)] to float64 resolution."""
-    t_out, t_in = t_out.copy(), t_in.copy()
-    for _ in range(steps):
-        mid = 0.5 * (t_out + t_in)
-        ins = inside_fn(o + mid[:, None] * d)
-        t_in = np.where(ins, mid, t_in)
-        t_out = np.where(ins, t_out, mid)
-    return t_in
-
-
 def real_c_depth(origins, dirs, c1, max_iter, bailout, near=None, far=None,
                  n_scan=8000, radius=None, record=None):
     """Real c = (c1, 0, 0, 0): depth along each unit ray o + t d to the first point of
@@ -170,7 +129,7 @@ def real_c_depth(origins, dirs, c1, max_iter, bailout, near=None, far=None,
     d = np.asarray(dirs, np.float64)
     if radius is None:
         radius = bounding_radius((c1, 0, 0, 0), bailout, max_iter)
-    nr, fr_, live = _ray_interval(o, d, radius)
+    nr, fr_, live = ray_interval(o, d, radius)
     if near is not None:
         nr = np.full(len(o), float(near))
     if far is not None:
@@ -181,13 +140,13 @@ def real_c_depth(origins, dirs, c1, max_iter, bailout, near=None, far=None,
     k = np.nonzero(live)[0]
     results = []
     for n in (n_scan, 2 * n_scan):
-        first = _first_inside(inside, o[k], d[k], nr[k], fr_[k], n)
+        first = first_inside(inside, o[k], d[k], nr[k], fr_[k], n)
         t = np.full(len(k), np.inf)
         h = (fr_[k] - nr[k]) / n
         at0 = first == 0
         t[at0] = nr[k][at0]
         ok = first > 0
-        t[ok] = _bisect(inside, o[k][ok], d[k][ok], nr[k][ok] + (first[ok] - 1) * h[ok],
+        t[ok] = bisect(inside, o[k][ok], d[k][ok], nr[k][ok] + (first[ok] - 1) * h[ok],
                         nr[k][ok] + first[ok] * h[ok])
         results.append(t)
     coarse, fine = results
@@ -217,7 +176,7 @@ class ConvergedDepth:
     confirm: int = 1
 
 
-def _ulp32(t):
+def ulp32(t):
     """Spacing of float32 numbers at |t| (at least float32's smallest normal)."""
     t = np.abs(np.asarray(t, np.float64)).astype(np.float32)
     return (np.nextafter(t, np.float32(np.inf)) - t).astype(np.float64) + 1e-38
@@ -247,13 +206,13 @@ def _refine_first(inside_fn, o, d, lo, hi, near=None, n_scan=256, steps=40, back
         lo[todo[out]] = x[out]
         stuck = ~out & (x <= near[todo])
         todo = todo[~out & ~stuck]
-    first = _first_inside(inside_fn, o, d, lo, hi, n_scan)
+    first = first_inside(inside_fn, o, d, lo, hi, n_scan)
     h = (hi - lo) / n_scan
     k = np.nonzero(first > 0)[0]
     if k.size:
         a = lo[k] + (first[k] - 1) * h[k]
         b = lo[k] + first[k] * h[k]
-        t[k] = _bisect(inside_fn, o[k], d[k], a, b, steps=steps)
+        t[k] = bisect(inside_fn, o[k], d[k], a, b, steps=steps)
         ok[k] = True
     return t, ok
 
@@ -278,7 +237,7 @@ def _polish(scene: Scene, depth32, hit, inside_fn=None):
         inside_fn = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)
     if k.size:
         tk = t[k]
-        delta = 2.0 * _ulp32(tk) + 1e-9
+        delta = 2.0 * ulp32(tk) + 1e-9
         lo, hi = np.maximum(tk - delta, 0.0), tk + delta
         tt, ok = _refine_first(inside_fn, o[k], d[k], lo, hi)
         out[k[ok]] = tt[ok]
@@ -489,83 +448,3 @@ def ground_truth(scene: Scene, n_scan: int = 8000, de_search: bool = True, **con
     tr = Truth(t.reshape(h, w), hit.reshape(h, w), n.reshape(h, w, 3), kind, rec)
     tr.seconds = time.perf_counter() - t0
     return tr
-
-
-# ------------------------------------------------------------------ any pair, by brute force
-
-def brute_force_depth(scene: Scene, origins, dirs, chord: float = 2e-4, fine: float = 2e-6,
-                      radius: float | None = None) -> np.ndarray:
-    """The first crossing of each unit ray o + t d into the scene's truncated set (inside
-    when |q_n| <= bailout for n = 0..max_iter, its float64 twin ``reference.julia_inside``
-    with the scene's algebra, function and kind), +inf where none: a chord scan at spacing
-    at most ``chord`` through the bounding ball (bounds.bounding_radius, ``radius``), then a
-    scan at ``fine`` back over the chord before the first inside sample, then bisection to
-    float64 resolution.  It steps over parts of the set thinner than ``chord`` along a ray
-    that the fine scan does not reach: a truth for the thickness it resolves, whatever
-    march a render used; no distance estimate, no kernel."""
-    from pyjulia4d.geometry.camera import march_radius
-
-    f = scene.fractal
-    F = ref.formula_of(f)
-    o, d = np.asarray(origins, np.float64), np.asarray(dirs, np.float64)
-
-    def inside(p):
-        return ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)
-
-    R = march_radius(scene) if radius is None else radius
-    near, far, live = _ray_interval(o, d, R)
-    out = np.full(len(o), np.inf)
-    idx = np.nonzero(live)[0]
-    if idx.size == 0:
-        return out
-    n_scan = max(1, int(np.ceil(float(np.max(far[idx] - near[idx])) / chord)))
-    first = _first_inside(inside, o[idx], d[idx], near[idx], far[idx], n_scan)
-    hit = first >= 0
-    k = idx[hit]
-    if k.size == 0:
-        return out
-    h = (far[k] - near[k]) / n_scan
-    t_in = near[k] + first[hit] * h
-    out[k] = _crossing_before(inside, o[k], d[k], np.maximum(t_in - h, near[k]), t_in, fine)
-    return out
-
-
-def _crossing_before(inside, o, d, t_lo, t_in, fine):
-    """The first crossing in [t_lo, t_in], t_in inside: a scan at ``fine``, then bisection;
-    t_lo itself where it is inside already (the ray's entry, or the eye)."""
-    n_fine = max(1, int(np.ceil(float(np.max(t_in - t_lo)) / fine)))
-    j = _first_inside(inside, o, d, t_lo, t_in, n_fine)   # never -1: t_in is inside
-    j = np.where(j < 0, n_fine, j)
-    hf = (t_in - t_lo) / n_fine
-    t_hit = t_lo + j * hf
-    at_start = j == 0
-    t_out = np.where(at_start, t_hit, t_hit - hf)
-    polished = _bisect(inside, o, d, t_out, t_hit)
-    return np.where(at_start, t_hit, polished)
-
-
-def refine_depth(scene: Scene, origins, dirs, truth, t_inside, chord: float = 2e-4, fine: float = 2e-6,
-                 radius: float | None = None) -> tuple[np.ndarray, int]:
-    """brute_force_depth's ``truth`` with more samples: per ray, a point ``t_inside`` (from
-    anywhere: a render's inside end) that lies in front of the truth and that the float64
-    set test finds inside proves the chord scan stepped over a part there; the crossing is
-    then found by the fine scan over the chord before it and bisection, as brute_force_depth
-    does after its own inside sample.  Returns (the earlier of the two per ray, how many rays
-    moved)."""
-    from pyjulia4d.geometry.camera import march_radius
-
-    f = scene.fractal
-    F = ref.formula_of(f)
-    o, d = np.asarray(origins, np.float64), np.asarray(dirs, np.float64)
-    t = np.asarray(t_inside, np.float64)
-    out = np.array(truth, np.float64)
-    near, far, live = _ray_interval(o, d, march_radius(scene) if radius is None else radius)
-    with np.errstate(invalid="ignore"):
-        k = np.nonzero(live & np.isfinite(t) & (t < out) & (t >= near) & (t <= far))[0]
-    if k.size:
-        k = k[ref.julia_inside(o[k] + t[k, None] * d[k], f.c, f.max_iter, f.bailout, F)]
-    if k.size == 0:
-        return out, 0
-    inside = lambda p: ref.julia_inside(p, f.c, f.max_iter, f.bailout, F)  # noqa: E731
-    out[k] = np.minimum(out[k], _crossing_before(inside, o[k], d[k], np.maximum(t[k] - chord, near[k]), t[k], fine))
-    return out, int(k.size)

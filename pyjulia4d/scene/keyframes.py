@@ -36,7 +36,8 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from pyjulia4d.geometry.vec4 import Degenerate, orthonormalise, unit_or_none
-from pyjulia4d.scene.model import CHECKS, Scene
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.ranges import CHECKS
 from pyjulia4d.scene.checks import SceneError, Integer, OrWord, Real, Vector, show, show_key
 from pyjulia4d.scene.text import override_key, override_list, read_scene_table
 

@@ -6,7 +6,10 @@ tests/interfaces/test_scene.py holds both to the checkers."""
 from __future__ import annotations
 
 from pyjulia4d.scene.checks import fmt
-from pyjulia4d.scene.model import Scene, key_names, valid_range
+from pyjulia4d.scene.model import Scene
+
+# One line per key: what it is, in the words of docs/scene-keys.md, shortened.
+from pyjulia4d.scene.ranges import key_names, valid_range
 
 # One line per key: what it is, in the words of docs/scene-keys.md, shortened.
 MEANINGS = {

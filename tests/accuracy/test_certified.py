@@ -49,7 +49,7 @@ def scene(name, march):
 def brute_force(s: Scene, n=6000):
     """First inside sample of an n-step scan over the march's interval, then 60 bisections
     (the set's own test, reference.julia_inside)."""
-    from pyjulia4d.measure.truth import _bisect, _first_inside, _ray_interval
+    from pyjulia4d.measure.ray_scan import bisect as _bisect, first_inside as _first_inside, ray_interval as _ray_interval
     from pyjulia4d.geometry.bounds import bounding_radius
 
     f = s.fractal

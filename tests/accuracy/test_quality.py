@@ -48,7 +48,7 @@ def test_preset_meets_its_stated_error(truths, quality, oracle):
     assert res.error_stats()["p99"] <= p["p99_bound"]
     d = res.depth[both].astype(np.float64)
     signed = d - tr.depth[both]
-    slack = 8 * truth._ulp32(res.depth[both])
+    slack = 8 * truth.ulp32(res.depth[both])
     assert np.mean((signed <= res.unresolved[both] + slack) & (-signed <= res.bracket[both] + slack)) >= 0.99
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pyjulia4d import reference as ref
-from pyjulia4d.measure import truth
+from pyjulia4d.measure import brute_force, truth
 from pyjulia4d.geometry.camera import camera_frame, march_radius
 from pyjulia4d.opencl.executor import render
 from pyjulia4d.scene.model import Scene
@@ -137,7 +137,7 @@ def test_brute_force_depth_is_the_analytic_ball():
     s = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", "fractal.c=0,0,0,0",
                                         "fractal.max_iter=3"])
     o, d = rays(s)
-    t = truth.brute_force_depth(s, o, d)
+    t = brute_force.brute_force_depth(s, o, d)
     ts = truth.sphere_depth(o, d, truth.sphere_radius(3, 4.0))
     assert np.array_equal(np.isfinite(t), np.isfinite(ts)) and np.isfinite(t).sum() > 100
     m = np.isfinite(ts)
@@ -153,17 +153,17 @@ def test_refine_depth_finds_what_a_coarse_chord_stepped_over():
     o, d = rays(s)
     R = truth.sphere_radius(3, 4.0)
     ts = truth.sphere_depth(o, d, R)
-    coarse = truth.brute_force_depth(s, o, d, chord=2.2 * R)
+    coarse = brute_force.brute_force_depth(s, o, d, chord=2.2 * R)
     m = np.isfinite(ts)
     stepped = m & ~np.isfinite(coarse)
     assert stepped.sum() > 20                      # the coarse scan stepped over the ball there
     b = np.sum(o * d, -1)
     mid = np.where(m, -b, np.inf)                  # the chord's midpoint: inside the ball
-    fixed, moved = truth.refine_depth(s, o, d, coarse, mid, chord=2.2 * R)
+    fixed, moved = brute_force.refine_depth(s, o, d, coarse, mid, chord=2.2 * R)
     assert moved >= stepped.sum()
     assert np.max(np.abs(fixed[m] - ts[m])) < 1e-12 and not np.isfinite(fixed[~m]).any()
     outside = np.where(m, ts - 1e-3, np.inf)       # just in front of the ball: outside
-    same, moved = truth.refine_depth(s, o, d, coarse, outside, chord=2.2 * R)
+    same, moved = brute_force.refine_depth(s, o, d, coarse, outside, chord=2.2 * R)
     assert moved == 0 and np.array_equal(same, coarse)
 
 
@@ -174,7 +174,7 @@ def test_brute_force_depth_is_a_verified_crossing(algebra, function):
     s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "max_iter": 6},
                          "camera": {"position": [2.5, 2.0, -3.0]}, "image": {"width": 16, "height": 12}})
     o, d = rays(s)
-    t = truth.brute_force_depth(s, o, d)
+    t = brute_force.brute_force_depth(s, o, d)
     hit = np.isfinite(t)
     assert hit.sum() > 5
     F, f = ref.formula_of(s.fractal), s.fractal

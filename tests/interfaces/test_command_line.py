@@ -16,7 +16,7 @@ import pyjulia4d
 from pyjulia4d import Scene, SceneError
 from pyjulia4d.app import cli
 from pyjulia4d.scene import keys
-from pyjulia4d.scene.model import key_names, valid_range
+from pyjulia4d.scene.ranges import key_names, valid_range
 
 from processes import cli_process as _cli
 

@@ -22,7 +22,8 @@ from pyjulia4d.app.explore.session import ExploreError, Session, animation_toml,
 from pyjulia4d.pipeline.result import RenderResult
 from pyjulia4d.scene import keyframes
 from pyjulia4d.scene.checks import SceneError
-from pyjulia4d.scene.model import CHECKS, Scene
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.ranges import CHECKS
 
 SMALL = Scene.default().replace(**{"image.width": 96, "image.height": 72})
 

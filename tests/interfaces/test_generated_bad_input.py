@@ -26,7 +26,7 @@ import pytest
 
 import pyjulia4d
 from pyjulia4d.app import cli
-from pyjulia4d.scene.model import CHECKS
+from pyjulia4d.scene.ranges import CHECKS
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 SEED = 20261125

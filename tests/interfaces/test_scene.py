@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pyjulia4d.scene.model import CHECKS, SECTIONS, Scene, valid_range
+from pyjulia4d.scene.model import SECTIONS, Scene
+
+from pyjulia4d.scene.ranges import CHECKS, valid_range
 from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method
 

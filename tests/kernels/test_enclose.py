@@ -23,7 +23,7 @@ from harness import Runner
 from pyjulia4d import Scene, reference as ref
 from pyjulia4d.fractal.registry import FUNCTIONS, FUNCTIONS_OF, MANDELBROT_START
 from pyjulia4d.geometry.camera import camera_frame, march_radius
-from pyjulia4d.measure.truth import brute_force_depth
+from pyjulia4d.measure.brute_force import brute_force_depth
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d.reference.formula import Formula, formula_of

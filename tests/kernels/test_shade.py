@@ -72,7 +72,7 @@ def test_shade_matches_reference(over, fl):
 def test_colormaps_exist_in_matplotlib():
     import matplotlib
 
-    from pyjulia4d.scene.model import COLORMAPS
+    from pyjulia4d.scene.ranges import COLORMAPS
     for name in COLORMAPS:
         assert name in matplotlib.colormaps, name
 

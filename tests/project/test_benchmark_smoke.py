@@ -187,7 +187,7 @@ def test_peer_error_reads_povray_depth_to_the_mathematics(tmp_path):
     from pyjulia4d import reference as ref
     from pyjulia4d.geometry.camera import camera_frame
     from pyjulia4d.interop.povray import import_pov
-    from pyjulia4d.measure.truth import brute_force_depth
+    from pyjulia4d.measure.brute_force import brute_force_depth
 
     w, h = 32, 24
     text = pe.pov_matched(w, h, 1000)

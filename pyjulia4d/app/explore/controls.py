@@ -16,7 +16,8 @@ from typing import Any, Mapping
 
 from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS_OF, KINDS
 from pyjulia4d.scene.checks import Choice, SceneError, scalar, show, show_key
-from pyjulia4d.scene.model import CHECKS, Scene, valid_range
+from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.ranges import CHECKS, valid_range
 from pyjulia4d.scene.quality import QUALITIES
 
 # At most this many values in one change, and this long each (a form has about 60).
