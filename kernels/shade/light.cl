@@ -324,9 +324,14 @@ inline void light_gather(const size_t (*lane_index)[LANES], int n_items, __globa
     }
 }
 
-/* Each lane's terms written to its pixel: (1, 1, 0, 0) off hits */
+/* Each lane's terms written to its pixel, (1, 1, 0, 0) off hits; with -D EXTRA_SHADOWS its
+ * visibility of shading.lights too, (1, 1, 1, 0) off hits */
 inline void light_scatter(const size_t (*lane_index)[LANES], int n_items, __global const int *status,
-                          const lreal *vis, const lreal *amb, const lreal *val, __global float4 *terms)
+                          const lreal *vis, const lreal *amb, const lreal *val, __global float4 *terms
+#ifdef EXTRA_SHADOWS
+                          , lreal (*ve)[PACKETS], __global float4 *vis_extra
+#endif
+                          )
 {
     for (int b = 0; b < PACKETS; ++b) {
         for (int k = 0; k < LANES; ++k) {
@@ -337,28 +342,15 @@ inline void light_scatter(const size_t (*lane_index)[LANES], int n_items, __glob
                            ? (float4)((float)LANE(vis[b], k), (float)LANE(amb[b], k),
                                       (float)LANE(val[b], k), 0.0f)
                            : (float4)(1, 1, 0, 0);
-        }
-    }
-}
-
 #ifdef EXTRA_SHADOWS
-/* Each lane's visibility of shading.lights written to its pixel: (1, 1, 1, 0) off hits */
-inline void extra_scatter(const size_t (*lane_index)[LANES], int n_items, __global const int *status,
-                          lreal (*ve)[PACKETS], __global float4 *vis_extra)
-{
-    for (int b = 0; b < PACKETS; ++b) {
-        for (int k = 0; k < LANES; ++k) {
-            size_t i = lane_index[b][k];
-            if (i >= (size_t)n_items)
-                continue;
             vis_extra[i] = status[i] == STATUS_HIT
                            ? (float4)((float)LANE(ve[0][b], k), (float)LANE(ve[1][b], k),
                                       (float)LANE(ve[2][b], k), 0.0f)
                            : (float4)(1, 1, 1, 0);
+#endif
         }
     }
 }
-#endif
 #endif
 
 /* terms[i] = (visibility, ambient factor, colour value, 0) of hit i (normal in camera
@@ -436,9 +428,10 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     vis_extra[i0] = (float4)((float)ve[0][0], (float)ve[1][0], (float)ve[2][0], 0.0f);
 #endif
 #else
-    light_scatter(lane_index, n_items, status, vis, amb, val, terms);
 #ifdef EXTRA_SHADOWS
-    extra_scatter(lane_index, n_items, status, ve, vis_extra);
+    light_scatter(lane_index, n_items, status, vis, amb, val, terms, ve, vis_extra);
+#else
+    light_scatter(lane_index, n_items, status, vis, amb, val, terms);
 #endif
 #endif
 }

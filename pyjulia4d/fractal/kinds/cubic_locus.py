@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from pyjulia4d.fractal.registry import locus_escape_radius
+from pyjulia4d.fractal.kinds.own_map import check_own_map
 from pyjulia4d.scene.checks import SceneError
 
 
@@ -26,14 +27,7 @@ def check(scene: Any) -> None:
     no estimate (fixed scan, Jacobian or zbuffer normals), and a bailout that is an escape
     radius for every map in the ball, so that the truncated set tends to the locus."""
     f, m = scene.fractal, scene.march
-    if f.algebra != "quaternion" or f.function != "sqr":
-        raise SceneError("fractal.kind", "cubic_locus iterates the complex cubic z^3 - 3 a^2 z + b: leave "
-                         "fractal.algebra=quaternion and fractal.function=sqr")
-    if f.theta != 0:
-        raise SceneError("fractal.theta", "the rotation is of the quaternion map, not of the cubic locus: set 0")
-    if scene.shading.coloring in ("iteration", "trap"):
-        raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the quaternion orbit of "
-                         "fractal.c, not the cubic locus's; use flat or w")
+    check_own_map(scene, "the complex cubic z^3 - 3 a^2 z + b", "the cubic locus", "the cubic locus's")
     if m.method == "de" and m.quality == "custom":   # a preset's de: refused by name below
         raise SceneError("march.method", "no distance estimate is known for the cubic connectedness locus "
                          "(Hart, Sandin & Kauffman 1989 section 5.2); use fixed or auto")

@@ -8,6 +8,7 @@ from typing import Any
 
 from pyjulia4d.geometry.bounds import bounding_radius
 from pyjulia4d.geometry.camera import to_world
+from pyjulia4d.fractal.kinds.own_map import check_own_map
 from pyjulia4d.scene.checks import SceneError
 
 
@@ -39,15 +40,8 @@ def check(scene: Any) -> None:
     rotation, colouring by the quaternion orbit or estimate-based normals; its set does not
     depend on the fourth coordinate w, so the view must stay in one hyperplane w = const (the
     bounding ball, camera.march_radius, holds the stack there only)."""
-    f, cam, sl = scene.fractal, scene.camera, scene.slice
-    if f.algebra != "quaternion" or f.function != "sqr":
-        raise SceneError("fractal.kind", "julia_stack iterates the complex square z^2 + c: leave "
-                         "fractal.algebra=quaternion and fractal.function=sqr")
-    if f.theta != 0:
-        raise SceneError("fractal.theta", "the rotation is of the quaternion map, not of a Julia set stack: set 0")
-    if scene.shading.coloring in ("iteration", "trap"):
-        raise SceneError("shading.coloring", f"{scene.shading.coloring} follows the quaternion orbit of "
-                         "fractal.c, not a stack's; use flat or w")
+    cam, sl = scene.camera, scene.slice
+    check_own_map(scene, "the complex square z^2 + c", "a Julia set stack", "a stack's")
     if scene.normals.method == "gradient":
         raise SceneError("normals.method", "gradient differences a distance estimate, which a Julia set stack "
                          "has no proven one of; use jacobian or zbuffer")
