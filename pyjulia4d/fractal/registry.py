@@ -1,8 +1,10 @@
 """The registry of algebras, functions and kinds of set: one entry each, naming its OpenCL
 piece and its float64 twin and stating its facts.  Adding a function is one FUNCTIONS_TABLE
-entry plus kernels/function/<name>.cl and pyjulia4d/reference/function/<name>.py; the
-scene's choices, the kernel configuration (pipeline/kernel_config.py), the bounding ball
-(geometry/camera.py) and the reference all read it here.
+entry plus kernels/function/<name>.cl and pyjulia4d/reference/function/<name>.py; adding a
+kind of set is one KINDS_TABLE entry plus kernels/kind/<name>.cl, its host hooks
+pyjulia4d/fractal/kinds/<name>.py (kind_hooks) and its twin pyjulia4d/reference/kind/<name>.py.
+The scene's choices and rules, the kernel configuration (pipeline/kernel_config.py), the
+bounding ball (geometry/camera.py) and the reference all read it here.
 
 The algebras and functions are POV-Ray's julia_fractal's (POV-Ray 3.6 documentation), in
 its order, with Gintz's CQuats and the naive commutative rules (Ödegaard & Wennergren
