@@ -54,10 +54,9 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
 
     def normals(point, depth, status, guard):
         if method == "jacobian":
-            return normals_jacobian(point, status, ma.c, ma.max_iter, ma.bailout, frame, guard, F)
+            return normals_jacobian(point, status, frame, ma, guard, F)
         if method == "gradient":
-            return normals_gradient(point, status, ma.c, ma.max_iter, ma.bailout, plan.normals_args.step, frame,
-                                    guard, F)
+            return normals_gradient(point, status, frame, ma, plan.normals_args, guard, F)
         return normals_zbuffer(point, depth, status, w, h, frame, guard)
 
     cone = None

@@ -2,11 +2,16 @@
 cut-face normals."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from pyjulia4d.geometry.camera import Frame
 from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, STATUS_HIT
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
+
+if TYPE_CHECKING:
+    from pyjulia4d.pipeline.plan import MarchArgs, NormalsArgs
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula
 from pyjulia4d.reference.kind.level import rescale_columns
 
@@ -69,9 +74,11 @@ def normal_jacobian(p, c, max_iter, bailout, guard=None, formula: Formula = QUAT
         return F.ALG_DOT(J, q[..., None, :])
 
 
-def normals_jacobian(point, status, c, max_iter, bailout, frame: Frame, guard=None,
-                     formula: Formula = QUATERNION_SQR):
-    """Unit normals of the hits, 0 elsewhere; ``guard`` (int array, optional) gets the flags."""
+def normals_jacobian(point, status, frame: Frame, march: MarchArgs, guard=None, formula: Formula = QUATERNION_SQR):
+    """normals/jacobian.cl with the march's record (``march``: its c, max_iter, bailout): unit
+    normals of the hits in camera coordinates, 0 elsewhere; ``guard`` (int array, optional)
+    gets the flags."""
+    c, max_iter, bailout = march.c, march.max_iter, march.bailout
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
@@ -94,8 +101,11 @@ def normal_gradient(p, c, max_iter, bailout, h, frame: Frame, formula: Formula =
                      f(p - h * w) - f(p + h * w)], axis=-1)
 
 
-def normals_gradient(point, status, c, max_iter, bailout, h, frame: Frame, guard=None,
+def normals_gradient(point, status, frame: Frame, march: MarchArgs, normals: NormalsArgs, guard=None,
                      formula: Formula = QUATERNION_SQR):
+    """normals/gradient.cl with the same records (the march's c, max_iter, bailout; the
+    normals' difference step): unit normals of the hits, 0 elsewhere."""
+    c, max_iter, bailout, h = march.c, march.max_iter, march.bailout, normals.step
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():

@@ -5,6 +5,8 @@ import pytest
 
 from harness import Runner, packet_widths
 from pyjulia4d.pipeline import kernel_config
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.pipeline import signatures
 from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame, march_radius
@@ -16,26 +18,20 @@ W, H = 48, 36
 
 def march_kernel(s: Scene, config, lanes: int, w: int = W, h: int = H):
     """The march kernel of ``config`` on the (float32-representable) rays of a small image:
-    its outputs, the rays and the march's arguments."""
+    its outputs, the rays and the march's record (pipeline/plan.MarchArgs), which the kernel
+    takes packed by its signature and the twin as it is."""
     R = Runner(config)
     o, d = ref.generate_rays(camera_frame(s), w, h)
     o, d = o.astype(R.real).astype(float), d.astype(R.real).astype(float)
-    f, m = s.fractal, s.march
     n = len(o)
-    near = -1.0 if m.near == "auto" else m.near
-    far = -1.0 if m.far == "auto" else m.far
-    depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
-    flags, bracket, unresolved = R.out(n, np.int32), R.out(n), R.out(n)
-    args = (f.c, f.max_iter, f.bailout, m.epsilon, march_radius(s), near, far,
-            m.z_resolution, m.post_steps, m.max_steps)
-    R("march", (n,), np.int32(w), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
-      R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(near), R.scalar(far),
-      np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples, flags, bracket, unresolved,
+    outputs = dict(depth=R.out(n), point=R.out4(n), status=R.out(n, np.int32), samples=R.out(n, np.int32),
+                   flags=R.out(n, np.int32), bracket=R.out(n), unresolved=R.out(n))
+    record = march_args(s)
+    packed = Packed(signatures.MARCH, {"march": record}, Precision(R.double), config.defines)
+    R("march", (n,), *packed(tile_w=w, origins=R.buf4(o), dirs=R.buf4(d), **outputs),
       items=march_items(n, w, lanes, kernel_config.config_packets(config)))
-    out = {"depth": depth.get(), "point": R.get4(point), "status": status.get(), "samples": samples.get(),
-           "flags": flags.get(), "bracket": bracket.get(), "unresolved": unresolved.get()}
-    return out, o, d, args
+    out = {k: (R.get4(v) if k == "point" else v.get()) for k, v in outputs.items()}
+    return out, o, d, record
 
 
 def run_march(s: Scene, lanes: int = 1):
@@ -47,7 +43,7 @@ def run_march(s: Scene, lanes: int = 1):
     n = len(o)
     rflags = np.zeros(n, np.int32)
     rbracket = np.zeros(n)
-    r = ref.march(o, d, march_args(s), rflags, rbracket) + (rbracket,)
+    r = ref.march(o, d, args, rflags, rbracket) + (rbracket,)
     # the guard flags (kernels/common/codes.cl) agree wherever the statuses do
     same = k[2] == r[2]
     assert np.array_equal(out["flags"][same], rflags[same])

@@ -8,7 +8,9 @@ from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.pipeline.codes import GUARD_ULP_STEP
 from pyjulia4d import reference as ref
 from pyjulia4d.geometry.camera import camera_frame
-from pyjulia4d.pipeline.plan import march_args
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.pipeline import signatures
+from pyjulia4d.pipeline.plan import make_plan, march_args
 from pyjulia4d.scene.model import Scene
 
 W, H = 64, 48
@@ -44,7 +46,8 @@ def test_normals_match_reference(method, lanes, fl, c):
                                         "fractal.c=" + ",".join(map(str, c))])
     R = Runner(kernel_config.march_config(s, lanes, ray_buffers=True) if lanes > 1
                else kernel_config.scene_config(s, ray_buffers=True))
-    fr = camera_frame(s)
+    plan = make_plan(s, "CPU", 1)   # the kernel and its twin take the plan's records
+    fr = plan.frame
     depth, point, status = hits(s, R.real)
     n = len(point)
     out = R.out4(n)
@@ -52,22 +55,16 @@ def test_normals_match_reference(method, lanes, fl, c):
     flags0 = np.where(np.arange(n) % 7 == 0, GUARD_ULP_STEP, 0).astype(np.int32)
     flags = R.buf(flags0, np.int32)
     guard = flags0.astype(np.int64)   # the twin's guard: ORed into the same way
-    f = s.fractal
-    vec = R.vec
+    packed = Packed(signatures.NORMALS[method], plan.records(), Precision(fl == "double"))
+    given = dict(point=R.buf4(point), status=R.buf(status, np.int32), normal=out, flags=flags)
     if method == "jacobian":
-        R("normals_jacobian", (n,), R.buf4(point), R.buf(status, np.int32), vec(f.c),
-          np.int32(f.max_iter), R.scalar(f.bailout), vec(fr.right), vec(fr.up), vec(fr.forward), out, flags,
-          lanes=lanes)
-        want = ref.normals_jacobian(point, status, f.c, f.max_iter, f.bailout, fr, guard)
+        R("normals_jacobian", (n,), *packed(**given), lanes=lanes)
+        want = ref.normals_jacobian(point, status, fr, plan.march, guard)
     elif method == "gradient":
-        h = s.march.epsilon
-        R("normals_gradient", (n,), R.buf4(point), R.buf(status, np.int32), vec(f.c),
-          np.int32(f.max_iter), R.scalar(f.bailout), R.scalar(h), vec(fr.right), vec(fr.up),
-          vec(fr.forward), out, flags)
-        want = ref.normals_gradient(point, status, f.c, f.max_iter, f.bailout, h, fr, guard)
+        R("normals_gradient", (n,), *packed(**given))
+        want = ref.normals_gradient(point, status, fr, plan.march, plan.normals_args, guard)
     else:
-        R("normals_zbuffer", (W * H,), R.buf4(point), R.buf(depth), R.buf(status, np.int32),
-          np.int32(W), np.int32(H), vec(fr.position), vec(fr.right), vec(fr.up), vec(fr.forward), out, flags)
+        R("normals_zbuffer", (W * H,), *packed(**given, depth=R.buf(depth), width=W, height=H))
         with np.errstate(invalid="ignore"):
             want = ref.normals_zbuffer(point, depth, status, W, H, fr, guard)
     got = R.get4(out)
