@@ -8,6 +8,8 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.opencl import build
+from pyjulia4d.opencl.records import Packed, Precision
+from pyjulia4d.pipeline import signatures
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.opencl.devices import select_device
 from pyjulia4d.opencl.runner import launch, queue_for
@@ -32,6 +34,7 @@ class Runner:
     """Kernels of one build configuration; arrays in, arrays out."""
 
     def __init__(self, config: kernel_config.KernelConfig):
+        self.config = config
         self.ctx, self.queue = queue_for(device())
         self.prg = build.program(self.ctx, config)
         self.double = "REAL_DOUBLE" in config.defines
@@ -69,3 +72,10 @@ class Runner:
         (n,) = size
         launch(self.queue, cl.Kernel(self.prg, name), n, *conv, lanes=lanes, items=items)
         self.queue.finish()
+
+    def named(self, name, size, *, lanes: int = 1, items: int | None = None, **values):
+        """Run kernel ``name`` as ``__call__`` does, every argument given by name and packed in
+        the kernel's declared order by its signature (pipeline/signatures.py): a name missing
+        or unknown is an error, and each value is cast to its parameter's type."""
+        packed = Packed(signatures.SIGNATURES[name].all_given(), {}, Precision(self.double), self.config.defines)
+        self(name, size, *packed(**values), lanes=lanes, items=items)

@@ -59,6 +59,11 @@ class Signature:
         """The parameters a program built with ``defines`` declares, in order."""
         return tuple(p for p in self.params if p.compiled(defines))
 
+    def all_given(self) -> "Signature":
+        """The same parameters, each value given at launch by name (no plan's records: the
+        tests' runs of a kernel on values of their own)."""
+        return Signature(self.kernel, self.piece, tuple(Param(p.name, p.type, "", p.when) for p in self.params))
+
 
 def group(when: str, *params: Param) -> tuple[Param, ...]:
     """``params``, each compiled under ``when``."""

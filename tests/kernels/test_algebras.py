@@ -160,7 +160,8 @@ def test_function_piece_matches_its_twin(name, fl, tol):
     z = (z.real.astype(R.real) + 1j * z.imag.astype(R.real)).astype(np.complex128)
     n = len(z)
     outs = [R.out(n) for _ in range(4)]
-    R("probe_cfun", (n,), R.buf(z.real), R.buf(z.imag), *outs)
+    R.named("probe_cfun", (n,), re=R.buf(z.real), im=R.buf(z.imag), f_re=outs[0], f_im=outs[1], d_re=outs[2],
+            d_im=outs[3])
     kf = outs[0].get() + 1j * outs[1].get()
     kd = outs[2].get() + 1j * outs[3].get()
     rf, rd = complex_value(name, z, (2.5, 0.7))
@@ -205,7 +206,7 @@ def test_step_matches_reference(algebra, function, fl, tol):
     c = np.array(s.fractal.c)
     n = len(p)
     val, jvp = R.out4(n), R.out4(n)
-    R("probe_step", (n,), R.buf4(p), R.buf4(h), R.vec(c), val, jvp)
+    R.named("probe_step", (n,), points=R.buf4(p), dirs=R.buf4(h), c=c, value=val, jvp=jvp)
     F = ref.formula_of(s.fractal)
     q = F.ALG_IN(p)
     rv, rj = F.julia_f(q, F.ALG_C(c)), F.julia_f_jvp(q, F.ALG_IN(h))
@@ -226,7 +227,8 @@ def test_inside_matches_reference(algebra, function):
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
     c = s.fractal.c
-    R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(6), R.scalar(4.0), ins, d, f)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=c, max_iter=6, bailout=4.0, inside=ins, distance=d,
+            formula=f)
     r = ref.julia_inside(p, c, 6, 4.0, ref.formula_of(s.fractal))
     assert min(r.sum(), (~r).sum()) >= 50   # both classes present: the test means something
     assert np.mean(ins.get().astype(bool) != r) <= 5e-3
@@ -322,7 +324,8 @@ def test_hypercomplex_distance_estimate(function, c):
     p = np.random.default_rng(16).uniform(-1.5, 1.5, (8000, 4)).astype(np.float32).astype(np.float64)
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(12), R.scalar(4.0), ins, d, f)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=c, max_iter=12, bailout=4.0, inside=ins, distance=d,
+            formula=f)
     kd = d.get().astype(np.float64)
     rd = ref.julia_distance(p, c, 12, 4.0, F)
     both = (kd > 0) & (rd > 0)

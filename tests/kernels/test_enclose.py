@@ -215,8 +215,8 @@ def test_kernel_proofs_match_the_twin(algebra, function, how):
     o, d = o.astype(np.float32).astype(float), d.astype(np.float32).astype(float)
     t1 = t1.astype(np.float32).astype(float)
     proven, margin = R.out(n, np.int32), R.out(n)
-    R("prove_segments", (n,), R.buf4(o), R.buf4(d), R.buf(t0), R.buf(t1), R.vec(f.c), np.int32(f.max_iter),
-      R.scalar(f.bailout), proven, margin)
+    R.named("prove_segments", (n,), origins=R.buf4(o), dirs=R.buf4(d), t0s=R.buf(t0), t1s=R.buf(t1), c=f.c,
+            max_iter=f.max_iter, bailout=f.bailout, proven=proven, margins=margin)
     kp = proven.get().astype(bool)
     rp, rm = enc_prove(o, d, t0, t1, f.c, f.max_iter, f.bailout, F)
     # float32 against float64: a proof decided by a hair may go either way, on few segments
@@ -256,10 +256,11 @@ def march_on_rays(s, o, d):
     n = len(o)
     depth, point, status, samples = R.out(n), R.out4(n), R.out(n, np.int32), R.out(n, np.int32)
     flags, bracket, unresolved = R.out(n, np.int32), R.out(n), R.out(n)
-    R("march", (n,), np.int32(n), R.buf4(o), R.buf4(d), R.vec(f.c), np.int32(f.max_iter), R.scalar(f.bailout),
-      R.scalar(m.epsilon), R.scalar(march_radius(s)), R.scalar(-1.0), R.scalar(-1.0),
-      np.int32(m.z_resolution), np.int32(m.post_steps), np.int32(m.max_steps),
-      depth, point, status, samples, flags, bracket, unresolved)
+    R.named("march", (n,), tile_w=n, origins=R.buf4(o), dirs=R.buf4(d), c=f.c, max_iter=f.max_iter,
+            bailout=f.bailout, epsilon=m.epsilon, radius=march_radius(s), near_set=-1.0, far_set=-1.0,
+            z_resolution=m.z_resolution, post_steps=m.post_steps, max_steps=m.max_steps, depth=depth,
+            point=point, status=status, samples=samples, flags=flags, bracket=bracket,
+            unresolved=unresolved)
     return (depth.get().astype(float), status.get(), bracket.get().astype(float), unresolved.get().astype(float))
 
 
@@ -318,8 +319,9 @@ def test_caff_kernel_matches_the_twin_and_holds_the_products():
     b_r = (np.abs(rng.normal(size=n)) * 0.1 * scale[:, 0]).astype(np.float32).astype(float)
     k, bailout = (0.7, -1.3), 2.0
     outs = [R.out4(n), R.out(n), R.out4(n), R.out(n), R.out4(n), R.out(n), R.out(n, np.int32)]
-    R("caff_ops", (n,), R.buf4(a_mv), R.buf(a_r), R.buf4(b_mv), R.buf(b_r), R.vec((*k, 0, 0)),
-      R.scalar(bailout), *outs)
+    R.named("caff_ops", (n,), a_mv=R.buf4(a_mv), a_r=R.buf(a_r), b_mv=R.buf4(b_mv), b_r=R.buf(b_r), k=(*k, 0, 0),
+            bailout=bailout, mul_mv=outs[0], mul_r=outs[1], add_mv=outs[2], add_r=outs[3],
+            scale_mv=outs[4], scale_r=outs[5], outside=outs[6])
     form = lambda mv, r: (mv[:, 0] + 1j * mv[:, 1], mv[:, 2] + 1j * mv[:, 3], r)   # noqa: E731
     a, b = form(a_mv, a_r), form(b_mv, b_r)
     twins = [T.caff_mul(a, b), T.caff_add(a, b), T.caff_scale(complex(*k), a)]

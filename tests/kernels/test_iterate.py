@@ -24,7 +24,8 @@ def run_probe(fl, p, c, max_iter, bailout):
     p = p.astype(R.real).astype(np.float64)  # both sides see the same, representable inputs
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(max_iter), R.scalar(bailout), ins, d, f)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=c, max_iter=max_iter, bailout=bailout, inside=ins,
+            distance=d, formula=f)
     return p, ins.get().astype(bool), d.get().astype(np.float64), f.get().astype(np.float64)
 
 

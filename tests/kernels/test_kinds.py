@@ -43,8 +43,8 @@ def probe(s, p, c=(0, 0, 0, 0)):
     R = Runner(kernel_config.probe_config(s))
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec(c), np.int32(s.fractal.max_iter), R.scalar(s.fractal.bailout),
-      ins, d, f)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=c, max_iter=s.fractal.max_iter, bailout=s.fractal.bailout,
+            inside=ins, distance=d, formula=f)
     return ins.get().astype(bool), d.get().astype(np.float64), f.get().astype(np.float64)
 
 
@@ -268,7 +268,7 @@ def test_rotated_step_and_set_match_reference(function, fl, tol):
     c = np.array(s.fractal.c)
     n = len(p)
     val, jvp = R.out4(n), R.out4(n)
-    R("probe_step", (n,), R.buf4(p), R.buf4(h), R.vec(c), val, jvp)
+    R.named("probe_step", (n,), points=R.buf4(p), dirs=R.buf4(h), c=c, value=val, jvp=jvp)
     for k, r in ((R.get4(val), F.julia_f(p, c)), (R.get4(jvp), F.julia_f_jvp(p, h))):
         assert np.max(np.abs(k - r) / (1 + np.abs(r))) < tol
     ins, d, _ = probe(s, p, c)

@@ -21,8 +21,9 @@ def test_generate_rays_matches_reference(over, fl, tol):
     f = camera_frame(s)
     w, h = 37, 23
     o, d = R.out4(w * h), R.out4(w * h)
-    R("generate_rays", (w * h,), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
-      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), o, d)
+    R.named("generate_rays", (w * h,), position=f.position, forward=f.forward, right=f.right, up=f.up,
+            tan_half_fov=f.tan_half_fov, width=w, height=h, x0=0, y0=0, tile_w=w, origins=o,
+            dirs=d)
     ro, rd = ref.generate_rays(f, w, h)
     # rounding of the frame to the kernel's precision and one normalise: a few ulp of a
     # unit vector (float32: 2e-6; float64: 1e-14)
@@ -78,8 +79,9 @@ def test_tile_of_rays_matches_the_whole_image():
     f = camera_frame(s)
     w, h, x0, y0, tw, th = 37, 23, 11, 5, 9, 7
     o, d = R.out4(tw * th), R.out4(tw * th)
-    R("generate_rays", (tw * th,), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
-      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), np.int32(x0), np.int32(y0), np.int32(tw), o, d)
+    R.named("generate_rays", (tw * th,), position=f.position, forward=f.forward, right=f.right, up=f.up,
+            tan_half_fov=f.tan_half_fov, width=w, height=h, x0=x0, y0=y0, tile_w=tw, origins=o,
+            dirs=d)
     _, rd = ref.generate_rays(f, w, h)
     want = rd.reshape(h, w, 4)[y0:y0 + th, x0:x0 + tw].reshape(-1, 4)
     np.testing.assert_allclose(R.get4(d), want, atol=2e-6)
@@ -96,8 +98,9 @@ def test_padded_launch_leaves_items_past_n_alone():
     w, h = 7, 5                                     # 35 items: not a multiple of the local size
     o = R.buf4(np.full((64 * 2, 4), 123.0))
     d = R.buf4(np.full((64 * 2, 4), 123.0))
-    R("generate_rays", (w * h,), R.vec(f.position), R.vec(f.forward), R.vec(f.right), R.vec(f.up),
-      R.scalar(f.tan_half_fov), np.int32(w), np.int32(h), np.int32(0), np.int32(0), np.int32(w), o, d)
+    R.named("generate_rays", (w * h,), position=f.position, forward=f.forward, right=f.right, up=f.up,
+            tan_half_fov=f.tan_half_fov, width=w, height=h, x0=0, y0=0, tile_w=w, origins=o,
+            dirs=d)
     got = R.get4(d)
     assert np.all(got[w * h:] == 123.0)
     np.testing.assert_allclose(got[: w * h], ref.generate_rays(f, w, h)[1], atol=2e-6)

@@ -215,8 +215,9 @@ def test_reflect_kernels_match_reference(light, fl):
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     nrm = nrm.astype(R.real).astype(float)
     o, d = R.out4(n), R.out4(n)
-    R("reflect_rays", (n,), R.buf4(point), R.buf4(np.c_[nrm, np.zeros(n)]), R.buf(status, np.int32),
-      R.vec(fr.position), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), R.scalar(0.01), R.scalar(2.0), o, d)
+    R.named("reflect_rays", (n,), point=R.buf4(point), normal=R.buf4(np.c_[nrm, np.zeros(n)]),
+            status=R.buf(status, np.int32), eye=fr.position, right=fr.right, up=fr.up,
+            forward=fr.forward, bias=0.01, radius=2.0, origins=o, dirs=d)
     got_o, got_d = R.get4(o), R.get4(d)
     want_o, want_d = ref.reflect_rays(point, nrm, status, fr, 0.01, 2.0)
     tol = 1e-5 if fl == "single" else 1e-12

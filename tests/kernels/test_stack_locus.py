@@ -44,8 +44,8 @@ def probe(s, p):
     R = Runner(kernel_config.probe_config(s))
     n = len(p)
     ins, d, f = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec((9, 9, 9, 9)), np.int32(s.fractal.max_iter),
-      R.scalar(s.fractal.bailout), ins, d, f)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=(9, 9, 9, 9), max_iter=s.fractal.max_iter,
+            bailout=s.fractal.bailout, inside=ins, distance=d, formula=f)
     return ins.get().astype(bool), d.get().astype(np.float64), f.get().astype(np.float64)
 
 
