@@ -41,13 +41,6 @@ class Runner:
         self.real = np.float64 if self.double else np.float32
         self.vdt = cl.cltypes.double4 if self.double else cl.cltypes.float4
 
-    def vec(self, v):
-        mk = cl.cltypes.make_double4 if self.double else cl.cltypes.make_float4
-        return mk(*[float(x) for x in v])
-
-    def scalar(self, x):
-        return self.real(x)
-
     def buf4(self, a):
         a = np.ascontiguousarray(np.asarray(a, self.real).reshape(-1, 4))
         return cla.to_device(self.queue, a.view(self.vdt).ravel())

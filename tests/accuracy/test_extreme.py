@@ -176,8 +176,8 @@ def test_distance_estimate_finite_float32(max_iter, bailout):
     p = probe_points()
     n = len(p)
     inside, dist, formula = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec(s.fractal.c), np.int32(max_iter), R.scalar(bailout),
-      inside, dist, formula)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=s.fractal.c, max_iter=max_iter, bailout=bailout,
+            inside=inside, distance=dist, formula=formula)
     d, fm = dist.get(), formula.get()
     assert np.all(np.isfinite(d)) and np.all(d >= 0)
     assert np.all(np.isfinite(fm))
@@ -199,8 +199,8 @@ def test_derivative_beyond_range_is_rescaled(fl):
     R = Runner(kernel_config.probe_config(s))
     n = len(p)
     inside, dist, formula = R.out(n, np.int32), R.out(n), R.out(n)
-    R("probe_iterate", (n,), R.buf4(p), R.vec(s.fractal.c), np.int32(10000), R.scalar(4.0),
-      inside, dist, formula)
+    R.named("probe_iterate", (n,), points=R.buf4(p), c=s.fractal.c, max_iter=10000, bailout=4.0, inside=inside,
+            distance=dist, formula=formula)
     assert np.all(np.isfinite(formula.get())) and np.all(np.isfinite(dist.get()))
     assert np.mean(inside.get()) > 0.4
     d64, esc = ref.julia_distance_formula(p, s.fractal.c, 10000, 4.0)
@@ -208,9 +208,9 @@ def test_derivative_beyond_range_is_rescaled(fl):
     R = Runner(kernel_config.march_config(s.with_overrides(["normals.method=jacobian"]), 1))
     fr = camera_frame(s)
     out = R.out4(n)
-    R("normals_jacobian", (n,), R.buf4(p), R.buf(np.ones(n), np.int32), R.vec(s.fractal.c),
-      np.int32(10000), R.scalar(4.0), R.vec(fr.right), R.vec(fr.up), R.vec(fr.forward), out,
-      R.buf(np.zeros(n), np.int32))
+    R.named("normals_jacobian", (n,), point=R.buf4(p), status=R.buf(np.ones(n), np.int32), c=s.fractal.c,
+            max_iter=10000, bailout=4.0, right=fr.right, up=fr.up, forward=fr.forward, normal=out,
+            flags=R.buf(np.zeros(n), np.int32))
     nrm = R.get4(out)
     assert np.all(np.isfinite(nrm))
     np.testing.assert_allclose(np.linalg.norm(nrm[:, :3], axis=1), 1, atol=1e-5)
