@@ -10,7 +10,8 @@
  * Compiled after iterate.cl (its de_value, DE_GROW, JULIA_DF2): the set test, level function
  * and distance estimate below take over the names julia_inside, julia_level,
  * julia_distance_formula and julia_distance for every later piece (march, refine, gradient
- * normals, shadows); normals/jacobian.cl has its own -D KIND_MANDELBROT branch. */
+ * normals, shadows); its hooks at the end give the Jacobian normals and the colourings its
+ * orbit. */
 /* f(q) + c with c a lane value (the point), f the algebra's own (julia_f at c = 0) */
 inline quat mandel_f(quat q, quat c) { return QADD(julia_f(q, (real4)(0)), c); }
 
@@ -218,3 +219,28 @@ inline lreal mandel_distance(quat p, julia_params jp)
 
 #define julia_inside mandel_inside
 #define julia_level mandel_level
+
+/* The kind's hooks for the pieces after it, which take the Julia set's own where a kind names
+ * none.  The orbit a colour follows (shade/light.cl): that of v with c = p, from q_1 = v + c,
+ * so its count starts at 1. */
+#define KIND_ORBIT_START(p) quat oc_ = ALG_IN(p); quat q = MANDEL_START(oc_)
+#define KIND_ORBIT_F(q) mandel_f(q, oc_)
+#define KIND_ORBIT_N0 1
+
+/* The Jacobian normal's (normals/jacobian.cl): the point is c, so q_1 = v + c, J_1 = dq_1/dp =
+ * ALG_IN, and J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings): the added
+ * identity is kept at J's scale, unit = 1 / s; e0..e2 are each direction's added ALG_IN v. */
+#define KIND_JVP_START(q, j0, j1, j2) \
+    quat c = q; \
+    q = MANDEL_START(c); \
+    quat e0 = j0, e1 = j1, e2 = j2; \
+    lreal unit = (lreal)1
+#define KIND_JVP_FIRST 1
+#define KIND_JVP_STEP(q, j0, j1, j2, live) do { \
+        j0 = QSEL(j0, QADD(j0, QSCALE(unit, e0)), live); \
+        j1 = QSEL(j1, QADD(j1, QSCALE(unit, e1)), live); \
+        j2 = QSEL(j2, QADD(j2, QSCALE(unit, e2)), live); \
+        q = QSEL(q, mandel_f(q, c), live); \
+    } while (0)
+#define KIND_JVP_RESCALE(inv, rescale) unit = L_SEL(unit, unit * (inv), rescale);   /* its own ';' */
+

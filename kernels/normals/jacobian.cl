@@ -21,6 +21,12 @@ inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 f
     return QUAT(QDOT_UNIFORM(g, right), QDOT_UNIFORM(g, up), QDOT_UNIFORM(g, forward), (lreal)0);
 }
 #else
+#ifndef KIND_JVP_START   /* the Julia set's: q_0 = p, J_0 = I, q -> f(q) + c (a kind's piece may name its own) */
+#define KIND_JVP_START(q, j0, j1, j2) real4 c = ALG_C(jp.c)
+#define KIND_JVP_FIRST 0
+#define KIND_JVP_STEP(q, j0, j1, j2, live) q = QSEL(q, julia_f(q, c), live)
+#define KIND_JVP_RESCALE(inv, rescale)   /* nothing: a statement of its own where named (no ';' here) */
+#endif
 /* the gradient's components along right, up and forward, up to a common positive scale */
 inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 forward, lmask *guard)
 {
@@ -28,22 +34,9 @@ inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 f
     quat j0 = ALG_IN(QUAT_UNIFORM(right));     /* J right, J up, J forward */
     quat j1 = ALG_IN(QUAT_UNIFORM(up));
     quat j2 = ALG_IN(QUAT_UNIFORM(forward));
-#ifdef KIND_MANDELBROT
-    /* the point is c (kind/mandelbrot.cl): q_1 = c, J_1 = dq_1/dp = ALG_IN, and
-     * J_{n+1} = f'(q_n) J_n + ALG_IN, carried as J / s (s: the rescalings below) */
-    quat c = q;
-    q = MANDEL_START(c);            /* q_1 = v + c: J_1 is the same */
-    quat e0 = j0, e1 = j1, e2 = j2;   /* the added ALG_IN v, each direction's */
-    lreal unit = (lreal)1;          /* 1 / s: the added identity at the scale J is kept in */
-#else
-    real4 c = ALG_C(jp.c);
-#endif
+    KIND_JVP_START(q, j0, j1, j2);   /* the kind's orbit and derivative start, and its state */
     lmask live = L_TRUE;
-#ifdef KIND_MANDELBROT
-    for (int n = 1; n < jp.max_iter && L_ANY(live); ++n) {
-#else
-    for (int n = 0; n < jp.max_iter && L_ANY(live); ++n) {
-#endif
+    for (int n = KIND_JVP_FIRST; n < jp.max_iter && L_ANY(live); ++n) {
         lreal m2 = ALG_NORM2(q);
         live &= m2 <= jp.bailout2;
         /* Inside points of c = 0 go to 0 like p^(2^n): q underflows to exactly 0 within a
@@ -61,14 +54,7 @@ inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 f
         j0 = QSEL(j0, julia_f_jvp(q, j0), live);
         j1 = QSEL(j1, julia_f_jvp(q, j1), live);
         j2 = QSEL(j2, julia_f_jvp(q, j2), live);
-#ifdef KIND_MANDELBROT
-        j0 = QSEL(j0, QADD(j0, QSCALE(unit, e0)), live);
-        j1 = QSEL(j1, QADD(j1, QSCALE(unit, e1)), live);
-        j2 = QSEL(j2, QADD(j2, QSCALE(unit, e2)), live);
-        q = QSEL(q, mandel_f(q, c), live);
-#else
-        q = QSEL(q, julia_f(q, c), live);
-#endif
+        KIND_JVP_STEP(q, j0, j1, j2, live);
         /* the largest derivative's squared length (sqrt is monotonic: sqrt(s2) is the largest
          * length); rescale both ways: J shrinks geometrically on orbits drawn to an attracting
          * cycle (inside points at max_iter 1000+) and would underflow to 0 in float32 */
@@ -79,9 +65,7 @@ inline quat normal_along(quat p, julia_params jp, real4 right, real4 up, real4 f
             j0 = QSEL(j0, QSCALE(inv, j0), rescale);
             j1 = QSEL(j1, QSCALE(inv, j1), rescale);
             j2 = QSEL(j2, QSCALE(inv, j2), rescale);
-#ifdef KIND_MANDELBROT
-            unit = L_SEL(unit, unit * inv, rescale);
-#endif
+            KIND_JVP_RESCALE(inv, rescale)
         }
     }
     return QUAT(ALG_DOT(q, j0), ALG_DOT(q, j1), ALG_DOT(q, j2), (lreal)0);

@@ -170,24 +170,20 @@ inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp
 /* The orbit a colour follows: q_0 = p under q -> f(q) + c for a Julia set; for a
  * Mandelbrot set (kind/mandelbrot.cl) the orbit of the critical point 0 with c = p, from
  * q_1 = c (so its count starts at 1). */
-#ifdef KIND_MANDELBROT
-#define ORBIT_START(p) quat oc_ = ALG_IN(p); quat q = MANDEL_START(oc_)
-#define ORBIT_F(q) mandel_f(q, oc_)
-#define ORBIT_N0 1
-#else
-#define ORBIT_START(p) real4 oc_ = ALG_C(jp.c); quat q = ALG_IN(p)
-#define ORBIT_F(q) julia_f(q, oc_)
-#define ORBIT_N0 0
+#ifndef KIND_ORBIT_START   /* the Julia set's, where the kind's piece names no orbit of its own */
+#define KIND_ORBIT_START(p) real4 oc_ = ALG_C(jp.c); quat q = ALG_IN(p)
+#define KIND_ORBIT_F(q) julia_f(q, oc_)
+#define KIND_ORBIT_N0 0
 #endif
 #ifdef COLOR_ITERATION
 inline lreal orbit_value(quat p, julia_params jp)
 {
-    ORBIT_START(p);
+    KIND_ORBIT_START(p);
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
-    lmask n = ORBIT_N0;
-    for (int k = ORBIT_N0; k < 4 * jp.max_iter && L_ANY(live); ++k) {
-        q = QSEL(q, ORBIT_F(q), live);
+    lmask n = KIND_ORBIT_N0;
+    for (int k = KIND_ORBIT_N0; k < 4 * jp.max_iter && L_ANY(live); ++k) {
+        q = QSEL(q, KIND_ORBIT_F(q), live);
         m2 = L_SEL(m2, ALG_NORM2(q), live);
         n = L_SEL(n, n + 1, live);
         live &= m2 <= jp.bailout2;
@@ -201,13 +197,13 @@ inline lreal orbit_value(quat p, julia_params jp)
 #ifdef COLOR_TRAP
 inline lreal orbit_value(quat p, julia_params jp, real4 trap)
 {
-    ORBIT_START(p);
+    KIND_ORBIT_START(p);
     quat tq = QSCALE((lreal)-1, ALG_IN(QUAT_UNIFORM(trap)));
     lreal m2 = ALG_NORM2(q);
     lmask live = m2 <= jp.bailout2;
     lreal best = ALG_NORM2(QADD(q, tq));
-    for (int k = ORBIT_N0; k < jp.max_iter && L_ANY(live); ++k) {
-        q = QSEL(q, ORBIT_F(q), live);
+    for (int k = KIND_ORBIT_N0; k < jp.max_iter && L_ANY(live); ++k) {
+        q = QSEL(q, KIND_ORBIT_F(q), live);
         m2 = ALG_NORM2(q);
         live &= m2 <= jp.bailout2;
         best = L_SEL(best, fmin(best, ALG_NORM2(QADD(q, tq))), live);

@@ -295,3 +295,10 @@ def test_no_branch_on_a_kinds_name() -> None:
     bad = [m for m, p in MODULES.items() if not m.startswith(("pyjulia4d.fractal.kinds", "pyjulia4d.reference.kind"))
            and pattern.search(p.read_text())]
     assert bad == []
+    # the kernels likewise: a shared piece takes a kind's hooks (KIND_ORBIT_START, KIND_JVP_START,
+    # KIND_NORMAL, defined by kernels/kind/<kind>.cl), never the kind's own switch
+    switch = re.compile(r"#\s*if.*\bKIND_(?:" + "|".join(k.upper() for k in registry.KINDS_TABLE) + r")\b")
+    own = {f"kind/{k}" for k in registry.KINDS_TABLE} | {f"enclose/{k}" for k in registry.KINDS_TABLE}
+    bad = [str(p.relative_to(kernel_dir())) for p in kernel_dir().rglob("*.cl")
+           if p.relative_to(kernel_dir()).with_suffix("").as_posix() not in own and switch.search(p.read_text())]
+    assert bad == []
