@@ -52,9 +52,11 @@ def shown_path(path: str) -> str:
 
 
 def quoted_path(path: str | Path) -> str:
-    """The path in quotes: 'dir', or its repr when not printable."""
+    """The path in quotes: 'dir', or its repr when not printable; shortened as shown_path
+    shortens it, so that a message naming it stays one line."""
     path = str(path)
-    return f"'{path}'" if path and path.isprintable() else repr(path)
+    s = f"'{path}'" if path and path.isprintable() else repr(path)
+    return s if len(s) <= SHOWN_PATH_MOST else f"{s[:120]}...{s[-(SHOWN_PATH_MOST - 123):]}"
 
 
 def path_limit(directory: str | Path, name: str, fallback: int) -> int:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
-from pyjulia4d.app.output import OutputError, check_output_path, read_header
+from pyjulia4d.app.output import OutputError, check_output_path, output_errors, read_header
 from pyjulia4d.files import NAME_MAX, atomic_write, path_limit, path_text, shown_path, temp_affixes
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import add_counts
@@ -268,9 +268,10 @@ def _make_dirs(dirs: Iterable[Path]) -> list[Path]:
     for d in sorted(dirs):
         missing = []
         p = d
-        while not p.exists() and p != p.parent:
-            missing.append(p)
-            p = p.parent
+        with output_errors(d, "cannot create the frame directory"):
+            while not p.exists() and p != p.parent:
+                missing.append(p)
+                p = p.parent
         for m in reversed(missing):
             try:
                 m.mkdir()

@@ -2,12 +2,13 @@
 writers (atomic: pyjulia4d/files.py) and the reader of their headers."""
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import stat
 import tempfile
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -20,6 +21,19 @@ TIFF = (".tif", ".tiff")
 
 class OutputError(ValueError):
     """Unusable output path or format; the message starts with the path."""
+
+
+@contextlib.contextmanager
+def output_errors(path: str | Path, doing: str = "cannot write") -> Iterator[None]:
+    """OS errors on an output path, in one place: whatever the system refuses while ``path`` is
+    made or written (ENAMETOOLONG, ELOOP, ENOTDIR, EACCES, EROFS, ENOSPC, ...) becomes one
+    OutputError naming the path, shortened (files.shown_path), what was being done and the
+    system's reason.  Every writer (images, scene files, meshes, frames, videos) runs in one;
+    the files themselves are written atomically (files.atomic_write), so nothing is left."""
+    try:
+        yield
+    except OSError as e:
+        raise OutputError(f"{shown_path(str(path))}: {doing}: {e.strerror or e}") from None
 
 
 def _suffix(path: str | Path) -> str:
@@ -316,7 +330,7 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
                           if a is not None), None)
             write_exr(p, channels, {**(header or {}), **extra}, release, shape)
     except OSError as e:
-        raise OutputError(f"{p}: cannot write: {e.strerror or e}") from e
+        raise OutputError(f"{shown_path(str(p))}: cannot write: {e.strerror or e}") from None
 
 
 def write_file(path: str | Path, data: bytes | str) -> None:
@@ -324,11 +338,8 @@ def write_file(path: str | Path, data: bytes | str) -> None:
     be written (scene files, meshes)."""
     if isinstance(data, str):
         data = data.encode("utf-8")
-    try:
-        with atomic_write(path) as tmp:
-            tmp.write_bytes(data)
-    except OSError as e:
-        raise OutputError(f"{path}: cannot write: {e.strerror or e}") from None
+    with output_errors(path), atomic_write(path) as tmp:
+        tmp.write_bytes(data)
 
 
 def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:

@@ -15,7 +15,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from pyjulia4d.app.output import OutputError, check_directory
+from pyjulia4d.app.output import OutputError, check_directory, output_errors
 from pyjulia4d.files import atomic_write, path_text, quoted_path, shown_path
 from pyjulia4d.resources import module_installed
 
@@ -110,7 +110,7 @@ def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: floa
     first = _even(first)
     h, w = first.shape[:2]
     n = 0
-    with atomic_write(p) as tmp:
+    with output_errors(p), atomic_write(p) as tmp:
         writer = imageio_ffmpeg.write_frames(
             str(tmp), (w, h), fps=fps, codec=CODECS[ext], pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
             quality=None, macro_block_size=1, output_params=QUALITY[ext], ffmpeg_log_level="error")
