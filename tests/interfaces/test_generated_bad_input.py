@@ -96,6 +96,8 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
     vals: list[str] = []
     garbage = [g for g in GARBAGE if g.strip() != word]
     vals += rng.sample(garbage, 3) + [_unicode(rng, rng.randint(1, 12))]
+    if kind == "Bool":   # "true" and "false" (and with spaces around them) are its values
+        return [v for v in vals if v.strip() not in ("true", "false")] + ["True", "yes", "1", "on"]
     if kind == "Choice":
         opts = check.options
         vals += [rng.choice(opts).upper(), rng.choice(opts)[:-1], rng.choice(opts) + "x", "1", "0"]
