@@ -119,7 +119,7 @@ PACKET_KERNEL void march(const int n_items, const int tile_w, RAY_ARGS,
 {
     /* LANES neighbouring rays per packet (common/lanes.cl): one ray, or a block of BLOCK_W x
      * BLOCK_H pixels of the tile (tile_w wide, n_items / tile_w high), PACKETS packets per
-     * work-item; launches are padded to whole work-groups (render.launch) and a block may
+     * work-item; launches are padded to whole work-groups (opencl/runner.launch) and a block may
      * reach past the tile's edges */
 #if LANES == 1
     size_t i0 = get_global_id(0);

@@ -1,7 +1,7 @@
-"""The kernels of a render plan on one device, tile by tile (executor.py runs the tiles).
+"""The kernels of a render plan on one device, tile by tile (opencl/passes.py runs the tiles).
 
-``TileRunner`` holds a plan's programs, its argument records cast to the device's precision
-(pipeline/plan.py) and two slots of tile buffers (opencl/pool.py keeps them between renders);
+``TileRunner`` holds a plan's programs, each kernel's arguments packed once from the plan's
+records by the kernel's signature (pipeline/signatures.py, opencl/records.py) and two slots of tile buffers (opencl/pool.py keeps them between renders);
 ``enqueue`` queues one tile's kernels - the march (rays made in the kernel), normals, light
 terms and shading, the mirror bounce - and the maps of what the plan reads back.  ``launch``
 is the one place a kernel is enqueued.

@@ -81,7 +81,7 @@ def probe_tiles(plan: Plan) -> tuple:
 
 
 def predict(plan: Plan, run_tiles) -> Prediction:
-    """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (opencl/executor.py) and
+    """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (opencl/passes.py) and
     returns their kernel seconds; scaled to the region's pixels and the passes."""
     tiles = probe_tiles(plan)
     pixels = sum(t.w * t.h for t in tiles)

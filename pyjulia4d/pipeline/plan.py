@@ -1,10 +1,14 @@
 """A render's plan: the scene resolved once into everything its kernels need.
 
-scene -> plan -> tiles -> image.  ``make_plan`` checks the work and the memory
-(workload.py), resolves the 4D camera frame, the bounding radius, the light, the
-kernel configurations (build.py) and the tile list, and fixes which outputs are kept.
-A plan holds plain values (numbers, numpy vectors, the scene), so it can be pickled
-and a tile of it executed anywhere the same kernels build; opencl/executor.py executes it, and reference/executor.py in float64.
+scene -> plan -> tiles -> image.  ``make_plan`` checks the arguments once (check_arguments),
+the work and the memory (workload.py), and resolves the image, the 4D camera frame, the
+bounding radius, the light, one record of numbers per stage (MarchArgs, ClipArgs,
+NormalsArgs, LightArgs, ShadeArgs: what each kernel takes, pipeline/signatures.py), the kernel
+configurations (kernel_config.py) and the tile list, and fixes which outputs are kept.  A
+plan holds plain values (numbers, numpy vectors, records; the scene only as the result's
+metadata), so it can be pickled and a tile of it executed anywhere the same kernels build;
+opencl/passes.py executes it, and reference/executor.py in float64, each reading the plan
+alone.
 """
 from __future__ import annotations
 

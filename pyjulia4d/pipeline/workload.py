@@ -186,7 +186,7 @@ OUTPUT_BYTES = {k: o.bytes for k, o in OUTPUTS_TABLE.items()}
 
 def passes(samples: int, outputs) -> int:
     """Passes over every pixel: the centre, and ``samples`` colour passes where there are more
-    than one and colour or alpha is kept (opencl/executor.py, the float64 executor)."""
+    than one and colour or alpha is kept (opencl/passes.py, the float64 executor)."""
     return 1 + samples if samples > 1 and {"color", "alpha"} & set(outputs) else 1
 HOST_MEMORY_SHARE = 0.5     # of the physical memory
 
