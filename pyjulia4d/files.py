@@ -47,7 +47,11 @@ def shown_path(path: str) -> str:
     """The path as a message shows it: itself when printable, else its repr; past
     SHOWN_PATH_MOST characters its start and end around "...", so the message stays a line
     one can read."""
-    s = path if path and path.isprintable() else repr(path)
+    return _shortened(path if path and path.isprintable() else repr(path))
+
+
+def _shortened(s: str) -> str:
+    """``s`` past SHOWN_PATH_MOST characters as its start and end around "..."."""
     return s if len(s) <= SHOWN_PATH_MOST else f"{s[:120]}...{s[-(SHOWN_PATH_MOST - 123):]}"
 
 
@@ -55,8 +59,7 @@ def quoted_path(path: str | Path) -> str:
     """The path in quotes: 'dir', or its repr when not printable; shortened as shown_path
     shortens it, so that a message naming it stays one line."""
     path = str(path)
-    s = f"'{path}'" if path and path.isprintable() else repr(path)
-    return s if len(s) <= SHOWN_PATH_MOST else f"{s[:120]}...{s[-(SHOWN_PATH_MOST - 123):]}"
+    return _shortened(f"'{path}'" if path and path.isprintable() else repr(path))
 
 
 def path_limit(directory: str | Path, name: str, fallback: int) -> int:

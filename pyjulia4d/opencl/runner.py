@@ -179,16 +179,17 @@ class TileRunner:
         normals = sig.NORMALS[plan.normals_args.method]
         packet = plan.normals_in_march_config
         self.normals_k = build.kernel(self.march_prg if packet else self.prg, normals.kernel) if plan.normals else None
-        self.normals_args = Packed(normals, rec, pr)
+        self.normals_args = Packed(normals, rec, pr) if plan.normals else None
         self.normals_lanes = plan.lanes if packet else 1
         planes = plan.clip.planes
         self.clip_k = build.kernel(self.prg, "clip_normals") if planes and plan.normals else None
-        self.clip_args = Packed(sig.CLIP, rec, pr)
+        self.clip_args = Packed(sig.CLIP, rec, pr) if self.clip_k is not None else None
         self.shade_k = build.kernel(self.prg, "shade") if plan.shades else None
-        self.shade_args = Packed(sig.SHADE, rec, pr, lut=self.lut, n_lut=len(lut) if lut is not None else 2, **lights)
+        self.shade_args = (Packed(sig.SHADE, rec, pr, lut=self.lut, n_lut=len(lut) if lut is not None else 2, **lights)
+                           if plan.shades else None)
         # shade/light.cl: in the march's program, in its packets (kernel_config.march_config)
         self.light_k = build.kernel(self.march_prg, "light_terms") if plan.light_terms else None
-        self.light_args = Packed(sig.LIGHT_TERMS, rec, pr, **lights)
+        self.light_args = Packed(sig.LIGHT_TERMS, rec, pr, **lights) if plan.light_terms else None
         if plan.reflects:
             self.refl_prg = build.program(self.ctx, plan.reflect_config)
             self.refl_march_k = build.kernel(self.refl_prg, "march")
@@ -273,7 +274,7 @@ class TileRunner:
         if plan.normals:
             kernels += self.enqueue_normals(tile, bufs, "")
         if plan.reflects:
-            kernels += self.enqueue_reflection(tile, bufs)
+            kernels += self.enqueue_reflection(tile, bufs, items)
         if plan.light_terms:
             kernels.append(launch(q, self.light_k, n, *self.light_args(
                 tile_w=tile.aw, point=bufs["point"], normal=bufs["normal"], status=bufs["status"],
@@ -315,16 +316,16 @@ class TileRunner:
             ev.append(launch(q, self.clip_k, n, *self.clip_args(flags=flags, status=status, normal=normal)))
         return ev
 
-    def enqueue_reflection(self, tile: Tile, bufs: dict) -> list:
+    def enqueue_reflection(self, tile: Tile, bufs: dict, items: int) -> list:
         """shade/reflect.cl: the reflected ray of each hit, marched like a camera ray (the
         march reading given rays, in the same packets), its normals and its colour."""
-        plan, q, n = self.plan, self.queue, tile.n
+        q, n = self.queue, tile.n
         ev = [launch(q, self.reflect_rays_k, n, *self.reflect_rays_args(
             point=bufs["point"], normal=bufs["normal"], status=bufs["status"], origins=bufs["origins"],
             dirs=bufs["dirs"]))]
         ev.append(launch(q, self.refl_march_k, n, *self.refl_march_args(
             tile_w=tile.aw, origins=bufs["origins"], dirs=bufs["dirs"], **self.march_outputs(bufs, "2")),
-            items=march_items(n, tile.aw, plan.lanes, plan.march_packets)))
+            items=items))
         ev += self.enqueue_normals(tile, bufs, "2")
         ev.append(launch(q, self.reflect_color_k, n, *self.reflect_color_args(
             status=bufs["status2"], normal=bufs["normal2"], point=bufs["point2"], dirs=bufs["dirs"],
