@@ -19,6 +19,11 @@ def kernel_dir() -> Path:
     return here.parent / "kernels"
 
 
+def data_dir() -> Path:
+    """The folder of the files pyjulia4d ships (the path tracer's sky, pyjulia4d/data)."""
+    return Path(__file__).resolve().parent / "data"
+
+
 def cache_dir() -> Path:
     """pyjulia4d's cache folder: $PYJULIA4D_CACHE, else ~/.cache/pyjulia4d."""
     root = os.environ.get("PYJULIA4D_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "pyjulia4d")

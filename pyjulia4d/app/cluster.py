@@ -29,6 +29,7 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
+from pyjulia4d.pipeline import film
 from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
@@ -410,7 +411,9 @@ def render_tiled(client: Any, scene: Scene, device: str | None = None, outputs=N
     result = RenderResult(**arrays, counts=counts, guards=guards, lanes=first.lanes,
                           march_method=first.march_method,
                           device_name=", ".join(names) + where,
-                          kernel_seconds=sum(r.kernel_seconds for r in parts.values()), scene=scene)
+                          kernel_seconds=sum(r.kernel_seconds for r in parts.values()), scene=scene,
+                          film=film.join(parts, H, W))
+    film.finish(result, scene)   # the denoiser over the joined picture: no tile seams
     result.seconds = time.perf_counter() - t0
     return result, scene
 
@@ -425,6 +428,7 @@ def render_on_cluster(scene: Scene, workers: int | None = None, scheduler: str |
 
     check_where(workers, scheduler)
     require_cluster(workers, scheduler)
+    film.check_denoiser(scene)
     check(scene, check_device(device, scheduler), force=force, outputs=outputs)
     with cluster(workers, scheduler, device) as client:
         result, _ = render_tiled(client, scene, device, outputs, force, tile, progress)

@@ -134,4 +134,12 @@ def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray | Band], d
                     hit = np.isfinite(result.bracket[rows])
                     return np.where(hit, np.nan_to_num(src[rows], posinf=0.0), 0.0).astype(np.float32)
                 ch[f"ViewLayer.{key}.Z"] = reach
+    film = getattr(result, "film", None)
+    if film is not None:   # a path-traced render's: the denoiser's guide and the noise, per channel
+        for k, name in enumerate("RGB"):
+            ch[f"ViewLayer.Denoising Albedo.{name}"] = np.ascontiguousarray(film.albedo[..., k])
+            ch[f"ViewLayer.Variance.{name}"] = np.ascontiguousarray(film.variance[..., k])
+        if film.noisy is not None:   # image.denoise: Combined is the denoised picture, this the one before
+            for k, name in enumerate("RGB"):
+                ch[f"ViewLayer.Noisy Image.{name}"] = np.ascontiguousarray(film.noisy[..., k])
     return ch, header

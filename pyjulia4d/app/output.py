@@ -318,10 +318,12 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
     scene = getattr(result, "scene", None)
     bits = scene.image.bits if scene is not None else 8
     try:
-        if _suffix(p) == ".png":
-            write_png(p, result.color, result.alpha, header, bits)
-        elif _suffix(p) in TIFF:
-            write_tiff(p, result.color, result.alpha, header, bits)
+        if _suffix(p) in (".png",) + TIFF:
+            from pyjulia4d.pipeline.tonemap import display
+            color = result.color
+            if scene is not None and color is not None:   # exposure and tone map: the picture's, not an EXR's
+                color = display(color, scene.image.exposure, scene.image.tonemap)
+            (write_png if _suffix(p) == ".png" else write_tiff)(p, color, result.alpha, header, bits)
         else:
             from pyjulia4d.app.exr_layout import exr_output
 

@@ -19,6 +19,7 @@ from pyjulia4d.fractal.registry import march_method
 from pyjulia4d.opencl.devices import check_device, device_of, has_fp64
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes, packet_pairs
 from pyjulia4d.opencl.passes import kernel_seconds, run_plan, run_tiles
+from pyjulia4d.pipeline.film import check_denoiser, finish
 from pyjulia4d.opencl.runner import TileRunner, local_size, march_items
 from pyjulia4d.pipeline import workload
 from pyjulia4d.pipeline.calibrate import Prediction, judge, predict, tile_side, wanted
@@ -63,10 +64,13 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
         check_lanes(lanes)
     if not isinstance(store, ImageStore):
         raise SceneError("store", f"expected a pyjulia4d.pipeline.store.ImageStore, got {type(store).__name__}")
+    check_denoiser(scene)
     dev = device_of(device)
     plan, prediction = plan_render(scene, dev, args, lanes, calibrate)
     result = run_plan(plan, dev, progress, on_progress, store)
     result.prediction = prediction
+    if args.region is None:   # a whole picture: post-processed once (a cluster's tiles, once joined)
+        finish(result, result.scene or scene)
     result.seconds = time.perf_counter() - t_start
     return result
 

@@ -13,6 +13,7 @@ from typing import Callable
 import numpy as np
 import pyopencl as cl
 
+from pyjulia4d.opencl.path import path_pass
 from pyjulia4d.opencl.runner import TileRunner
 from pyjulia4d.pipeline import antialias
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
@@ -113,6 +114,9 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
     ``on_progress(pixels done, pixels in all)`` is called as each tile is filed.  The images
     are ``store``'s (pipeline/store.py), each row of tiles let go once filed."""
     t_start = time.perf_counter()
+    path = plan.path
+    if path is not None:   # the centre pass keeps all but the colour, which the path pass makes
+        plan = dataclasses.replace(plan, outputs=plan.outputs - {"color"})
     runner = TileRunner(plan, dev)
     _, _, W, H = plan.region
     filing = Filing(plan, store)
@@ -124,20 +128,30 @@ def run_plan(plan: Plan, dev: cl.Device, progress: bool = False,
         if centre is not None:
             centre.note(t, got)
 
-    with Progress(W * H * plan.passes, "render", "px", enabled=progress, line=_render_line,
+    film = None
+    total = W * H * (plan.passes + (path.samples if path is not None else 0))
+    with Progress(total, "render", "px", enabled=progress, line=_render_line,
                   unit_scale=True, hook=on_progress) as bar:
         # the centre of each pixel: every output (depth, normal, position come from it)
         run_tiles(runner, plan.tiles, centre_file, kernel_events, bar)
         runner.close()
         if plan.passes > 1:
             antialias_passes(plan, dev, filing, centre, kernel_events, bar)
+        if path is not None:
+            film = path_pass(dataclasses.replace(plan, path=path), dev, filing.at, kernel_events, bar)
     img = filing.img
+    if film is not None:
+        img["color"] = np.ascontiguousarray(film.mean[..., :3])
+        if "alpha" in img:
+            img["alpha"] = np.ascontiguousarray(film.mean[..., 3])
     result = RenderResult(
         color=img.get("color"), alpha=img.get("alpha"), depth=img.get("depth"),
         normal=img.get("normal"), position=img.get("position"), status=img.get("status"),
         samples=img.get("samples"), bracket=img.get("bracket"), unresolved=img.get("unresolved"),
         counts=filing.counts, device_name=dev.name.strip(), kernel_seconds=kernel_seconds(kernel_events),
         lanes=plan.lanes, guards=filing.guards, scene=plan.scene, march_method=plan.march.method)
+    if film is not None:
+        result.film = film.result()
     result.seconds = time.perf_counter() - t_start
     return result
 

@@ -82,13 +82,14 @@ def probe_tiles(plan: Plan) -> tuple:
 
 def predict(plan: Plan, run_tiles) -> Prediction:
     """The probe: ``run_tiles(tiles)`` runs the plan's kernels over the tiles (opencl/passes.py) and
-    returns their kernel seconds; scaled to the region's pixels and the passes."""
+    returns their kernel seconds; scaled to the region's pixels and the rays each takes (its
+    passes; a path-traced render's paths, at most: Plan.rays_per_pixel)."""
     tiles = probe_tiles(plan)
     pixels = sum(t.w * t.h for t in tiles)
     seconds = run_tiles(tiles)
     spp = seconds / pixels
     _, _, w, h = plan.region
-    return Prediction(spp * w * h * plan.passes, spp, pixels, seconds)
+    return Prediction(spp * w * h * plan.rays_per_pixel, spp, pixels, seconds)
 
 
 def _duration(seconds: float) -> str:

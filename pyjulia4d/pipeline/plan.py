@@ -19,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pyjulia4d.pipeline import kernel_config, workload
+from pyjulia4d.pipeline.records import ClipArgs, LightArgs, MarchArgs, NormalsArgs, ShadeArgs, march_args
+from pyjulia4d.pipeline.path_plan import PathArgs, path_args, path_config, path_march_config, resolve_focus
 from pyjulia4d.pipeline.workload import resolve_outputs
 from pyjulia4d.geometry.camera import Frame, camera_frame, clip_planes, extra_lights, light_position, march_radius
 from pyjulia4d.scene.checks import SceneError, show
@@ -92,113 +94,6 @@ def make_tiles(width: int, height: int, tile: int = TILE, halo: int = 0,
     return tuple(out)
 
 
-# ---------------------------------------------------------------- the kernels' argument records
-# What each kernel takes besides its buffers, resolved from the scene once, in float64: the
-# OpenCL executor casts them to the device's precision in the order the kernel declares
-# them; the float64 reference executes the same records.
-
-
-@dataclass(frozen=True)
-class MarchArgs:
-    """march/march.cl's constants (and the reflected rays' march, shade/reflect.cl)."""
-    c: tuple[float, float, float, float]
-    max_iter: int
-    bailout: float
-    epsilon: float
-    radius: float          # the bounding 4-ball (camera.march_radius)
-    near: float            # march.near, or -1 for "the ball's entry"
-    far: float             # march.far, or -1 for "the ball's exit"
-    z_resolution: int
-    post_steps: int
-    max_steps: int
-    method: str            # "fixed", "de" or "proven": march.method resolved (fractal/registry.march_method)
-    refine: str
-    cone: bool = False     # camera rays start where their block's cone reached (kernel_config.cone_start)
-
-
-@dataclass(frozen=True)
-class ClipArgs:
-    """[clip]'s half-spaces in world space, as march.cl and march/clip.cl take them: up to
-    four (normal, offset) pairs, the unused ones zero."""
-    planes: tuple[tuple[np.ndarray, float], ...]
-
-    @property
-    def n_clip(self) -> int:
-        return len(self.planes)
-
-    def normal(self, k: int):
-        return self.planes[k][0] if k < len(self.planes) else (0.0, 0.0, 0.0, 0.0)
-
-    clip_n0 = property(lambda self: self.normal(0))
-    clip_n1 = property(lambda self: self.normal(1))
-    clip_n2 = property(lambda self: self.normal(2))
-    clip_n3 = property(lambda self: self.normal(3))
-
-    @property
-    def clip_off(self) -> tuple[float, ...]:
-        return tuple(self.planes[k][1] if k < len(self.planes) else 0.0 for k in range(4))
-
-
-@dataclass(frozen=True)
-class NormalsArgs:
-    method: str            # "jacobian", "gradient" or "zbuffer"
-    step: float            # the gradient's difference step (gradient_step)
-
-
-@dataclass(frozen=True)
-class LightArgs:
-    """shade/light.cl's numbers (light_parameters): shadow rays, occlusion, the orbit trap."""
-    step: float
-    max_steps: int
-    bias: float
-    softness: float
-    ao_distance: float
-    ao_strength: float
-    trap: tuple[float, float, float, float]
-    shadow: str            # the positioned light's shadows: "none", "hard" or "soft" (none for the light at the eye)
-    extra_shadow: str      # shading.lights' shadows: "none" without them
-    coloring: str          # shading.coloring: the colour value light.cl computes
-
-    @property
-    def used(self) -> bool:
-        """Whether shade/light.cl has anything to compute (kernel_config.light_defines)."""
-        return self.shadow != "none" or self.extra_shadow != "none" or self.ao_strength > 0 or self.coloring != "flat"
-
-
-@dataclass(frozen=True)
-class ShadeArgs:
-    """shade/shade.cl's constants and shade/reflect.cl's colour."""
-    light: np.ndarray      # the positioned light in world space, or the eye (what the kernels take)
-    point_light: np.ndarray | None   # the positioned light, None for the light at the eye (-D LIGHT_POINT)
-    color: tuple[float, ...]
-    background: tuple[float, ...]
-    light_color: tuple[float, ...]
-    sky: tuple[float, ...]
-    ambient: float
-    diffuse: float
-    specular: float
-    shininess: float
-    fog: float
-    fog_start: float       # the eye's distance to the bounding ball (fog_start)
-    reflection: float
-    colormap: str | None   # shading.colormap where a colour map is used, else None
-    lights_geo: np.ndarray     # shading.lights (camera.extra_lights; one inert row where there are none)
-    lights_rgb: np.ndarray
-    n_lights: int = 0          # how many shading.lights there are
-
-
-def march_args(scene: Scene, radius: float | None = None, **changes) -> MarchArgs:
-    """The march's record of ``scene`` (its bounding ball's ``radius``: camera.march_radius
-    where None), with ``changes`` to its fields (the tests' and benchmarks' own settings)."""
-    f, m = scene.fractal, scene.march
-    args = MarchArgs(c=tuple(f.c), max_iter=f.max_iter, bailout=f.bailout, epsilon=m.epsilon,
-                     radius=march_radius(scene) if radius is None else radius,
-                     near=-1.0 if m.near == "auto" else float(m.near), far=-1.0 if m.far == "auto" else float(m.far),
-                     z_resolution=m.z_resolution, post_steps=m.post_steps, max_steps=m.max_steps,
-                     method=march_method(scene), refine=m.refine, cone=kernel_config.cone_start(scene))
-    return dataclasses.replace(args, **changes) if changes else args
-
-
 def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     """The argument records of every kernel of ``scene`` (Plan's march, clip, normals,
     light_args, shade)."""
@@ -246,17 +141,29 @@ class Plan:
     halo: int                     # pixels around each tile computed for its Z-buffer normals (halo_for)
     region: tuple[int, int, int, int] = (0, 0, 0, 0)   # (x0, y0, w, h) rendered: the image or a part
     pairs: bool = False           # two packets per work-item of the march, where they apply (kernel_config.march_packets)
+    path: PathArgs | None = None  # shading.integrator = "path": the path tracer's record (path_plan.py)
+    path_config: kernel_config.KernelConfig | None = None   # its program (path_plan.path_config)
+    path_march_config: kernel_config.KernelConfig | None = None   # its rays' march (path_plan.path_march_config)
 
     def records(self) -> dict:
         """The records kernels take their constants from, by the names pipeline/signatures.py
         gives them ("march.c")."""
         return {"camera": self.frame, "image": self.image, "march": self.march, "clip": self.clip,
-                "normals": self.normals_args, "light": self.light_args, "shade": self.shade}
+                "normals": self.normals_args, "light": self.light_args, "shade": self.shade, "path": self.path}
 
     @property
     def passes(self) -> int:
-        """Passes over every pixel: the centre, and image.samples colour passes (workload.passes)."""
-        return workload.passes(self.image.samples, self.outputs)
+        """Passes over every pixel: the centre, and image.samples colour passes (workload.passes);
+        a path-traced render's samples are its path pass's (opencl/path.py), not these."""
+        return 1 if self.path is not None else workload.passes(self.image.samples, self.outputs)
+
+    @property
+    def rays_per_pixel(self) -> int:
+        """Rays marched per pixel at most: the passes, or the centre pass and per path sample a
+        march of each bounce's rays and of its shadow rays (workload.rays_per_pixel)."""
+        if self.path is None:
+            return self.passes
+        return 1 + self.path.samples * 2 * self.path.bounces
 
     @property
     def radius(self) -> float:
@@ -390,6 +297,7 @@ def plan_from(scene: Scene, device, lanes: int, args: RenderArgs, pairs: bool = 
     halo = halo_for(scene.normals.method, args.outputs)
     records = kernel_arguments(scene, frame, radius)
     region = args.region
+    path = scene.shading.integrator == "path" and bool({"color", "alpha"} & args.outputs)
     return Plan(
         scene=scene, image=scene.image, fractal=scene.fractal, frame=frame, march=records["march"],
         clip=records["clip"], normals_args=records["normals"], light_args=records["light_args"],
@@ -400,7 +308,9 @@ def plan_from(scene: Scene, device, lanes: int, args: RenderArgs, pairs: bool = 
                         if scene.shading.reflection > 0 else None),
         halo=halo, tiles=make_tiles(scene.image.width, scene.image.height, args.tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height), pairs=pairs,
-        estimate=est)
+        estimate=est, path=path_args(scene, resolve_focus(scene, frame, records["march"])) if path else None,
+        path_config=path_config(scene) if path else None,
+        path_march_config=path_march_config(scene, lanes, pairs) if path else None)
 
 
 # ---------------------------------------------------------------- numbers the kernels take

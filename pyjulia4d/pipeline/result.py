@@ -12,6 +12,7 @@ import numpy as np
 
 from pyjulia4d.pipeline.codes import GUARD_JACOBIAN_TINY, GUARD_NORMAL_FALLBACK, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, \
     STATUS_HIT
+from pyjulia4d.pipeline.film import Film
 from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.scene.model import Scene
 
@@ -45,6 +46,7 @@ class RenderResult:
     scene: Scene | None = None   # the scene as rendered: camera.fit resolved into the camera it chose
     march_method: str = ""       # the march that ran: "fixed", "de" or "proven" (the plan's)
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran
+    film: Film | None = None     # a path-traced render's samples, variance and stated noise (pipeline/film.py)
 
     def __repr__(self) -> str:
         h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
@@ -174,6 +176,12 @@ class RenderResult:
             if un["hit"] or un["miss"]:
                 tail += ("; the space in front of the hits is not proven empty (march.method=proven proves "
                          "it and states the whole error)")
+        if self.film is not None:   # a path-traced picture states its noise as it states its depth error
+            header["pyjulia4d.noise"] = self.film.header()
+            n = self.film.noise_stats()
+            lo, hi = int(self.film.paths.min()), int(self.film.paths.max())
+            tail += (f"; noise p50 {n['p50']:.2g} p99 {n['p99']:.2g} (standard error of the mean luminance of "
+                     f"the set's pixels, {lo if lo == hi else f'{lo}-{hi}'} paths per pixel)")
         return header, tail
 
     @property
@@ -203,6 +211,15 @@ class RenderResult:
         if self.position is not None:
             for k, name in enumerate("XYZW"):
                 ch[f"P.{name}"] = self.position[..., k]
+        if self.film is not None:   # path-traced: the variance of each channel's mean, the noise, the albedo
+            for k, name in enumerate("RGB"):
+                ch[f"variance.{name}"] = self.film.variance[..., k]
+                ch[f"albedo.{name}"] = self.film.albedo[..., k]
+            ch["noise.Y"] = self.film.noise
+            ch["paths.Y"] = self.film.paths
+            if self.film.noisy is not None:   # image.denoise: R, G, B are the denoised picture
+                for k, name in enumerate("RGB"):
+                    ch[f"noisy.{name}"] = self.film.noisy[..., k]
         return {k: np.ascontiguousarray(v, dtype=f) for k, v in ch.items()}
 
 

@@ -149,6 +149,41 @@ REFLECT_COLOR = Signature("reflect_color", "shade/reflect", (
     P("global const real4* dirs"), *BASIS, P("real4 light_pos", "shade.light"), *SURFACE_COLOR,
     P("global float4* refl")))
 
+# ---------------------------------------------------------------- the path tracer's kernels (kernels/path/path.cl)
+
+TILE_PLACE = (P("int tile_w"), P("int x0"), P("int y0"))
+
+PATH_CAMERA = Signature("path_camera", "path/path", (
+    *TILE_PLACE, P("real4 eye", "camera.position"), P("real4 forward", "camera.forward"),
+    P("real4 right", "camera.right"), P("real4 up", "camera.up"), P("real tan_half_fov", "camera.tan_half_fov"),
+    P("int image_w", "image.width"), P("int image_h", "image.height"), P("real aperture", "path.aperture"),
+    P("real focus", "path.focus"), P("real radius", "march.radius"), P("int sample"), P("float noise", "path.noise"),
+    P("int min_samples", "path.min_samples"), P("global const float4* film_m2"), P("global const int* film_count"),
+    P("global real4* origins"), P("global real4* dirs"), P("global float4* thru"), P("global float4* rad")))
+
+PATH_BOUNCE = Signature("path_bounce", "path/path", (
+    *TILE_PLACE, P("int image_w", "image.width"), P("int sample"), P("int bounce"), P("int bounces", "path.bounces"),
+    P("global const int* status"), P("global const real4* point"), P("global const real4* normal"),
+    P("global const real* bracket"), *ORBIT, *BASIS, P("real4 light_pos", "shade.light"),
+    P("float4 light_color", "shade.light_color"), P("global const real4* lights_geo"),
+    P("global const float4* lights_rgb"), P("float4 color", "shade.color"), P("float4 background", "shade.background"),
+    P("float4 sky", "path.sky"), P("real metallic", "path.metallic"), P("real alpha2", "path.alpha2"),
+    P("real f0s", "path.f0s"), P("real bias", "light.bias"), P("real radius", "march.radius"),
+    P("real4 trap", "light.trap"), P("global const float4* lut"), P("int n_lut"), P("global real4* origins"),
+    P("global real4* dirs"), P("global float4* thru"), P("global float4* rad"), P("global float4* pending"),
+    P("global real4* s_origins"), P("global real4* s_dirs"), P("global float4* albedo"),
+    *group("ENV_MAP", P("global const float4* env"), P("global const real* env_rows"), P("global const real* env_cols"),
+           P("int env_w", "path.env_w"), P("int env_h", "path.env_h"), P("real4 env_x", "path.env_x"),
+           P("real4 env_y", "path.env_y"), P("real4 env_z", "path.env_z"))))
+
+PATH_SHADOW = Signature("path_shadow", "path/path", (
+    P("global const int* status"), P("global const real* depth"), P("global const float4* pending"),
+    P("global float4* rad")))
+
+PATH_FILM = Signature("path_film", "path/path", (
+    P("global const float4* rad"), P("global const float4* albedo"), P("global float4* film_mean"),
+    P("global float4* film_m2"), P("global float4* film_albedo"), P("global int* film_count")))
+
 # ---------------------------------------------------------------- the mesh's kernels (pipeline/mesh_plan.py)
 
 MESH_ORBIT = (P("real radius2", "mesh.radius2"), P("real4 c", "mesh.c"), P("int max_iter", "mesh.max_iter"),
@@ -195,7 +230,7 @@ CAFF_OPS = Signature("caff_ops", "enclose/caff", (
 
 SIGNATURES = {s.kernel: s for s in (
     CONE_STARTS, MARCH, NORMALS_JACOBIAN, NORMALS_GRADIENT, NORMALS_ZBUFFER, CLIP, LIGHT_TERMS, SHADE, REFLECT_RAYS,
-    REFLECT_COLOR, MESH_SAMPLE, MESH_VERTICES, GENERATE_RAYS, PROBE_ITERATE, PROBE_STEP, PROBE_CFUN,
+    REFLECT_COLOR, PATH_CAMERA, PATH_BOUNCE, PATH_SHADOW, PATH_FILM, MESH_SAMPLE, MESH_VERTICES, GENERATE_RAYS, PROBE_ITERATE, PROBE_STEP, PROBE_CFUN,
     PROVE_SEGMENTS, CAFF_OPS)}
 
 NORMALS = {"jacobian": NORMALS_JACOBIAN, "gradient": NORMALS_GRADIENT, "zbuffer": NORMALS_ZBUFFER}

@@ -86,7 +86,7 @@ def estimate(scene: Scene, device=None, outputs=None) -> Estimate:
     """Upper bound of the work of ``scene`` keeping ``outputs`` (None: all) and its predicted
     time on ``device`` (a pyopencl Device, "CPU", "GPU", or None for the measured CPU figure)."""
     f, m = scene.fractal, scene.march
-    pixels = scene.image.width * scene.image.height * passes(scene.image.samples, resolve_outputs(outputs))
+    pixels = scene.image.width * scene.image.height * rays_per_pixel(scene, outputs)
     # ITP refinement: up to post_steps + 1 set tests and the two ends' levels (march/refine.cl)
     refine = m.post_steps + 3 if m.refine == "itp" else m.post_steps
     if march_method(scene) == "fixed":
@@ -246,10 +246,19 @@ def check_memory(scene: Scene, outputs=None) -> None:
                                  f"half of this machine's {total / 2**30:.3g} GiB; at most ~{most:.3g} pixels")
 
 
-def probe_iterations(scene: Scene, est: Estimate) -> float:
-    """The bound's share of calibrate.py's probe render (PROBE_RAYS pixels)."""
+def rays_per_pixel(scene: Scene, outputs=None) -> int:
+    """Rays marched per pixel, at most: a pass each (``passes``), or for a path-traced render
+    the centre pass and per sample a march of each bounce's rays and of its shadow rays."""
+    outs = resolve_outputs(outputs)
+    if scene.shading.integrator == "path" and {"color", "alpha"} & outs:
+        return 1 + scene.image.samples * 2 * scene.shading.bounces
+    return passes(scene.image.samples, outs)
+
+
+def probe_iterations(scene: Scene, est: Estimate, outputs=None) -> float:
+    """The bound's share of calibrate.py's probe render (PROBE_RAYS pixels, one ray each)."""
     pixels = scene.image.width * scene.image.height
-    return est.iterations * min(1.0, PROBE_RAYS / pixels)
+    return est.iterations / rays_per_pixel(scene, outputs) * min(1.0, PROBE_RAYS / pixels)
 
 
 def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estimate:
@@ -260,7 +269,7 @@ def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estim
     check_numerics(scene)
     check_memory(scene, outputs)
     est = estimate(scene, device, outputs)
-    if (est.iterations > REFUSE_ITERATIONS and probe_iterations(scene, est) > PROBE_LIMIT_ITERATIONS
+    if (est.iterations > REFUSE_ITERATIONS and probe_iterations(scene, est, outputs) > PROBE_LIMIT_ITERATIONS
             and not force):
         text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
                 f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "

@@ -15,7 +15,9 @@ from pyjulia4d.pipeline.result import RenderResult, count_guards
 from pyjulia4d.reference.antialias import flag_edges
 from pyjulia4d.reference.cone import cone_of_pixels, cone_starts
 from pyjulia4d.reference.formula import formula_of
+from pyjulia4d.pipeline.film import Film
 from pyjulia4d.reference.march import march
+from pyjulia4d.reference.path import film as path_film
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian, normals_zbuffer
 from pyjulia4d.reference.rays import generate_rays
 from pyjulia4d.reference.shade import extra_visibility, light_terms, reflect_color, reflect_rays, shade
@@ -99,5 +101,12 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
                        unresolved=unresolved.reshape(h, w),
                        device_name="numpy float64 reference", scene=plan.scene, march_method=ma.method,
                        guards=count_guards(status, depth, guard))
+    if plan.path is not None:   # reference/path.py: the same paths, every pixel, in float64
+        y, x = np.mgrid[0:h, 0:w]
+        mean, cover, film = path_film(plan, x.ravel(), y.ravel())
+        res.color, res.alpha = mean.reshape(h, w, 3).astype(np.float32), cover.reshape(h, w).astype(np.float32)
+        res.film = Film(paths=film.paths.reshape(h, w), variance=film.variance.reshape(h, w, 3),
+                        noise=film.noise.reshape(h, w), albedo=film.albedo.reshape(h, w, 3),
+                        covered=film.covered.reshape(h, w))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

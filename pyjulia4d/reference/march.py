@@ -11,7 +11,7 @@ from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula, julia_inside, julia_level
 
 if TYPE_CHECKING:
-    from pyjulia4d.pipeline.plan import MarchArgs
+    from pyjulia4d.pipeline.records import MarchArgs
 
 def refine_bracket(o, d, a, b, steps, c, max_iter, bailout, itp=True, tests=None,
                    formula: Formula = QUATERNION_SQR):

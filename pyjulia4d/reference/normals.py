@@ -11,7 +11,7 @@ from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_JACOBIAN_TINY, GUARD_N
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 
 if TYPE_CHECKING:
-    from pyjulia4d.pipeline.plan import MarchArgs, NormalsArgs
+    from pyjulia4d.pipeline.records import MarchArgs, NormalsArgs
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula
 from pyjulia4d.reference.kind.level import rescale_columns
 

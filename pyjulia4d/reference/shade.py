@@ -14,7 +14,7 @@ from pyjulia4d.reference.normals import to_camera
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 
 if TYPE_CHECKING:
-    from pyjulia4d.pipeline.plan import LightArgs, MarchArgs, ShadeArgs
+    from pyjulia4d.pipeline.records import LightArgs, MarchArgs, ShadeArgs
 
 
 def shadow_ray(o, l, tmax, c, max_iter, bailout, radius, step, softness, max_steps, soft,

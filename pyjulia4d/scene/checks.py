@@ -326,6 +326,29 @@ class Lights:
         return tuple(out)
 
 
+class ImageFile:
+    """One of a few words, or the path of an image file with one of ``suffixes`` (read at
+    planning, where a missing or bad file is refused the same way)."""
+
+    verbatim = True
+
+    def __init__(self, words: tuple[str, ...], suffixes: tuple[str, ...], what: str) -> None:
+        self.words, self.suffixes = words, suffixes
+        quoted = ", ".join(f'"{w}"' for w in words)
+        self.valid = f"{quoted} or the path of {what} ({', '.join(suffixes)})"
+
+    def __call__(self, key: str, v: Any) -> str:
+        if not isinstance(v, str) or not v.strip():
+            raise SceneError(key, f"expected {self.valid}, got {show(v)}")
+        if v in self.words:
+            return v
+        if len(v) > 4096 or any(ch in v for ch in "\0\n\r"):
+            raise SceneError(key, f"expected a file path (one line, at most 4096 characters), got {show(v)}")
+        if not v.lower().endswith(self.suffixes):
+            raise SceneError(key, f"expected {self.valid}, got {show(v)}")
+        return v
+
+
 class OrWord:
     """The literal string ``word``, else what ``inner`` accepts."""
 

@@ -74,6 +74,11 @@ class Camera:
     # read by from_dict/from_toml (or the command line) that gives no camera.position and
     # no camera.fit gets true (Scene.from_dict)
     fit: bool = False
+    # the path tracer's thin lens (shading.integrator = "path"): its radius in scene units (0:
+    # a pinhole, all in focus), focused at a distance along the view axis or, "auto", on the
+    # surface at the picture's centre (pipeline/path_plan.resolve_focus)
+    aperture: float = 0.0
+    focus: Union[float, Auto] = "auto"
 
     def __post_init__(self) -> None:
         check_section(self, "camera")
@@ -146,6 +151,15 @@ class Shading:
     sky: Vec3 = (1.0, 1.0, 1.0)    # colour of the ambient light (times ambient and occlusion)
     lights: tuple["Light", ...] = ()   # more lights beside ``light`` (at most MAX_LIGHTS)
     reflection: float = 0.0        # share of one mirror bounce in the colour (shade/reflect.cl); 0 = off
+    # "direct": the lights, shadows and occlusion above; "path": Monte Carlo light transport
+    # (kernels/path/): diffuse and glossy bounces lit by the lights and the sky
+    integrator: str = "direct"
+    # path: the light from every direction, times ambient and sky: "uniform", "sky" (the shipped
+    # daylight, pyjulia4d/data/sky.py) or an equirectangular .exr / .hdr (pipeline/environment.py)
+    environment: str = "sky"
+    bounces: int = 4               # path: hits a path takes at most (1: direct light alone)
+    roughness: float = 0.35        # path: the microfacet width (0 mirror-like, 1 matte)
+    metallic: float = 0.0          # path: 0 a dielectric (coloured diffuse, white gloss), 1 a metal
 
     def __post_init__(self) -> None:
         check_section(self, "shading")
@@ -161,6 +175,10 @@ class Image:
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
     bits: int = 8         # per channel of a PNG or TIFF (app/output.py); EXR is float32 always
     exr: str = "pyjulia4d"   # an EXR's channels: pyjulia4d's own, or the passes compositors read (app/exr_layout.py)
+    noise: float = 0.0    # path: stop a pixel's samples once its stated noise is this low (0: take them all)
+    exposure: float = 0.0   # stops of brightness applied before the tone map
+    tonemap: str = "clamp"  # "clamp", "aces" or "agx" (pipeline/tonemap.py): linear light to the display
+    denoise: bool = False   # path: Open Image Denoise over the whole picture (the extra pyjulia4d[denoise])
 
     def __post_init__(self) -> None:
         check_section(self, "image")

@@ -9,8 +9,8 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS, KINDS
-from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, Integer, Lights, OrWord, Planes, Real,
-                                    SceneError, Vector, Whole)
+from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, ImageFile, Integer, Lights, OrWord, Planes,
+                                    Real, SceneError, Vector, Whole)
 from pyjulia4d.scene.quality import QUALITIES
 
 Vec3 = tuple[float, float, float]
@@ -81,6 +81,8 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "limbo": Vector((3, 4), -COORD, COORD, nonzero=True),
         "fov": Real(1e-6, 179.9),
         "fit": Bool(),
+        "aperture": Real(0.0, 1e3),
+        "focus": OrWord("auto", Real(1e-6, 1e7)),
     },
     "slice": {
         "normal": Vector((4,), -COORD, COORD, nonzero=True),
@@ -122,14 +124,23 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "sky": Vector((3,), 0.0, 1e3),
         "lights": Lights(MAX_LIGHTS, Light),
         "reflection": Real(0.0, 1.0),
+        "integrator": Choice("direct", "path"),
+        "environment": ImageFile(("uniform", "sky"), (".exr", ".hdr"), "an equirectangular image, twice as wide as high"),
+        "bounces": Integer(1, 64),
+        "roughness": Real(0.0, 1.0),
+        "metallic": Real(0.0, 1.0),
     },
     "image": {
         "width": Integer(1, INT_MAX),
         "height": Integer(1, INT_MAX),
-        "samples": Integer(1, 256),
+        "samples": Integer(1, 65536),
         "adaptive": Bool(),
         "bits": Whole(8, 16),
         "exr": Choice("pyjulia4d", "compositing"),
+        "noise": Real(0.0, 1.0),
+        "exposure": Real(-20.0, 20.0),
+        "tonemap": Choice("clamp", "aces", "agx"),
+        "denoise": Bool(),
     },
     "clip": {
         "planes": Planes(4),

@@ -60,3 +60,4 @@ def check_fractal(scene: Any) -> None:
                          f"has none of; use jacobian or zbuffer")
 
 
+

@@ -68,7 +68,7 @@ def test_keys_section_and_bad_section(capsys) -> None:
     out = capsys.readouterr().out
     assert [ln.split(" = ")[0] for ln in out.splitlines() if not ln.startswith(" ")] == \
         ["image.width", "image.height", "image.samples", "image.adaptive", "image.bits",
-         "image.exr"]
+         "image.exr", "image.noise", "image.exposure", "image.tonemap", "image.denoise"]
     assert cli.main(["keys", "octonion"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("pyjulia4d: error: octonion: unknown section") and err.count("\n") == 1

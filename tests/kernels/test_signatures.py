@@ -17,6 +17,7 @@ from pyjulia4d import Scene
 from pyjulia4d.opencl.runner import queue_for
 from pyjulia4d.pipeline import kernel_config, signatures
 from pyjulia4d.pipeline.kernel_config import KernelConfig
+from pyjulia4d.pipeline.path_plan import path_config
 from pyjulia4d.resources import kernel_dir
 
 K = kernel_config
@@ -42,10 +43,13 @@ CONFIGS = {
     "shade_gradient": lambda: K.shade_config(_scene("normals.method=gradient", *SHADING)),
     "shade_zbuffer": lambda: K.shade_config(_scene("normals.method=zbuffer")),
     "whole_scene": lambda: K.scene_config(_scene("march.quality=normal", *SHADING), ray_buffers=True),
+    "path": lambda: path_config(_scene("shading.integrator=path", *SHADING)),
+    "path_gradient_double": lambda: path_config(_scene("shading.integrator=path", "normals.method=gradient",
+                                                       "render.float=double")),
     "mesh": lambda: K.mesh_config(_scene()),
     "probe": lambda: K.probe_config(_scene()),
 }
-SAMPLE = ("march_packets_pairs", "march_clip_light", "shade", "mesh")
+SAMPLE = ("march_packets_pairs", "march_clip_light", "shade", "path", "mesh")
 
 
 def _declared(kernel: cl.Kernel) -> list[tuple[str, str]]:

@@ -241,7 +241,7 @@ def test_executors_see_a_scene_read() -> None:
 # Where the march is resolved from a scene: planning (the registry, the plan and what it
 # calls: kernel configurations, the work bound, the bounding ball) and the render's entry,
 # which picks the packet width before the plan.  Everything after reads plan.march.method.
-PLANNING = {"pyjulia4d.fractal.registry", "pyjulia4d.pipeline.plan", "pyjulia4d.pipeline.kernel_config",
+PLANNING = {"pyjulia4d.fractal.registry", "pyjulia4d.pipeline.plan", "pyjulia4d.pipeline.records", "pyjulia4d.pipeline.kernel_config",
             "pyjulia4d.pipeline.workload", "pyjulia4d.geometry.camera", "pyjulia4d.opencl.executor"}
 
 

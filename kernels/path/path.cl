@@ -1,0 +1,305 @@
+/* path/path.cl (-D PATH): the path tracer's stages between the marches, one ray per
+ * work-item (shading.integrator = "path").  Each sample of each pixel of a tile is a path
+ * of at most BOUNCES hits (Kajiya, "The Rendering Equation", 1986, §7: one path per sample):
+ *
+ *   path_camera  the camera ray through a random point of the pixel and of the lens (a thin
+ *                lens of radius ``aperture`` focused at ``focus`` along the view axis; 0:
+ *                a pinhole), or none where the pixel already meets the noise target;
+ *   (march)      march/march.cl with -D RAYS_FROM_BUFFERS, the render's own march;
+ *   (normals)    the render's normals, the Jacobian's where the Z-buffer's were asked for;
+ *   path_bounce  at a miss the environment (the background for a camera ray); at a hit one
+ *                light's sample (next-event estimation: the key light, shading.lights, or
+ *                the sky, picked uniformly) waiting on its shadow ray, and the next ray
+ *                drawn from the material (path/sample.cl), Russian roulette from the third
+ *                hit on (Arvo & Kirk, "Particle Transport and Image Synthesis", 1990, §4);
+ *   (march)      the shadow rays, the same march;
+ *   path_shadow  a light's sample counts where its shadow ray reached it;
+ *   path_film    each pixel's mean and its squared deviations, sample by sample (Welford,
+ *                1962), from which the stated noise comes.
+ *
+ * Light: shading.light and each of shading.lights gives a white matte surface facing it
+ * its colour (a point light without falloff, or a distant one: irradiance pi color); the
+ * sky is an environment of radiance ambient * sky (times shading.environment's image), drawn
+ * cosine-weighted about the normal (uniform) or by the image's light, and joined with the
+ * material's samples by the power heuristic.  A path holds
+ * thru = (throughput, the weight the sky gets where its next ray escapes) and rad =
+ * (radiance, coverage); rad.w = -1 marks a pixel that takes no sample (path_film skips it). */
+
+#ifdef EXTRA_LIGHTS
+#define EXTRA_LIGHT_COUNT EXTRA_LIGHTS
+#else
+#define EXTRA_LIGHT_COUNT 0
+#endif
+/* The sky: uniform (radiance sky, drawn cosine-weighted about the normal), or with -D ENV_MAP
+ * shading.environment's image (path/environment.cl) times sky, drawn by its light. */
+#ifdef ENV_MAP
+#define ENV_PARAMS , __global const float4 *env, __global const real *env_rows, __global const real *env_cols, \
+                   const int env_w, const int env_h, const real4 env_x, const real4 env_y, const real4 env_z
+#define ENV_INIT env_map em = { env, env_rows, env_cols, env_w, env_h, env_x, env_y, env_z }
+#define SKY_RADIANCE(d4) (sky * env_radiance(&em, (d4)))
+#define SKY_PDF(n, d3) env_pdf(&em, to_world((d3), right, up, forward))
+#define SKY_SAMPLE(n, u1, u2) path_unit(to_cam(env_sample(&em, (u1), (u2)), right, up, forward))
+#else
+#define ENV_PARAMS
+#define ENV_INIT
+#define SKY_RADIANCE(d4) (sky)
+#define SKY_PDF(n, d3) (fmax(DOT3((n), (d3)), (real)0) * (real)(1 / PATH_PI))
+#define SKY_SAMPLE(n, u1, u2) path_cosine((n), (u1), (u2))
+#endif
+#define PATH_FAR(radius) ((real4)(4 * (radius), 0, 0, 0))   /* a ray the march finds outside the ball */
+#define DIM(bounce, k) (4u + 8u * (uint)(bounce) + (uint)(k))   /* the random dimensions of a hit */
+
+inline pvec to_cam(real4 a, real4 right, real4 up, real4 forward)
+{
+    return PVEC(DOT4(a, right), DOT4(a, up), -DOT4(a, forward));
+}
+
+inline real4 to_world(pvec a, real4 right, real4 up, real4 forward)
+{
+    return a.x * right + a.y * up - a.z * forward;
+}
+
+inline uint pixel_key(size_t i, int tile_w, int x0, int y0, int image_w)
+{
+    int px = x0 + (int)(i % (size_t)tile_w), py = y0 + (int)(i / (size_t)tile_w);
+    return (uint)py * (uint)image_w + (uint)px;
+}
+
+inline float film_lum(float4 c)
+{
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
+
+/* standard error of a pixel's mean luminance after n samples (m2: squared deviations) */
+inline float film_error(float m2, int n)
+{
+    return n > 1 ? sqrt(fmax(m2, 0.0f) / ((float)n * (float)(n - 1))) : INFINITY;
+}
+
+__kernel void path_camera(const int n_items, const int tile_w, const int x0, const int y0, const real4 eye,
+                          const real4 forward, const real4 right, const real4 up, const real tan_half_fov,
+                          const int image_w, const int image_h, const real aperture, const real focus,
+                          const real radius, const int sample, const float noise, const int min_samples,
+                          __global const float4 *film_m2, __global const int *film_count,
+                          __global real4 *origins, __global real4 *dirs, __global float4 *thru,
+                          __global float4 *rad)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    int n = film_count[i];
+    if (noise > 0.0f && n >= min_samples && film_error(film_m2[i].w, n) <= noise) {
+        origins[i] = PATH_FAR(radius);
+        dirs[i] = (real4)(1, 0, 0, 0);
+        thru[i] = (float4)(0.0f);
+        rad[i] = (float4)(0.0f, 0.0f, 0.0f, -1.0f);
+        return;
+    }
+    uint key = pixel_key(i, tile_w, x0, y0, image_w);
+    int px = x0 + (int)(i % (size_t)tile_w), py = y0 + (int)(i / (size_t)tile_w);
+    real u, v;
+    camera_uv(px, py, path_rand(key, (uint)sample, 0u), path_rand(key, (uint)sample, 1u), tan_half_fov, image_w,
+              image_h, &u, &v);
+    real4 d = camera_dir(u, v, forward, right, up);
+    real4 o = eye;
+    if (aperture > (real)0) {
+        /* the thin lens: every ray through the pixel's point of the focal plane */
+        real2 l = aperture * path_disc(path_rand(key, (uint)sample, 2u), path_rand(key, (uint)sample, 3u));
+        real4 f = eye + d * (focus / DOT4(d, forward));
+        o = eye + l.x * right + l.y * up;
+        real4 e = f - o;
+        d = e / sqrt(DOT4(e, e));
+    }
+    origins[i] = o;
+    dirs[i] = d;
+    thru[i] = (float4)(1.0f, 1.0f, 1.0f, 1.0f);
+    rad[i] = (float4)(0.0f);
+}
+
+/* The colour of a hit: the scene's, or the colour map's entry for its colour value
+ * (shade/light.cl orbit_value, the inside end of its bracket for the escape count) */
+inline pvec hit_base(real4 p, real4 d, real bracket, julia_params jp, real radius, real4 trap,
+                      float4 color, __global const float4 *lut, int n_lut)
+{
+#if defined(COLOR_ITERATION) || defined(COLOR_TRAP) || defined(COLOR_W)
+#if defined(COLOR_ITERATION)
+    real val = orbit_value(p + bracket * d, jp);
+#elif defined(COLOR_TRAP)
+    real val = orbit_value(p, jp, trap);
+#else
+    real val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);
+#endif
+    float x = clamp((float)val, 0.0f, 1.0f) * (float)(n_lut - 1);
+    int k = min((int)x, n_lut - 2);
+    float4 c = mix(lut[k], lut[k + 1], x - (float)k);
+#else
+    float4 c = color;
+#endif
+    return clamp(PVEC((real)c.x, (real)c.y, (real)c.z), (real)0, (real)1);
+}
+
+__kernel void path_bounce(const int n_items, const int tile_w, const int x0, const int y0, const int image_w,
+                          const int sample, const int bounce, const int bounces, __global const int *status,
+                          __global const real4 *point, __global const real4 *normal,
+                          __global const real *bracket, const real4 c, const int max_iter, const real bailout,
+                          const real4 right, const real4 up, const real4 forward, const real4 light_pos,
+                          const float4 light_color, __global const real4 *lights_geo,
+                          __global const float4 *lights_rgb, const float4 color, const float4 background,
+                          const float4 sky, const real metallic, const real alpha2, const real f0s,
+                          const real bias, const real radius, const real4 trap, __global const float4 *lut,
+                          const int n_lut, __global real4 *origins, __global real4 *dirs,
+                          __global float4 *thru, __global float4 *rad, __global float4 *pending,
+                          __global real4 *s_origins, __global real4 *s_dirs, __global float4 *albedo ENV_PARAMS)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    ENV_INIT;
+    float4 T = thru[i];
+    float4 R = rad[i];
+    real4 d4 = dirs[i];
+    int st = status[i];
+    s_origins[i] = PATH_FAR(radius);
+    s_dirs[i] = (real4)(1, 0, 0, 0);
+    pending[i] = (float4)(0.0f);
+    origins[i] = PATH_FAR(radius);
+    dirs[i] = (real4)(1, 0, 0, 0);
+    if (bounce == 0)
+        albedo[i] = (float4)(0.0f);
+    if (T.x + T.y + T.z <= 0.0f)
+        return;
+    thru[i] = (float4)(0.0f);
+    if (st != STATUS_HIT) {
+        if (st == STATUS_MISS) {   /* capped: unknown, nothing counted */
+            if (bounce == 0)
+                R.xyz += background.xyz;
+            else
+                R.xyz += T.xyz * SKY_RADIANCE(d4).xyz * T.w;
+        }
+        rad[i] = R;
+        return;
+    }
+    if (bounce == 0)
+        R.w = 1.0f;
+    uint key = pixel_key(i, tile_w, x0, y0, image_w);
+    uint s = (uint)sample;
+    julia_params jp = { c, bailout * bailout, (real)0, max_iter };
+    real4 p = point[i];
+    pvec v = -to_cam(d4, right, up, forward);
+    pvec n = path_unit(PVEC(normal[i].x, normal[i].y, normal[i].z));
+    if (DOT3(n, v) < (real)0)   /* seen from behind (a cut face, a thin part): light the side seen */
+        n = -n;
+    real4 n4 = to_world(n, right, up, forward);
+    pvec base = hit_base(p, d4, bracket[i], jp, radius, trap, color, lut, n_lut);
+    if (bounce == 0)
+        albedo[i] = (float4)((float)base.x, (float)base.y, (float)base.z, 1.0f);
+    real nv = fmax(DOT3(n, v), (real)1e-6);
+    real ps = spec_share(base, metallic, f0s, nv);
+    real4 o = p + bias * n4;
+    /* next-event estimation: one light, picked uniformly */
+    float sky_on = sky.x + sky.y + sky.z > 0.0f ? 1.0f : 0.0f;
+    int key_on = (light_color.x + light_color.y + light_color.z > 0.0f) ? 1 : 0;   /* a black key light: not drawn */
+    int n_point = key_on + EXTRA_LIGHT_COUNT;
+    int n_all = n_point + (int)sky_on;
+    if (n_all == 0) {   /* nothing lights the scene: a black path */
+        rad[i] = R;
+        return;
+    }
+    int j = min((int)(path_rand(key, s, DIM(bounce, 0)) * (real)n_all), n_all - 1) + 1 - key_on;
+    pvec l;
+    float4 le;
+    real dist, wl;
+    if (j < 1 + EXTRA_LIGHT_COUNT) {
+        /* if-else, not ?: on vectors, here and below (see path_unit) */
+        real4 lv = light_pos - o;
+        float4 lc = (float4)(light_color.xyz, 0.0f);
+        if (j > 0) {
+            lc = lights_rgb[j - 1];
+            lv = lights_geo[j - 1];
+            if (lc.w == 0.0f)
+                lv = lv - o;
+        }
+        l = path_unit(to_cam(lv, right, up, forward));
+        dist = lc.w != 0.0f ? (real)INFINITY : sqrt(DOT4(lv, lv));
+        le = (float)PATH_PI * (float4)(lc.xyz, 0.0f);   /* a white matte surface facing it: its colour */
+        wl = (real)1;                   /* a point or a direction: no other way reaches it */
+    } else {
+        l = SKY_SAMPLE(n, path_rand(key, s, DIM(bounce, 1)), path_rand(key, s, DIM(bounce, 2)));
+        dist = (real)INFINITY;
+        real pl = SKY_PDF(n, l);
+        float4 sl = SKY_RADIANCE(to_world(l, right, up, forward));
+        le = pl > (real)0 ? (float4)(sl.xyz, 0.0f) / (float)pl : (float4)(0.0f);
+        /* both strategies' densities of l, the light's times its choice (1 / n_all) as at an
+         * escape below: weights that sum to one over the two ways to the sky; at the last
+         * hit no ray is drawn from the material, and the light's sample takes it all */
+        wl = bounce + 1 >= bounces ? (real)1
+                                   : power_weight(pl / (real)n_all, bsdf_eval(n, v, l, base, metallic, f0s, alpha2, ps).w);
+    }
+    real4 fl = bsdf_eval(n, v, l, base, metallic, f0s, alpha2, ps);
+    if (fl.x + fl.y + fl.z > (real)0) {
+        float4 add = (float4)(T.xyz, 0.0f) * convert_float4(fl) * le * (float)(wl * (real)n_all);
+        pending[i] = (float4)(add.xyz, (float)dist);
+        s_origins[i] = o;
+        s_dirs[i] = to_world(l, right, up, forward);
+    }
+    rad[i] = R;
+    if (bounce + 1 >= bounces)
+        return;
+    /* the next ray, from the material */
+    real u1 = path_rand(key, s, DIM(bounce, 4)), u2 = path_rand(key, s, DIM(bounce, 5));
+    pvec h = ggx_half(n, alpha2, u1, u2);
+    pvec nd_spec = (real)2 * DOT3(v, h) * h - v;
+    pvec nd_diff = path_cosine(n, u1, u2);
+    pvec nd = path_unit(path_rand(key, s, DIM(bounce, 3)) < ps ? nd_spec : nd_diff);
+    real4 fb = bsdf_eval(n, v, nd, base, metallic, f0s, alpha2, ps);
+    if (!(fb.w > (real)0) || fb.x + fb.y + fb.z <= (real)0)
+        return;
+    float4 w = (float4)(T.xyz, 0.0f) * convert_float4(fb / fb.w);
+    if (bounce >= 2) {   /* Russian roulette: go on with probability q, weighed by 1 / q */
+        float q = clamp(fmax(w.x, fmax(w.y, w.z)), 0.05f, 0.95f);
+        if ((float)path_rand(key, s, DIM(bounce, 6)) >= q)
+            return;
+        w /= q;
+    }
+    /* the weight the sky gets where this ray escapes: against the sky's own sample of it */
+    real psky = sky_on > 0.0f ? SKY_PDF(n, nd) / (real)n_all : (real)0;
+    thru[i] = (float4)(w.xyz, (float)power_weight(fb.w, psky));
+    origins[i] = o;
+    dirs[i] = to_world(nd, right, up, forward);
+}
+
+__kernel void path_shadow(const int n_items, __global const int *status, __global const real *depth,
+                          __global const float4 *pending, __global float4 *rad)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    float4 q = pending[i];
+    /* reached: nothing hit before the light (a step cap counts as a hit: not shown empty) */
+    if (q.x + q.y + q.z > 0.0f && (status[i] == STATUS_MISS || (status[i] == STATUS_HIT && depth[i] > (real)q.w)))
+        rad[i].xyz += q.xyz;
+}
+
+__kernel void path_film(const int n_items, __global const float4 *rad, __global const float4 *albedo,
+                        __global float4 *film_mean, __global float4 *film_m2, __global float4 *film_albedo,
+                        __global int *film_count)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+    float4 x = rad[i];
+    if (x.w < 0.0f)
+        return;
+    int n = film_count[i] + 1;
+    float4 m = film_mean[i];
+    float4 dlt = x - m;
+    float4 m1 = m + dlt / (float)n;
+    float lum_old = film_lum(m), lum_new = film_lum(m1), lx = film_lum(x);
+    float4 q = film_m2[i];
+    q.xyz += dlt.xyz * (x.xyz - m1.xyz);
+    q.w += (lx - lum_old) * (lx - lum_new);
+    film_mean[i] = m1;
+    film_m2[i] = q;
+    film_albedo[i] += (albedo[i] - film_albedo[i]) / (float)n;
+    film_count[i] = n;
+}
