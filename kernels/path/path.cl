@@ -116,11 +116,13 @@ __kernel void path_camera(const int n_items, const int tile_w, const int x0, con
     rad[i] = (float4)(0.0f);
 }
 
-/* The colour of a hit: the scene's, or the colour map's entry for its colour value
- * (shade/light.cl orbit_value, the inside end of its bracket for the escape count) */
+/* The colour of a hit: the scene's, or the colour map's entry for its colour value *val
+ * (shade/light.cl orbit_value, the inside end of its bracket for the escape count; 0 for
+ * the flat colour) */
 inline pvec hit_base(real4 p, real4 d, real bracket, julia_params jp, real radius, real4 trap,
-                      float4 color, __global const float4 *lut, int n_lut)
+                     float4 color, __global const float4 *lut, int n_lut, real *val_out)
 {
+    *val_out = (real)0;
 #if defined(COLOR_ITERATION) || defined(COLOR_TRAP) || defined(COLOR_W)
 #if defined(COLOR_ITERATION)
     real val = orbit_value(p + bracket * d, jp);
@@ -129,6 +131,7 @@ inline pvec hit_base(real4 p, real4 d, real bracket, julia_params jp, real radiu
 #else
     real val = clamp((real)0.5 + p.w / radius, (real)0, (real)1);
 #endif
+    *val_out = clamp(val, (real)0, (real)1);
     float x = clamp((float)val, 0.0f, 1.0f) * (float)(n_lut - 1);
     int k = min((int)x, n_lut - 2);
     float4 c = mix(lut[k], lut[k + 1], x - (float)k);
@@ -146,6 +149,7 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
                           const float4 light_color, __global const real4 *lights_geo,
                           __global const float4 *lights_rgb, const float4 color, const float4 background,
                           const float4 sky, const real metallic, const real alpha2, const real f0s,
+                          const real emission,
                           const real bias, const real radius, const real4 trap, __global const float4 *lut,
                           const int n_lut, __global real4 *origins, __global real4 *dirs,
                           __global float4 *thru, __global float4 *rad, __global float4 *pending,
@@ -190,7 +194,12 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
     if (DOT3(n, v) < (real)0)   /* seen from behind (a cut face, a thin part): light the side seen */
         n = -n;
     real4 n4 = to_world(n, right, up, forward);
-    pvec base = hit_base(p, d4, bracket[i], jp, radius, trap, color, lut, n_lut);
+    real val;
+    pvec base = hit_base(p, d4, bracket[i], jp, radius, trap, color, lut, n_lut, &val);
+    /* the surface's own light: emission x its colour x (1 - its colour value), brightest where
+     * a trap's orbits pass closest */
+    float4 glow = convert_float4(emission * ((real)1 - val) * base);
+    R.xyz += T.xyz * glow.xyz;
     if (bounce == 0)
         albedo[i] = (float4)((float)base.x, (float)base.y, (float)base.z, 1.0f);
     real nv = fmax(DOT3(n, v), (real)1e-6);

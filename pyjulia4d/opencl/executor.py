@@ -38,7 +38,8 @@ __all__ = ["render", "plan_render", "run_plan"]
 def render(scene: Scene, device: cl.Device | str | None = None, progress: bool = False,
            force: bool = False, tile: int = TILE, lanes: int | None = None,
            outputs=None, region=None, calibrate: bool = True,
-           on_progress: Callable[[int, int], None] | None = None, store: ImageStore = IN_MEMORY) -> RenderResult:
+           on_progress: Callable[[int, int], None] | None = None, store: ImageStore = IN_MEMORY,
+           first_sample: int = 0) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
@@ -52,9 +53,11 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     ``on_progress(pixels done, pixels in all)`` is called as each tile is filed (antialiasing's
     passes count again); an exception it raises abandons the render (the explorer's stale
     previews).  ``store``: where the host images live (pipeline/store.py; in memory, or in a
-    file for images larger than memory should hold)."""
+    file for images larger than memory should hold).  ``first_sample``: a path-traced render's
+    paths are its samples from this index on (0 to plan.MAX_FIRST_SAMPLE): a later batch of the
+    same picture, which film.merge joins to the earlier (the explorer's progressive refinement)."""
     t_start = time.perf_counter()
-    args = check_arguments(scene, outputs, force, tile, region)
+    args = check_arguments(scene, outputs, force, tile, region, first_sample)
     check_device(device)
     for name, value in (("progress", progress), ("calibrate", calibrate)):
         check_flag(name, value)

@@ -143,7 +143,8 @@ class PathRunner:
         for k in ("film_mean", "film_m2", "film_albedo", "film_count"):
             cl.enqueue_fill_buffer(q, b[k].data, np.uint8(0), 0, b[k].nbytes)
         events = []
-        for s in range(self.plan.path.samples):
+        first = self.plan.path.first_sample
+        for s in range(first, first + self.plan.path.samples):
             ev = self.sample(tile, s)
             q.flush()
             cl.wait_for_events([ev[-1]])

@@ -107,3 +107,28 @@ def join(parts: dict, height: int, width: int) -> Film | None:
         for name in ("paths", "variance", "noise", "albedo") + (("covered",) if covered else ()):
             getattr(out, name)[y0:y0 + h, x0:x0 + w] = getattr(f, name)
     return out
+
+
+def merge(a: tuple, b: tuple) -> tuple:
+    """Two batches of the same picture's paths, each (colour (H, W, 3), coverage (H, W),
+    Film), as one: the pooled mean and squared deviations (Chan, Golub & LeVeque, "Algorithms
+    for computing the sample variance", 1983, eq. 2.1b: M2 = M2a + M2b + d^2 na nb / n)."""
+    (ca, aa, fa), (cb, ab, fb) = a, b
+    na = fa.paths.astype(np.float64)[..., None]
+    nb = fb.paths.astype(np.float64)[..., None]
+    n = na + nb
+    wa, wb = np.where(n > 0, na / np.maximum(n, 1), 0), np.where(n > 0, nb / np.maximum(n, 1), 0)
+
+    def m2(var, k):
+        return np.where(k > 1, np.nan_to_num(var.astype(np.float64), posinf=0.0) * k * (k - 1), 0.0)
+
+    d = cb.astype(np.float64) - ca
+    color = ca + d * wb
+    m2c = m2(fa.variance, na) + m2(fb.variance, nb) + d * d * na * nb / np.maximum(n, 1)
+    dl = d @ LUMA
+    m2l = (m2(fa.noise[..., None] ** 2, na) + m2(fb.noise[..., None] ** 2, nb))[..., 0] + dl * dl * (na * nb / np.maximum(n, 1))[..., 0]
+    alpha = aa * wa[..., 0] + ab * wb[..., 0]
+    albedo = fa.albedo * wa + fb.albedo * wb
+    film = Film.from_moments(np.concatenate([m2c, m2l[..., None]], axis=-1), albedo, n[..., 0].astype(np.int32),
+                             alpha)
+    return color.astype(np.float32), alpha.astype(np.float32), film

@@ -30,6 +30,7 @@ class PathArgs:
     reflectance at normal incidence, 0.08 shading.specular (Burley 2012 §5.3)."""
     bounces: int
     samples: int
+    first_sample: int      # the first sample's index: a later batch of the same picture (render's first_sample)
     aperture: float
     focus: float
     noise: float
@@ -38,6 +39,7 @@ class PathArgs:
     alpha2: float
     f0s: float
     sky: tuple[float, float, float, float]
+    emission: float        # shading.emission: the surface's own light, times its colour and 1 - its colour value
     normals: str           # the bounces' normals: "jacobian" or "gradient" (bounce_normals)
     environment: Environment | None = None   # shading.environment's image and its distribution; None: uniform
     env_x: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)   # the scene's axes in 4D (the slice's rotation)
@@ -56,16 +58,18 @@ class PathArgs:
 ALPHA_MIN = 0.002   # kernels/path/sample.cl ALPHA_MIN
 
 
-def path_args(scene: Scene, focus: float) -> PathArgs:
-    """The record of ``scene``, its lens focused at ``focus`` (resolve_focus)."""
+def path_args(scene: Scene, focus: float, first_sample: int = 0) -> PathArgs:
+    """The record of ``scene``, its lens focused at ``focus`` (resolve_focus), its samples
+    numbered from ``first_sample``."""
     sh, im = scene.shading, scene.image
     a = max(sh.roughness ** 2, ALPHA_MIN)
     sky = tuple(sh.ambient * s for s in sh.sky) + (0.0,)
     env = None if sh.environment == "uniform" else load_environment(sh.environment)
     axes = [tuple(float(x) for x in to_world(scene, e, direction=True)) for e in np.eye(4)[:3]]
-    return PathArgs(bounces=sh.bounces, samples=im.samples, aperture=scene.camera.aperture, focus=focus,
+    return PathArgs(bounces=sh.bounces, samples=im.samples, first_sample=first_sample, aperture=scene.camera.aperture, focus=focus,
                     noise=im.noise, min_samples=MIN_SAMPLES, metallic=sh.metallic, alpha2=a * a,
-                    f0s=0.08 * min(sh.specular, 12.5), sky=sky, normals=bounce_normals(scene), environment=env,
+                    f0s=0.08 * min(sh.specular, 12.5), sky=sky, emission=sh.emission, normals=bounce_normals(scene),
+                    environment=env,
                     env_x=axes[0], env_y=axes[1], env_z=axes[2])
 
 
@@ -113,23 +117,29 @@ def path_march_config(scene: Scene, lanes: int, pairs: bool) -> KernelConfig:
 
 def resolve_focus(scene: Scene, frame, march) -> float:
     """camera.focus as a distance along the view axis: the number given, or for "auto" the
-    depth of the surface at the picture's centre, found by the float64 march of that one ray
-    (the same march on any device, so the focus is too); where the centre ray meets nothing,
-    the camera target's distance."""
+    depth of the surface at the picture's centre (focus_at)."""
     focus = scene.camera.focus
     if focus != "auto":
         return float(focus)
+    w, h = scene.image.width, scene.image.height
+    return focus_at(scene, frame, march, w // 2, h // 2)
+
+
+def focus_at(scene: Scene, frame, march, px: int, py: int) -> float:
+    """The distance along the view axis of the surface pixel (px, py) shows, found by the
+    float64 march of its centre ray (the same march on any device, so the focus is too);
+    where that ray meets nothing, the camera target's distance."""
+    from pyjulia4d.geometry.camera import clip_planes
+    from pyjulia4d.pipeline.codes import STATUS_HIT
     from pyjulia4d.reference.formula import formula_of
     from pyjulia4d.reference.march import march as march64
     from pyjulia4d.reference.rays import generate_rays
-    from pyjulia4d.geometry.camera import clip_planes, to_world
-    from pyjulia4d.pipeline.codes import STATUS_HIT
     w, h = scene.image.width, scene.image.height
-    o, d = generate_rays(frame, w, h, w // 2, h // 2, 1, 1)
+    o, d = generate_rays(frame, w, h, px, py, 1, 1)
     with np.errstate(all="ignore"):
         depth, _, status, _ = march64(o, d, march, formula=formula_of(scene.fractal), clip=list(clip_planes(scene)))
     fwd = np.asarray(frame.forward, np.float64)
     if status[0] == STATUS_HIT and np.isfinite(depth[0]):
-        return float(depth[0] * abs(float(np.dot(d[0], fwd))))
+        return max(float(depth[0] * abs(float(np.dot(d[0], fwd)))), 1e-6)
     target = to_world(scene, scene.camera.target)
-    return max(float(np.dot(target - np.asarray(frame.position, np.float64), fwd)), 1e-6)
+    return min(max(float(np.dot(target - np.asarray(frame.position, np.float64), fwd)), 1e-6), 1e7)

@@ -262,16 +262,24 @@ class RenderArgs:
     force: bool = False
     tile: int = TILE
     region: tuple[int, int, int, int] | None = None
+    first_sample: int = 0
 
 
-def check_arguments(scene: Scene, outputs=None, force: bool = False, tile: int = TILE, region=None) -> RenderArgs:
-    """``scene``, ``outputs``, ``force``, ``tile`` and ``region`` checked, each with the one-line
-    SceneError naming it."""
+MAX_FIRST_SAMPLE = 2 ** 31 - 2 ** 17   # first_sample + image.samples stays an int (the kernels' sample index)
+
+
+def check_arguments(scene: Scene, outputs=None, force: bool = False, tile: int = TILE, region=None,
+                    first_sample: int = 0) -> RenderArgs:
+    """``scene``, ``outputs``, ``force``, ``tile``, ``region`` and ``first_sample`` (the path
+    tracer's first sample index, a whole number in [0, MAX_FIRST_SAMPLE]) checked, each with
+    the one-line SceneError naming it."""
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     check_tile(tile)
     check_flag("force", force)
-    return RenderArgs(resolve_outputs(outputs), force, tile, check_region(scene, region))
+    if isinstance(first_sample, bool) or not isinstance(first_sample, int) or not 0 <= first_sample <= MAX_FIRST_SAMPLE:
+        raise SceneError("first_sample", f"expected a whole number in [0, {MAX_FIRST_SAMPLE}], got {show(first_sample, 120)}")
+    return RenderArgs(resolve_outputs(outputs), force, tile, check_region(scene, region), first_sample)
 
 
 def make_plan(scene: Scene, device, lanes: int, outputs=None, force: bool = False,
@@ -308,7 +316,7 @@ def plan_from(scene: Scene, device, lanes: int, args: RenderArgs, pairs: bool = 
                         if scene.shading.reflection > 0 else None),
         halo=halo, tiles=make_tiles(scene.image.width, scene.image.height, args.tile, halo, region),
         region=region or (0, 0, scene.image.width, scene.image.height), pairs=pairs,
-        estimate=est, path=path_args(scene, resolve_focus(scene, frame, records["march"])) if path else None,
+        estimate=est, path=path_args(scene, resolve_focus(scene, frame, records["march"]), args.first_sample) if path else None,
         path_config=path_config(scene) if path else None,
         path_march_config=path_march_config(scene, lanes, pairs) if path else None)
 

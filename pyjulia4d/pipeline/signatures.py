@@ -168,7 +168,7 @@ PATH_BOUNCE = Signature("path_bounce", "path/path", (
     P("float4 light_color", "shade.light_color"), P("global const real4* lights_geo"),
     P("global const float4* lights_rgb"), P("float4 color", "shade.color"), P("float4 background", "shade.background"),
     P("float4 sky", "path.sky"), P("real metallic", "path.metallic"), P("real alpha2", "path.alpha2"),
-    P("real f0s", "path.f0s"), P("real bias", "light.bias"), P("real radius", "march.radius"),
+    P("real f0s", "path.f0s"), P("real emission", "path.emission"), P("real bias", "light.bias"), P("real radius", "march.radius"),
     P("real4 trap", "light.trap"), P("global const float4* lut"), P("int n_lut"), P("global real4* origins"),
     P("global real4* dirs"), P("global float4* thru"), P("global float4* rad"), P("global float4* pending"),
     P("global real4* s_origins"), P("global real4* s_dirs"), P("global float4* albedo"),

@@ -95,10 +95,11 @@ class PathTwin:
         return depth, point, status, bracket, clip_normals(guard, status, p.frame, self.planes, n)
 
     def base(self, pt, d, bracket):
-        """hit_base: the scene's colour or the colour map's at the hit's colour value."""
+        """hit_base: (the scene's colour or the colour map's at the hit's colour value, that
+        value; 0 for the flat colour)."""
         sa, la, ma = self.plan.shade, self.plan.light_args, self.march
         if self.lut is None:
-            return np.clip(np.tile(np.asarray(sa.color[:3], np.float64), (len(pt), 1)), 0, 1)
+            return np.clip(np.tile(np.asarray(sa.color[:3], np.float64), (len(pt), 1)), 0, 1), np.zeros(len(pt))
         if la.coloring == "iteration":
             val = orbit_iteration(pt + bracket[:, None] * d, ma.c, ma.max_iter, ma.bailout, self.F)
         elif la.coloring == "trap":
@@ -108,7 +109,7 @@ class PathTwin:
         x = np.clip(val, 0, 1) * (len(self.lut) - 1)
         k = np.minimum(x.astype(int), len(self.lut) - 2)
         t = (x - k)[:, None]
-        return np.clip(self.lut[k, :3] * (1 - t) + self.lut[k + 1, :3] * t, 0, 1)
+        return np.clip(self.lut[k, :3] * (1 - t) + self.lut[k + 1, :3] * t, 0, 1), np.clip(val, 0, 1)
 
     def trace(self, px, py, s: int):
         """Sample s of pixels (px, py): (radiance (n, 3), coverage (n,), first hits' colour (n, 3))."""
@@ -145,7 +146,8 @@ class PathTwin:
             nn = unit(nrm[k])
             nn = np.where((dot(nn, v) < 0)[:, None], -nn, nn)
             n4 = self.to_world(nn)
-            base = self.base(pt[k], dk, bracket[k])
+            base, val = self.base(pt[k], dk, bracket[k])
+            R[k] += T[k] * pa.emission * (1 - val)[:, None] * base   # the surface's own light
             if b == 0:
                 albedo[k] = base
             nv = np.maximum(dot(nn, v), 1e-6)
@@ -219,8 +221,9 @@ def film(plan: Plan, px, py, samples: int | None = None) -> tuple[np.ndarray, np
     n = len(px)
     mean, m2 = np.zeros((n, 4)), np.zeros((n, 4))
     alb = np.zeros((n, 3))
+    first = plan.path.first_sample
     for s in range(S):
-        R, A, a = twin.trace(px, py, s)
+        R, A, a = twin.trace(px, py, first + s)
         x = np.concatenate([R, A[:, None]], axis=1)
         d = x - mean
         m1 = mean + d / (s + 1)

@@ -71,6 +71,7 @@ MEANINGS = {
     "shading.environment": "path: the light from every direction (times ambient and sky): uniform, sky (shipped daylight) or a 2:1 .exr/.hdr",
     "shading.bounces": "path: the most surface hits a path takes (1: direct light alone)",
     "shading.roughness": "path: glossy lobe width (GGX), 0 mirror-like to 1 matte",
+    "shading.emission": "path: the surface's own light, x its colour x (1 - colour value): with coloring = trap, a glow where orbits pass the trap",
     "shading.metallic": "path: 0 a dielectric (white gloss), 1 a metal (gloss in the colour, no diffuse)",
     "image.width": "pixels",
     "image.height": "pixels",

@@ -160,6 +160,7 @@ class Shading:
     bounces: int = 4               # path: hits a path takes at most (1: direct light alone)
     roughness: float = 0.35        # path: the microfacet width (0 mirror-like, 1 matte)
     metallic: float = 0.0          # path: 0 a dielectric (coloured diffuse, white gloss), 1 a metal
+    emission: float = 0.0          # path: the surface's own light, x its colour x (1 - its colour value)
 
     def __post_init__(self) -> None:
         check_section(self, "shading")

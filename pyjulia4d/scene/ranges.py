@@ -129,6 +129,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "bounces": Integer(1, 64),
         "roughness": Real(0.0, 1.0),
         "metallic": Real(0.0, 1.0),
+        "emission": Real(0.0, 1e3),
     },
     "image": {
         "width": Integer(1, INT_MAX),

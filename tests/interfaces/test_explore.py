@@ -632,3 +632,61 @@ def test_the_renderer_refuses_what_is_no_device(device):
 
     with pytest.raises(SceneError, match="device: expected None, a pyopencl Device"):
         device_renderer(device)
+
+
+# ---------------------------------------------------------------- the path tracer in the explorer
+
+
+def test_path_batches_double_the_total_up_to_the_samples():
+    from pyjulia4d.app.explore.loop import path_batches
+    assert path_batches(1) == [(0, 1)]
+    assert path_batches(4) == [(0, 4)]
+    assert path_batches(16) == [(0, 4), (4, 4), (8, 8)]
+    assert path_batches(100) == [(0, 4), (4, 4), (8, 8), (16, 16), (32, 32), (64, 36)]
+    for s in (1, 5, 37, 256, 1000):
+        b = path_batches(s)
+        assert sum(c for _, c in b) == s and all(f == sum(c for _, c in b[:k]) for k, (f, _) in enumerate(b))
+
+
+def test_a_path_scenes_previews_are_direct_and_its_last_stage_the_scene():
+    path = Scene.default().replace(**{"shading.integrator": "path", "image.samples": 64})
+    moving = stages(path, True, 100 * 100)
+    assert [x.shading.integrator for _, x in moving] == ["direct"]
+    rest = stages(path, False, 160 * 120)
+    assert rest[-1] == ("final", path) and all(x.shading.integrator == "direct" for _, x in rest[:-1])
+
+
+def test_a_path_traced_picture_refines_at_rest_to_the_render_of_the_scene(tmp_path):
+    """On the device: batches of paths shown one after another, their noise falling and their
+    paths adding up, the last one's pixels the render of the whole scene (pooled: to float32
+    rounding); a click on the picture focuses the lens there."""
+    import harness
+    from pyjulia4d import render as render_scene
+    from pyjulia4d.app.explore.run import device_renderer
+
+    scene = Scene.from_dict({"camera": {"position": [1.8, 1.6, -2.2, 0], "aperture": 0.05},
+                             "shading": {"integrator": "path", "bounces": 3},
+                             "image": {"width": 48, "height": 36, "samples": 16}})
+    shown = []
+    orig = loop_mod.picture_png
+    loop_mod.picture_png = lambda color, sc=None: (shown.append(np.array(color)), orig(color, sc))[1]
+    render = device_renderer(harness.device())
+    s, got = make_session(tmp_path, render, scene)
+    try:
+        s.start()
+        got.wait(lambda: any(m["stage"] == "final" for m, _ in got.pictures), 120)
+        frames = [m for m, _ in got.pictures if m["generation"] == s.loop.generation]
+        paths = [int(m["facts"]["paths"]) for m in frames if "paths" in m["facts"]]
+        assert paths == [4, 8, 16]
+        noise = [float(m["facts"]["noise"].split()[1].rstrip(",")) for m in frames if "noise" in m["facts"]]
+        assert noise[-1] < noise[0]
+        s.handle({"op": "focus", "x": 0.5, "y": 0.5})
+        assert s.scene.camera.focus != "auto" and 0 < s.scene.camera.focus < 10
+        assert not got.of("error"), got.of("error")
+    finally:
+        s.close()
+        loop_mod.picture_png = orig
+    from pyjulia4d.resources import module_installed
+    if not module_installed("pyoidn"):   # the page shows the pooled picture itself
+        whole = render_scene(scene)
+        assert np.abs(shown[-1] - whole.color).max() < 1e-5

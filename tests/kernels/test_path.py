@@ -58,7 +58,7 @@ FEATURES = {
     "uniform sky": dict(shading={"environment": "uniform"}),
     "ggx metal": dict(shading={"metallic": 1.0, "roughness": 0.15}),
     "lens": dict(camera={"aperture": 0.15, "focus": 2.5}),
-    "colour map, cut": dict(shading={"coloring": "trap"}, clip={"planes": [[0, 0, 1, 0]]}),
+    "colour map, glow, cut": dict(shading={"coloring": "trap", "emission": 1.5}, clip={"planes": [[0, 0, 1, 0]]}),
     "no estimate, fixed scan": dict(fractal={"algebra": "hypercomplex", "function": "sin"}, normals={"method": "zbuffer"},
                                     march={"method": "fixed", "z_resolution": 200}),
 }

@@ -99,6 +99,7 @@ def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
     [],
     ["normals.method=zbuffer"],                           # a one-pixel halo across tiles
     ["image.samples=2", "camera.fit=true"],               # antialiasing; the fit resolved once
+    ["shading.integrator=path", "image.samples=3", "image.noise=0.2"],   # paths, their film; a noise target
 ])
 def test_tiles_on_two_workers_equal_the_whole_render(cluster, over):
     _, client = cluster
@@ -110,6 +111,9 @@ def test_tiles_on_two_workers_equal_the_whole_render(cluster, over):
     for name in OUTPUTS:
         assert _same(getattr(whole, name), getattr(tiled, name)), name
     assert whole.counts == tiled.counts and whole.guards == tiled.guards
+    if whole.film is not None:   # the path tracer's film, joined from the tiles
+        for name in ("paths", "variance", "noise", "albedo", "covered"):
+            assert np.array_equal(getattr(whole.film, name), getattr(tiled.film, name)), name
     assert fitted.camera.fit is False
     if "camera.fit=true" in over:
         assert fitted.camera.position != scene.camera.position

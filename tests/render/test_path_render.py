@@ -119,3 +119,51 @@ def test_files_state_the_noise_and_keep_its_channels(tmp_path) -> None:
     comp.save(tmp_path / "c.exr")
     names = set(OpenEXR.File(str(tmp_path / "c.exr"), separate_channels=True).channels())
     assert {"ViewLayer.Variance.R", "ViewLayer.Denoising Albedo.B"} <= names
+
+
+def _exr(path, img) -> None:
+    import OpenImageIO as oiio
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(img.shape[1], img.shape[0], img.shape[2], "float"))
+    out.write_image(np.ascontiguousarray(img, np.float32))
+    out.close()
+
+
+@pytest.mark.parametrize("case, reason", [
+    ("missing", "cannot read it"), ("truncated", "cannot read its pixels|not an image"), ("text", "not an image"),
+    ("square", "not an equirectangular map"), ("negative", "not light"), ("nan", "not light"),
+])
+def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, reason) -> None:
+    path = tmp_path / "env.exr"
+    if case == "truncated":
+        _exr(path, np.ones((64, 128, 3)))
+        path.write_bytes(path.read_bytes()[:600])
+    elif case == "text":
+        path.write_text("not an image")
+    elif case == "square":
+        _exr(path, np.ones((32, 32, 3)))
+    elif case in ("negative", "nan"):
+        img = np.ones((16, 32, 3))
+        img[3, 4, 1] = -1.0 if case == "negative" else np.nan
+        _exr(path, img)
+    sc = scene(shading={"environment": str(path)})
+    with pytest.raises(SceneError, match=reason) as info:
+        pyjulia4d.render(sc)
+    assert info.value.key == "shading.environment" and "\n" not in str(info.value)
+
+
+def test_a_bad_environment_on_the_command_line(tmp_path, capsys) -> None:
+    from pyjulia4d.app import cli
+    out = tmp_path / "x.png"
+    code = cli.main(["render", "--set", "shading.integrator=path", "--set", f"shading.environment={tmp_path}/no.hdr",
+                     "--set", "image.width=8", "--set", "image.height=6", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "shading.environment" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_environment_key_takes_words_and_image_paths() -> None:
+    for bad in ("", "sky.png", 3, "a\nb.exr"):
+        with pytest.raises(SceneError, match="shading.environment"):
+            scene(shading={"environment": bad})
+    assert scene(shading={"environment": "x/y.HDR"}).shading.environment == "x/y.HDR"

@@ -9,6 +9,11 @@
   with the scene's image.samples, each shown as it is done.  The last stage renders the scene
   exactly as given, so the picture at rest is the one ``pyjulia4d render`` makes of the saved
   scene on the same device.
+- A path-traced scene (shading.integrator = "path") previews with the direct integrator while
+  a control moves (at its speed), and at rest accumulates its paths in batches - 4, then
+  doubling the total up to image.samples (path_batches) - each batch the next samples of the
+  same sequence, pooled with the earlier (film.merge), shown with its stated noise and, where
+  Open Image Denoise is installed, denoised.
 
 Fractal artists know this from Mandelbulber2's navigator and Fragmentarium's progressive
 refinement.  The loop knows nothing of the page: it calls ``render(scene, on_progress)`` and
@@ -59,8 +64,9 @@ def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str,
     k = min(1.0, math.sqrt(max(MIN_PREVIEW_PIXELS, preview_pixels) / full))
 
     def sized(f: float, samples: int = 1) -> Scene:
+        # a path-traced scene's previews are the direct integrator's: today's speed while dragging
         return scene.replace(**{"image.width": max(1, round(w * f)), "image.height": max(1, round(h * f)),
-                                "image.samples": samples, "image.adaptive": False})
+                                "image.samples": samples, "image.adaptive": False, "shading.integrator": "direct"})
 
     if moving:   # one preview, finished even when the next request comes (RenderLoop)
         return [("preview", sized(k))]
@@ -69,18 +75,47 @@ def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str,
         out.append(("preview", sized(k)))
     if 0.25 * full > 1.5 * k * k * full:   # a half-size stage well above the preview's size
         out.append(("refine", sized(0.5)))
-    if s > 1 or scene.image.adaptive:
+    if (s > 1 or scene.image.adaptive) and scene.shading.integrator == "direct":
         out.append(("refine", sized(1.0)))
     out.append(("final", scene))
     return out
 
 
-def picture_png(color: np.ndarray) -> bytes:
-    """(H, W, 3) linear colour -> PNG bytes, sRGB-encoded, fast zlib level (a local page)."""
+PATH_FIRST_BATCH = 4
+
+
+def path_batches(samples: int) -> list[tuple[int, int]]:
+    """(first sample, count) of each batch a path-traced picture at rest is refined in: 4
+    samples, then as many again as there are (the total doubling), up to ``samples``."""
+    out, first, count = [], 0, PATH_FIRST_BATCH
+    while first < samples:
+        count = min(count, samples - first)
+        out.append((first, count))
+        first += count
+        count = first
+    return out
+
+
+def shown_color(result: Any) -> np.ndarray:
+    """What the page shows of a render: its colour, a path-traced one's denoised where Open
+    Image Denoise is installed (film.denoise, guided by its normal where the stage kept it)."""
+    from pyjulia4d.resources import module_installed
+    if result.film is None or not module_installed("pyoidn"):
+        return result.color
+    from pyjulia4d.pipeline.film import denoise
+    return denoise(result.color, result.film.albedo, result.normal)
+
+
+def picture_png(color: np.ndarray, scene: Scene | None = None) -> bytes:
+    """(H, W, 3) linear colour -> PNG bytes, through the scene's exposure and tone map as the
+    files have it (pipeline/tonemap.py), sRGB-encoded, fast zlib level (a local page)."""
     from PIL import Image
 
     from pyjulia4d.app.output import rgba_levels
+    from pyjulia4d.pipeline.tonemap import display
 
+    if scene is not None:
+        color = display(color, scene.image.exposure, scene.image.tonemap)
     buf = io.BytesIO()
     Image.fromarray(rgba_levels(color, None)).save(buf, format="PNG", compress_level=1)
     return buf.getvalue()
@@ -92,7 +127,7 @@ def facts(result: Any, stage: str) -> dict:
     header, _ = result.report()
     h, w = result.color.shape[:2]
     un = result.unresolved_counts()
-    return {"stage": stage, "size": f"{w}x{h}", "seconds": f"{result.seconds:.3f}",
+    out = {"stage": stage, "size": f"{w}x{h}", "seconds": f"{result.seconds:.3f}",
             "hit": f"{100 * result.hit_fraction:.1f} %",
             "bracket": header["pyjulia4d.depth_bracket"] or "none hit",
             "error": (header["pyjulia4d.depth_error"] if result.proven else
@@ -101,12 +136,18 @@ def facts(result: Any, stage: str) -> dict:
             "capped": str(result.capped),
             "guards": ", ".join(f"{k} {v}" for k, v in result.guards.items() if v) or "none",
             "device": result.device_name}
+    if result.film is not None:   # a path-traced picture's stated noise and its paths
+        n = result.film.noise_stats()
+        lo, hi = int(result.film.paths.min()), int(result.film.paths.max())
+        out["noise"] = f"p50 {n['p50']:.3g}, p99 {n['p99']:.3g}"
+        out["paths"] = str(lo) if lo == hi else f"{lo}-{hi}"
+    return out
 
 
 class RenderLoop:
     """A worker thread rendering the latest request (see the module's docstring)."""
 
-    def __init__(self, render: Callable[[Scene, Callable[[int, int], None]], Any],
+    def __init__(self, render: Callable[..., Any],
                  show: Callable[[Picture], None], fail: Callable[[str], None],
                  preview_seconds: float = PREVIEW_SECONDS) -> None:
         self._render, self._show, self._fail = render, show, fail
@@ -174,10 +215,13 @@ class RenderLoop:
             if camera is not None:
                 s = dataclasses.replace(s, camera=camera)
             current[0] = stage
+            if stage == "final" and s.shading.integrator == "path":
+                self._serve_paths(generation, s, check)
+                return
             t0 = time.perf_counter()
             try:
                 result = self._render(s, check)
-                png = picture_png(result.color)
+                png = picture_png(result.color, s)
             except Stale:
                 return
             except ValueError as e:   # SceneError, a refusal, a device's one-line error
@@ -196,3 +240,32 @@ class RenderLoop:
             if self._generation != generation and stage != "preview":
                 return
             self._show(Picture(generation, stage, rendered, png, facts(result, stage)))
+
+    def _serve_paths(self, generation: int, scene: Scene, check) -> None:
+        """A path-traced picture's paths in batches (path_batches), pooled and shown after each."""
+        from pyjulia4d.pipeline.film import merge
+        batches = path_batches(scene.image.samples)
+        pooled = None
+        t0 = time.perf_counter()
+        for k, (first, count) in enumerate(batches):
+            if self._generation != generation:
+                return
+            try:
+                result = self._render(scene.replace(**{"image.samples": count}), check, first)
+                part = (result.color, result.alpha, result.film)
+                pooled = part if pooled is None else merge(pooled, part)
+                result.color, result.alpha, result.film = pooled
+                result.seconds = time.perf_counter() - t0
+                png = picture_png(shown_color(result), scene)
+            except Stale:
+                return
+            except ValueError as e:
+                self._fail(one_line(e))
+                return
+            except Exception as e:
+                self._fail(f"render failed: {type(e).__name__}: {one_line(e)}")
+                return
+            if self._generation != generation:
+                return
+            stage = "final" if k == len(batches) - 1 else "refine"
+            self._show(Picture(generation, stage, scene, png, facts(result, stage)))

@@ -34,11 +34,13 @@ def device_renderer(device: Any) -> Render:
 
     device = device_of(device)
 
-    def run(scene: Scene, hook: Callable[[int, int], None], whole: bool) -> Any:
+    def run(scene: Scene, hook: Callable[[int, int], None], whole: bool, first_sample: int = 0) -> Any:
         if whole:
             return render(scene, device=device, on_progress=hook)
+        # a path-traced stage keeps its normals: the denoiser's guide (loop.shown_color)
+        outputs = STAGE_OUTPUTS + (("normal",) if scene.shading.integrator == "path" else ())
         return render(scene, device=device, on_progress=hook, calibrate=False, tile=EXPLORE_TILE,
-                      outputs=STAGE_OUTPUTS)
+                      outputs=outputs, first_sample=first_sample)
 
     return run
 

@@ -37,9 +37,10 @@ from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.text import scene_table_from_text, toml_value
 
 Emit = Callable[[dict, "bytes | None"], None]
-# render(scene, on_progress, whole) -> RenderResult; ``whole``: the file render (probed,
-# calibrated), else a stage of the loop
-Render = Callable[[Scene, Callable[[int, int], None], bool], Any]
+# render(scene, on_progress, whole, first_sample=0) -> RenderResult; ``whole``: the file
+# render (probed, calibrated), else a stage of the loop; ``first_sample``: a path-traced
+# batch's first sample (loop.path_batches)
+Render = Callable[..., Any]
 
 MAX_NAME = 200                # characters of a file name the page may give
 MAX_GAP = 100_000             # frames between two keyframes
@@ -127,7 +128,7 @@ class Session:
         self.scene = scene
         self.keyframes: list[tuple[int, Scene]] = []
         self._file_thread: threading.Thread | None = None
-        self.loop = RenderLoop(lambda s, hook: render(s, hook, False), self._shown, self._failed)
+        self.loop = RenderLoop(lambda s, hook, *first: render(s, hook, False, *first), self._shown, self._failed)
 
     # ---------------------------------------------------------------- what the viewer sees
 
@@ -184,6 +185,8 @@ class Session:
             self._move(op, msg, moving)
         elif op == "refine":
             self.loop.request(self.scene, moving=False)
+        elif op == "focus":
+            self.focus(_number(msg, "x", 0.0, 1.0), _number(msg, "y", 0.0, 1.0))
         elif op == "frame":   # camera.fit: the first stage frames the set, and the page takes its camera
             with self._lock:
                 self.scene = dataclasses.replace(self.scene, camera=dataclasses.replace(self.scene.camera, fit=True))
@@ -204,8 +207,26 @@ class Session:
                                    f"{show(interpolation)}")
             self.save_animation(msg.get("name"), _number(msg, "fps", 0.1, 1000.0, 24.0), interpolation)
         else:
-            raise ExploreError(f"op: unknown request {show(op)}; one of set, orbit, turn_w, zoom, refine, frame, "
+            raise ExploreError(f"op: unknown request {show(op)}; one of set, orbit, turn_w, zoom, refine, focus, frame, "
                                f"save_scene, render_file, keyframe, clear_keyframes, save_animation")
+
+    def focus(self, x: float, y: float) -> None:
+        """A click on the picture at (x, y), fractions of its width and height from the top
+        left: the lens focused on the surface seen there (path_plan.focus_at)."""
+        from pyjulia4d.geometry.camera import camera_frame
+        from pyjulia4d.pipeline.path_plan import focus_at
+        from pyjulia4d.pipeline.records import march_args
+        with self._lock:
+            sc = self.scene
+            if sc.shading.integrator != "path":
+                self.say('focus: the lens is the path tracer\'s (shading.integrator = "path")')
+                return
+            w, h = sc.image.width, sc.image.height
+            px, py = min(int(x * w), w - 1), min(int(y * h), h - 1)
+            focus = focus_at(sc, camera_frame(sc), march_args(sc), px, py)
+            self.scene = sc.replace(**{"camera.focus": focus})
+        self.say(f"focus: {focus:.4g} along the view axis (camera.focus)")
+        self.loop.request(self.scene, moving=False)
 
     def _move(self, op: str, msg: dict, moving: bool) -> None:
         with self._lock:

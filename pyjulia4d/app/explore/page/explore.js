@@ -76,6 +76,7 @@
     const rows = [["stage", f.stage], ["size", f.size], ["render time", f.seconds + " s"], ["pixels hit", f.hit],
       ["depth bracket", f.bracket], ["depth error", f.error], ["unresolved", f.unresolved],
       ["capped rays", f.capped], ["guards fired", f.guards], ["device", f.device]];
+    if (f.noise) rows.splice(3, 0, ["noise", f.noise], ["paths per pixel", f.paths]);
     facts.replaceChildren(...rows.flatMap(([k, v]) => {
       const dt = document.createElement("dt"); dt.textContent = k;
       const dd = document.createElement("dd"); dd.textContent = v;
@@ -212,7 +213,7 @@
   let drag = null;
   picture.addEventListener("contextmenu", (ev) => ev.preventDefault());
   picture.addEventListener("pointerdown", (ev) => {
-    drag = { x: ev.clientX, y: ev.clientY, w: ev.shiftKey || ev.button === 2 };
+    drag = { x: ev.clientX, y: ev.clientY, w: ev.shiftKey || ev.button === 2, x0: ev.clientX, y0: ev.clientY };
     picture.setPointerCapture(ev.pointerId);
     picture.classList.add("dragging");
     clearError();
@@ -225,11 +226,18 @@
     else { orbit.yaw -= dx * DEGREES_PER_PIXEL; orbit.pitch += dy * DEGREES_PER_PIXEL; }
     queueFlush();
   });
-  const endDrag = () => {
+  const endDrag = (ev) => {
     if (!drag) return;
+    // a click (no drag): the path tracer's lens focuses on what the picture shows there
+    const click = ev && ev.type === "pointerup" && !drag.w && Math.hypot(ev.clientX - drag.x0, ev.clientY - drag.y0) < 4;
     drag = null;
     picture.classList.remove("dragging");
     flush();
+    if (click) {
+      const r = view.getBoundingClientRect();
+      const fx = (ev.clientX - r.left) / Math.max(1, r.width), fy = (ev.clientY - r.top) / Math.max(1, r.height);
+      if (fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1) { send({ op: "focus", x: fx, y: fy }); return; }
+    }
     send({ op: "refine" });
   };
   picture.addEventListener("pointerup", endDrag);
