@@ -146,14 +146,16 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
                           __global const real4 *point, __global const real4 *normal,
                           __global const real *bracket, const real4 c, const int max_iter, const real bailout,
                           const real4 right, const real4 up, const real4 forward, const real4 light_pos,
-                          const float4 light_color, __global const real4 *lights_geo,
-                          __global const float4 *lights_rgb, const float4 color, const float4 background,
+                          const float4 light_color, const float light_radius, __global const real4 *lights_geo,
+                          __global const float4 *lights_rgb, __global const float *lights_size,
+                          const float4 color, const float4 background,
                           const float4 sky, const real metallic, const real alpha2, const real f0s,
                           const real emission,
                           const real bias, const real radius, const real4 trap, __global const float4 *lut,
                           const int n_lut, __global real4 *origins, __global real4 *dirs,
                           __global float4 *thru, __global float4 *rad, __global float4 *pending,
-                          __global real4 *s_origins, __global real4 *s_dirs, __global float4 *albedo ENV_PARAMS)
+                          __global real4 *s_origins, __global real4 *s_dirs, __global float4 *albedo,
+                          __global float4 *first_normal ENV_PARAMS)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -168,8 +170,10 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
     pending[i] = (float4)(0.0f);
     origins[i] = PATH_FAR(radius);
     dirs[i] = (real4)(1, 0, 0, 0);
-    if (bounce == 0)
+    if (bounce == 0) {
         albedo[i] = (float4)(0.0f);
+        first_normal[i] = (float4)(0.0f);
+    }
     if (T.x + T.y + T.z <= 0.0f)
         return;
     thru[i] = (float4)(0.0f);
@@ -200,8 +204,10 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
      * a trap's orbits pass closest */
     float4 glow = convert_float4(emission * ((real)1 - val) * base);
     R.xyz += T.xyz * glow.xyz;
-    if (bounce == 0)
+    if (bounce == 0) {   /* the denoiser's guides: the first hit's colour and normal */
         albedo[i] = (float4)((float)base.x, (float)base.y, (float)base.z, 1.0f);
+        first_normal[i] = (float4)((float)n.x, (float)n.y, (float)n.z, 0.0f);
+    }
     real nv = fmax(DOT3(n, v), (real)1e-6);
     real ps = spec_share(base, metallic, f0s, nv);
     real4 o = p + bias * n4;
@@ -222,16 +228,30 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
         /* if-else, not ?: on vectors, here and below (see path_unit) */
         real4 lv = light_pos - o;
         float4 lc = (float4)(light_color.xyz, 0.0f);
+        real size = (real)light_radius;
         if (j > 0) {
             lc = lights_rgb[j - 1];
             lv = lights_geo[j - 1];
+            size = (real)lights_size[j - 1];
             if (lc.w == 0.0f)
                 lv = lv - o;
         }
         l = path_unit(to_cam(lv, right, up, forward));
         dist = lc.w != 0.0f ? (real)INFINITY : sqrt(DOT4(lv, lv));
+        if (size > (real)0) {
+            /* a sphere (size: its radius) or a sun (size: its angular radius, degrees): a
+             * direction drawn uniformly in the cone it fills, shadows softened by it; its
+             * light spread over the cone, so that it lights as a point would (Pharr, Jakob &
+             * Humphreys 2023, §12.2.2, the cone of a sphere) */
+            real cmax = lc.w != 0.0f ? cos(fmin(size, (real)90) * (real)(PATH_PI / 180))
+                                     : sqrt(fmax((real)1 - (size / fmax(dist, size)) * (size / fmax(dist, size)), (real)0));
+            real ct = (real)1 - path_rand(key, s, DIM(bounce, 1)) * ((real)1 - cmax);
+            real st = sqrt(fmax((real)1 - ct * ct, (real)0)), phi = (real)(2 * PATH_PI) * path_rand(key, s, DIM(bounce, 2));
+            l = path_unit(path_local(l, st * cos(phi), st * sin(phi), ct));
+            dist = fmax(dist - size, (real)0);   /* the sphere's near side: a hit beyond it is behind the light */
+        }
         le = (float)PATH_PI * (float4)(lc.xyz, 0.0f);   /* a white matte surface facing it: its colour */
-        wl = (real)1;                   /* a point or a direction: no other way reaches it */
+        wl = (real)1;                   /* a light no bounce can hit: its sample takes it all */
     } else {
         l = SKY_SAMPLE(n, path_rand(key, s, DIM(bounce, 1)), path_rand(key, s, DIM(bounce, 2)));
         dist = (real)INFINITY;
@@ -290,8 +310,8 @@ __kernel void path_shadow(const int n_items, __global const int *status, __globa
 }
 
 __kernel void path_film(const int n_items, __global const float4 *rad, __global const float4 *albedo,
-                        __global float4 *film_mean, __global float4 *film_m2, __global float4 *film_albedo,
-                        __global int *film_count)
+                        __global const float4 *first_normal, __global float4 *film_mean, __global float4 *film_m2,
+                        __global float4 *film_albedo, __global float4 *film_normal, __global int *film_count)
 {
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
@@ -310,5 +330,6 @@ __kernel void path_film(const int n_items, __global const float4 *rad, __global 
     film_mean[i] = m1;
     film_m2[i] = q;
     film_albedo[i] += (albedo[i] - film_albedo[i]) / (float)n;
+    film_normal[i] += (first_normal[i] - film_normal[i]) / (float)n;
     film_count[i] = n;
 }

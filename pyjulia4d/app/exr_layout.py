@@ -139,6 +139,10 @@ def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray | Band], d
         for k, name in enumerate("RGB"):
             ch[f"ViewLayer.Denoising Albedo.{name}"] = np.ascontiguousarray(film.albedo[..., k])
             ch[f"ViewLayer.Variance.{name}"] = np.ascontiguousarray(film.variance[..., k])
+        if film.normal is not None:   # the mean first-hit normal, in the scene's x, y, z as Normal is
+            for k, name in enumerate("XYZ"):
+                axis = np.array([r[k], u[k], -f[k]])
+                ch[f"ViewLayer.Denoising Normal.{name}"] = (film.normal.astype(np.float64) @ axis).astype(np.float32)
         if film.noisy is not None:   # image.denoise: Combined is the denoised picture, this the one before
             for k, name in enumerate("RGB"):
                 ch[f"ViewLayer.Noisy Image.{name}"] = np.ascontiguousarray(film.noisy[..., k])

@@ -34,16 +34,20 @@ class PathFilm:
         self.mean = new_zeros((height, width, 4), np.float32)
         self.m2 = new_zeros((height, width, 4), np.float32)
         self.albedo = new_zeros((height, width, 3), np.float32)
+        self.normal = new_zeros((height, width, 3), np.float32)
         self.count = new_zeros((height, width), np.int32)
 
-    def file(self, dst, mean, m2, albedo, count) -> None:
+    def file(self, dst, mean, m2, albedo, normal, count) -> None:
         self.mean[dst] = mean
         self.m2[dst] = m2
         self.albedo[dst] = albedo[..., :3]
+        self.normal[dst] = normal[..., :3]
         self.count[dst] = count
 
     def result(self) -> Film:
-        return Film.from_moments(self.m2, self.albedo, self.count, self.mean[..., 3])
+        film = Film.from_moments(self.m2, self.albedo, self.count, self.mean[..., 3])
+        film.normal = self.normal
+        return film
 
 
 class PathRunner:
@@ -63,7 +67,8 @@ class PathRunner:
         sa = plan.shade
         lut = colormap.table(sa.colormap) if sa.colormap is not None else np.zeros((2, 4), np.float32)
         lights = dict(lights_geo=constant(self.queue, np.array([pr.v4(g) for g in sa.lights_geo])),
-                      lights_rgb=constant(self.queue, np.array([float4(c) for c in sa.lights_rgb])))
+                      lights_rgb=constant(self.queue, np.array([float4(c) for c in sa.lights_rgb])),
+                      lights_size=constant(self.queue, np.asarray(sa.lights_size, np.float32)))
         self.k = {name: build.kernel(self.prg, name) for name in ("path_camera", "path_bounce", "path_shadow",
                                                                   "path_film")}
         self.k["march"] = build.kernel(self.march_prg, "march")
@@ -95,8 +100,8 @@ class PathRunner:
                                                               "normal")}
         self.b.update({k: cla.empty(q, n, pr.scalar) for k in ("depth", "bracket", "unresolved")})
         self.b.update({k: cla.empty(q, n, np.int32) for k in ("status", "samples", "flags", "film_count")})
-        self.b.update({k: cla.empty(q, n, cl.cltypes.float4) for k in ("thru", "rad", "pending", "albedo",
-                                                                       "film_mean", "film_m2", "film_albedo")})
+        self.b.update({k: cla.empty(q, n, cl.cltypes.float4) for k in (
+            "thru", "rad", "pending", "albedo", "first_normal", "film_mean", "film_m2", "film_albedo", "film_normal")})
 
     def march(self, n: int, tile: Tile, origins: str, dirs: str) -> list:
         b = self.b
@@ -127,20 +132,22 @@ class PathRunner:
             ev.append(launch(q, self.k["path_bounce"], n, *self.bounce_args(
                 **place, sample=s, bounce=bounce, status=b["status"], point=b["point"], normal=b["normal"],
                 bracket=b["bracket"], origins=b["origins"], dirs=b["dirs"], thru=b["thru"], rad=b["rad"],
-                pending=b["pending"], s_origins=b["s_origins"], s_dirs=b["s_dirs"], albedo=b["albedo"])))
+                pending=b["pending"], s_origins=b["s_origins"], s_dirs=b["s_dirs"], albedo=b["albedo"],
+                first_normal=b["first_normal"])))
             ev += self.march(n, tile, "s_origins", "s_dirs")
             ev.append(launch(q, self.k["path_shadow"], n, *self.shadow_args(
                 status=b["status"], depth=b["depth"], pending=b["pending"], rad=b["rad"])))
         ev.append(launch(q, self.k["path_film"], n, *self.film_args(
-            rad=b["rad"], albedo=b["albedo"], film_mean=b["film_mean"], film_m2=b["film_m2"],
-            film_albedo=b["film_albedo"], film_count=b["film_count"])))
+            rad=b["rad"], albedo=b["albedo"], first_normal=b["first_normal"], film_mean=b["film_mean"],
+            film_m2=b["film_m2"], film_albedo=b["film_albedo"], film_normal=b["film_normal"],
+            film_count=b["film_count"])))
         return ev
 
     def tile(self, tile: Tile, on_sample=None) -> tuple[dict[str, np.ndarray], list]:
         """Every sample of ``tile``'s pixels: its film over its box, shaped (ah, aw[, 4]), and
         the kernels' events.  ``on_sample(tile)`` is called as each sample is done."""
         b, q, n = self.b, self.queue, tile.n
-        for k in ("film_mean", "film_m2", "film_albedo", "film_count"):
+        for k in ("film_mean", "film_m2", "film_albedo", "film_normal", "film_count"):
             cl.enqueue_fill_buffer(q, b[k].data, np.uint8(0), 0, b[k].nbytes)
         events = []
         first = self.plan.path.first_sample
@@ -152,7 +159,8 @@ class PathRunner:
             if on_sample is not None:
                 on_sample(tile)
         shape = (tile.ah, tile.aw)
-        out = {k: b[k][:n].get().view(np.float32).reshape(*shape, 4) for k in ("film_mean", "film_m2", "film_albedo")}
+        out = {k: b[k][:n].get().view(np.float32).reshape(*shape, 4)
+               for k in ("film_mean", "film_m2", "film_albedo", "film_normal")}
         out["film_count"] = b["film_count"][:n].get().reshape(shape)
         return out, events
 
@@ -168,5 +176,5 @@ def path_pass(plan: Plan, dev: cl.Device, at, events: list, bar) -> PathFilm:
         events += ev
         own = t.own()
         film.file(at(t), got["film_mean"][own], got["film_m2"][own], got["film_albedo"][own],
-                  got["film_count"][own])
+                  got["film_normal"][own], got["film_count"][own])
     return film

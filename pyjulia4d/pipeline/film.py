@@ -27,6 +27,7 @@ class Film:
     albedo: np.ndarray     # float32 (H, W, 3): the mean colour of each pixel's first hits (0 on a miss)
     noisy: np.ndarray | None = None   # image.denoise: the picture before the denoiser (the result's colour is after)
     covered: np.ndarray | None = None   # bool (H, W): pixels the set covers (some sample hit); None: all
+    normal: np.ndarray | None = None    # float32 (H, W, 3): the mean first-hit normal (camera coordinates), a guide
 
     @classmethod
     def from_moments(cls, m2: np.ndarray, albedo: np.ndarray, count: np.ndarray, coverage=None) -> "Film":
@@ -85,13 +86,19 @@ def denoise(color: np.ndarray, albedo: np.ndarray, normal: np.ndarray | None) ->
     return np.asarray(pyoidn.denoise(c, a, n, hdr=True, quality="high"), np.float32)
 
 
+def guide_normal(result) -> np.ndarray | None:
+    """The denoiser's normal guide: the film's mean first-hit normal (antialiased, like its
+    albedo: guides that agree with each other and with the picture), else the centre normal."""
+    return result.film.normal if result.film.normal is not None else result.normal
+
+
 def finish(result, scene) -> None:
     """What a path-traced picture gets once it is whole (a render, or a cluster's joined tiles):
     with image.denoise, the denoised colour, the picture before it kept in the film."""
     if result.film is None or not scene.image.denoise or result.color is None:
         return
     result.film.noisy = result.color
-    result.color = denoise(result.color, result.film.albedo, result.normal)
+    result.color = denoise(result.color, result.film.albedo, guide_normal(result))
 
 
 def join(parts: dict, height: int, width: int) -> Film | None:
@@ -103,8 +110,11 @@ def join(parts: dict, height: int, width: int) -> Film | None:
                noise=np.zeros((height, width), np.float32), albedo=np.zeros((height, width, 3), np.float32))
     covered = all(f.covered is not None for f in films.values())
     out.covered = np.zeros((height, width), bool) if covered else None
+    normal = all(f.normal is not None for f in films.values())
+    out.normal = np.zeros((height, width, 3), np.float32) if normal else None
     for (x0, y0, w, h), f in films.items():
-        for name in ("paths", "variance", "noise", "albedo") + (("covered",) if covered else ()):
+        for name in ("paths", "variance", "noise", "albedo") + (("covered",) if covered else ()) + \
+                    (("normal",) if normal else ()):
             getattr(out, name)[y0:y0 + h, x0:x0 + w] = getattr(f, name)
     return out
 
@@ -131,4 +141,6 @@ def merge(a: tuple, b: tuple) -> tuple:
     albedo = fa.albedo * wa + fb.albedo * wb
     film = Film.from_moments(np.concatenate([m2c, m2l[..., None]], axis=-1), albedo, n[..., 0].astype(np.int32),
                              alpha)
+    if fa.normal is not None and fb.normal is not None:
+        film.normal = (fa.normal * wa + fb.normal * wb).astype(np.float32)
     return color.astype(np.float32), alpha.astype(np.float32), film

@@ -114,7 +114,8 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
                         ambient=sh.ambient, diffuse=sh.diffuse, specular=sh.specular, shininess=sh.shininess,
                         fog=sh.fog, fog_start=fog_start(frame.position, radius), reflection=sh.reflection,
                         colormap=sh.colormap if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb,
-                        n_lights=len(sh.lights)))
+                        n_lights=len(sh.lights), light_radius=sh.light_radius,
+                        lights_size=np.array([lt.radius for lt in sh.lights] or [0.0])))
 
 
 @dataclass(frozen=True)

@@ -106,6 +106,8 @@ class ShadeArgs:
     lights_geo: np.ndarray     # shading.lights (camera.extra_lights; one inert row where there are none)
     lights_rgb: np.ndarray
     n_lights: int = 0          # how many shading.lights there are
+    light_radius: float = 0.0  # the path tracer's: shading.light_radius
+    lights_size: np.ndarray | None = None   # and each of shading.lights' radius (one inert 0 where there are none)
 
 
 def march_args(scene: Scene, radius: float | None = None, **changes) -> MarchArgs:

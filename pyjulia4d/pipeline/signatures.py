@@ -165,13 +165,14 @@ PATH_BOUNCE = Signature("path_bounce", "path/path", (
     *TILE_PLACE, P("int image_w", "image.width"), P("int sample"), P("int bounce"), P("int bounces", "path.bounces"),
     P("global const int* status"), P("global const real4* point"), P("global const real4* normal"),
     P("global const real* bracket"), *ORBIT, *BASIS, P("real4 light_pos", "shade.light"),
-    P("float4 light_color", "shade.light_color"), P("global const real4* lights_geo"),
-    P("global const float4* lights_rgb"), P("float4 color", "shade.color"), P("float4 background", "shade.background"),
-    P("float4 sky", "path.sky"), P("real metallic", "path.metallic"), P("real alpha2", "path.alpha2"),
+    P("float4 light_color", "shade.light_color"), P("float light_radius", "shade.light_radius"),
+    P("global const real4* lights_geo"), P("global const float4* lights_rgb"), P("global const float* lights_size"),
+    P("float4 color", "shade.color"), P("float4 background", "shade.background"), P("float4 sky", "path.sky"), P("real metallic", "path.metallic"), P("real alpha2", "path.alpha2"),
     P("real f0s", "path.f0s"), P("real emission", "path.emission"), P("real bias", "light.bias"), P("real radius", "march.radius"),
     P("real4 trap", "light.trap"), P("global const float4* lut"), P("int n_lut"), P("global real4* origins"),
     P("global real4* dirs"), P("global float4* thru"), P("global float4* rad"), P("global float4* pending"),
     P("global real4* s_origins"), P("global real4* s_dirs"), P("global float4* albedo"),
+    P("global float4* first_normal"),
     *group("ENV_MAP", P("global const float4* env"), P("global const real* env_rows"), P("global const real* env_cols"),
            P("int env_w", "path.env_w"), P("int env_h", "path.env_h"), P("real4 env_x", "path.env_x"),
            P("real4 env_y", "path.env_y"), P("real4 env_z", "path.env_z"))))
@@ -181,8 +182,9 @@ PATH_SHADOW = Signature("path_shadow", "path/path", (
     P("global float4* rad")))
 
 PATH_FILM = Signature("path_film", "path/path", (
-    P("global const float4* rad"), P("global const float4* albedo"), P("global float4* film_mean"),
-    P("global float4* film_m2"), P("global float4* film_albedo"), P("global int* film_count")))
+    P("global const float4* rad"), P("global const float4* albedo"), P("global const float4* first_normal"),
+    P("global float4* film_mean"), P("global float4* film_m2"), P("global float4* film_albedo"),
+    P("global float4* film_normal"), P("global int* film_count")))
 
 # ---------------------------------------------------------------- the mesh's kernels (pipeline/mesh_plan.py)
 

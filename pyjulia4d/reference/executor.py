@@ -107,6 +107,6 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
         res.color, res.alpha = mean.reshape(h, w, 3).astype(np.float32), cover.reshape(h, w).astype(np.float32)
         res.film = Film(paths=film.paths.reshape(h, w), variance=film.variance.reshape(h, w, 3),
                         noise=film.noise.reshape(h, w), albedo=film.albedo.reshape(h, w, 3),
-                        covered=film.covered.reshape(h, w))
+                        covered=film.covered.reshape(h, w), normal=film.normal.reshape(h, w, 3))
     res.seconds = res.kernel_seconds = time.perf_counter() - t0
     return res

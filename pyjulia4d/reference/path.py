@@ -17,8 +17,8 @@ from pyjulia4d.pipeline.plan import Plan
 from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.reference.march import march
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian
-from pyjulia4d.reference.path_sample import (PI, bsdf_eval, cosine, disc, dot, ggx_half, path_rand, power_weight,
-                                             spec_share, unit)
+from pyjulia4d.reference.path_sample import (PI, bsdf_eval, cosine, disc, dot, ggx_half, local, path_rand,
+                                             power_weight, spec_share, unit)
 from pyjulia4d.reference.path_environment import EnvTwin
 from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
 
@@ -121,12 +121,14 @@ class PathTwin:
         wsky = np.ones(n)
         alive = np.ones(n, bool)
         R, A, albedo = np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3))
+        self.first_normal = np.zeros((n, 3))
         sky = np.asarray(pa.sky[:3], np.float64)
         sky_on = sky.sum() > 0
         geo = [np.asarray(sa.light, np.float64)] + [np.asarray(g, np.float64) for g in sa.lights_geo[:sa.n_lights]]
         rgb = [np.append(np.asarray(sa.light_color[:3], np.float64), 0.0)] + \
               [np.asarray(c, np.float64) for c in sa.lights_rgb[:sa.n_lights]]
         key_on = int(np.sum(rgb[0][:3]) > 0)   # a black key light is not drawn
+        sizes = [float(np.float32(sa.light_radius))] + [float(x) for x in np.asarray(sa.lights_size, np.float32)[:sa.n_lights]]
         n_point = len(geo) - 1 + key_on
         n_all = n_point + int(sky_on)
         for b in range(pa.bounces):
@@ -150,6 +152,7 @@ class PathTwin:
             R[k] += T[k] * pa.emission * (1 - val)[:, None] * base   # the surface's own light
             if b == 0:
                 albedo[k] = base
+                self.first_normal[k] = nn
             nv = np.maximum(dot(nn, v), 1e-6)
             ps = spec_share(base, pa.metallic, pa.f0s, nv)
             ob = pt[k] + la.bias * n4
@@ -163,11 +166,22 @@ class PathTwin:
             wl = np.ones(k.size)
             for i in range(len(geo)):
                 m = j == i
-                g, c = geo[i], rgb[i]
+                g, c, size = geo[i], rgb[i], sizes[i]
                 lv = np.tile(g, (k.size, 1)) if c[3] != 0 else g - ob
                 l[m] = unit(self.to_cam(lv[m]))
                 if c[3] == 0:
                     dist[m] = np.linalg.norm(lv[m], axis=1)
+                if size > 0 and m.any():   # a sphere or a sun: a direction in its cone (path.cl)
+                    if c[3] != 0:
+                        cmax = np.full(m.sum(), np.cos(min(size, 90.0) * PI / 180))
+                    else:
+                        q = size / np.maximum(dist[m], size)
+                        cmax = np.sqrt(np.maximum(1 - q * q, 0))
+                    ct = 1 - path_rand(ks[m], s, dim(b, 1)) * (1 - cmax)
+                    st = np.sqrt(np.maximum(1 - ct * ct, 0))
+                    phi = 2 * PI * path_rand(ks[m], s, dim(b, 2))
+                    l[m] = unit(local(l[m], st * np.cos(phi), st * np.sin(phi), ct))
+                    dist[m] = np.maximum(dist[m] - size, 0)
                 le[m] = PI * c[:3]
             m = j == len(geo)
             if m.any():
@@ -232,4 +246,6 @@ def film(plan: Plan, px, py, samples: int | None = None) -> tuple[np.ndarray, np
         m2[:, 3] += (lum(x) - lum(mean)) * (lum(x) - lum(m1))
         mean = m1
         alb += (a - alb) / (s + 1)
-    return mean[:, :3], mean[:, 3], Film.from_moments(m2, alb, np.full(n, S, np.int32), mean[:, 3])
+    film = Film.from_moments(m2, alb, np.full(n, S, np.int32), mean[:, 3])
+    film.normal = nrm.astype(np.float32)
+    return mean[:, :3], mean[:, 3], film

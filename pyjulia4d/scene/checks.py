@@ -266,22 +266,24 @@ class Planes:
 class Lights:
     """Up to ``most`` lights, each a table with exactly one of position / direction (3 or 4
     numbers; a direction not all 0) and optional color (3 numbers in [0, 1e3]) and intensity
-    (in [0, 1e3]).  On the command line: "position x,y,z[,w] color r,g,b intensity k; direction
-    x,y,z[,w] ..." ("" or "[]": none)."""
+    (in [0, 1e3]), and for the path tracer a radius (in [0, 1e3]: a positioned light's sphere,
+    scene units; a distant one's angular radius, degrees).  On the command line: "position
+    x,y,z[,w] color r,g,b intensity k radius r; direction x,y,z[,w] ..." ("" or "[]": none)."""
 
     verbatim = True
-    FIELDS = ("position", "direction", "color", "intensity")
+    FIELDS = ("position", "direction", "color", "intensity", "radius")
 
     def __init__(self, most: int, make: Callable[..., Any]) -> None:
         self.most = most
         self.make = make   # the light's type (scene.model.Light), built from the checked fields
         self.valid = (f"up to {most} tables {{position = [x, y, z, w] or direction = [x, y, z, w], "
-                      f"color = [r, g, b], intensity = k}} (--set: position x,y,z,w color r,g,b "
-                      f"intensity k; ...)")
+                      f"color = [r, g, b], intensity = k, radius = r}} (--set: position x,y,z,w color r,g,b "
+                      f"intensity k radius r; ...)")
         self.point = Vector((3, 4), -COORD, COORD)
         self.direction = Vector((3, 4), -COORD, COORD, nonzero=True)
         self.color = Vector((3,), 0.0, 1e3)
         self.intensity = Real(0.0, 1e3)
+        self.radius = Real(0.0, 1e3)
 
     def _parse(self, key: str, text: str) -> list:
         lights = []
@@ -291,7 +293,7 @@ class Lights:
                 raise SceneError(key, f"light {i}: expected pairs 'name value', got {show(part.strip())}")
             table: dict[str, Any] = {}
             for name, value in zip(words[0::2], words[1::2]):
-                table[name] = scalar(value) if name == "intensity" else [scalar(x) for x in value.split(",")]
+                table[name] = scalar(value) if name in ("intensity", "radius") else [scalar(x) for x in value.split(",")]
             lights.append(table)
         return lights
 
@@ -314,12 +316,12 @@ class Lights:
             for name in table:
                 if name not in self.FIELDS:
                     raise SceneError(f"{where}.{show_key(str(name))}", "unknown key; use position or direction, "
-                                                                        "color, intensity")
+                                                                        "color, intensity, radius")
             if ("position" in table) == ("direction" in table):
                 raise SceneError(where, "give exactly one of position and direction")
             kw: dict[str, Any] = {}
             for name, check in (("position", self.point), ("direction", self.direction), ("color", self.color),
-                                ("intensity", self.intensity)):
+                                ("intensity", self.intensity), ("radius", self.radius)):
                 if name in table:
                     kw[name] = check(f"{where}.{name}", table[name])
             out.append(self.make(**kw))

@@ -56,6 +56,7 @@ MEANINGS = {
     "shading.shininess": "Blinn-Phong exponent",
     "shading.light": "\"eye\" (a light at the camera) or the key light's position",
     "shading.light_color": "key light colour",
+    "shading.light_radius": "path: the key light's sphere radius (scene units): soft shadows; 0 a point",
     "shading.shadow": "shadows of the set on itself: none, hard or soft",
     "shading.shadow_softness": "penumbra k in min(k d / t): larger is sharper",
     "shading.ao": "ambient occlusion strength; 0 compiles it out",

@@ -28,6 +28,9 @@ class Light:
     direction: Vec4 | None = None
     color: Vec3 = (1.0, 1.0, 1.0)
     intensity: float = 1.0
+    # the path tracer's soft light: a positioned light's sphere radius (scene units), a distant
+    # one's angular radius (degrees; the sun's is 0.27); 0: a point, a direction
+    radius: float = 0.0
 
     def __post_init__(self) -> None:
         """Checked as a table of shading.lights is (scene/checks.Lights)."""
@@ -41,6 +44,8 @@ class Light:
             out["direction"] = list(self.direction or ())
         out["color"] = list(self.color)
         out["intensity"] = self.intensity
+        if self.radius:
+            out["radius"] = self.radius
         return out
 
 
@@ -113,6 +118,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "shininess": Real(1e-3, 1e4),
         "light": OrWord("eye", Vector((3, 4), -COORD, COORD)),
         "light_color": Vector((3,), 0.0, 1e3),
+        "light_radius": Real(0.0, 1e3),
         "shadow": Choice("none", "hard", "soft"),
         "shadow_softness": Real(1.0, 1e3),
         "ao": Real(0.0, 1.0),
@@ -184,7 +190,7 @@ def check_light(light: "Light") -> None:
     if (light.position is None) == (light.direction is None):
         raise SceneError(where, "give exactly one of position and direction")
     for name, check in (("position", lights.point), ("direction", lights.direction), ("color", lights.color),
-                        ("intensity", lights.intensity)):
+                        ("intensity", lights.intensity), ("radius", lights.radius)):
         value = getattr(light, name)
         if value is not None:
             checked = check(f"{where}.{name}", value)

@@ -53,10 +53,12 @@ def one_sample(sc: Scene, s: int, lanes: int = 1):
 FEATURES = {
     "bounces": dict(shading={"bounces": 4, "roughness": 0.8}),
     "next-event, lights": dict(shading={"lights": [{"direction": [1, 1, 0], "color": [1, 0.6, 0.3]},
-                                                   {"position": [0.5, 2, -1], "color": [0.3, 0.5, 1]}]}),
+                                                   {"position": [0.5, 2, -1], "color": [0.3, 0.5, 1], "radius": 0.4}]}),
     "sky alone": dict(shading={"light_color": [0, 0, 0], "ambient": 1.0}),
     "uniform sky": dict(shading={"environment": "uniform"}),
     "ggx metal": dict(shading={"metallic": 1.0, "roughness": 0.15}),
+    "sphere light, sun": dict(shading={"light_radius": 0.6, "lights": [{"direction": [1, 2, -1], "color": [1, 1, 1],
+                                                                         "radius": 4.0}]}),
     "lens": dict(camera={"aperture": 0.15, "focus": 2.5}),
     "colour map, glow, cut": dict(shading={"coloring": "trap", "emission": 1.5}, clip={"planes": [[0, 0, 1, 0]]}),
     "no estimate, fixed scan": dict(fractal={"algebra": "hypercomplex", "function": "sin"}, normals={"method": "zbuffer"},
@@ -64,7 +66,12 @@ FEATURES = {
 }
 
 
-@pytest.mark.parametrize("name", list(FEATURES))
+# the default run keeps the features that share the default scene's program and two that
+# compile their own (lights, a colour map with a cut); the rest run with -m slow
+SLOW = ("uniform sky", "sphere light, sun", "no estimate, fixed scan")
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow if n in SLOW else ()) for n in FEATURES])
 def test_sample_matches_twin(name: str) -> None:
     for s in (0, 7):
         rad, R, A = one_sample(scene(**FEATURES[name]), s)

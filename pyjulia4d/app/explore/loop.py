@@ -102,8 +102,8 @@ def shown_color(result: Any) -> np.ndarray:
     from pyjulia4d.resources import module_installed
     if result.film is None or not module_installed("pyoidn"):
         return result.color
-    from pyjulia4d.pipeline.film import denoise
-    return denoise(result.color, result.film.albedo, result.normal)
+    from pyjulia4d.pipeline.film import denoise, guide_normal
+    return denoise(result.color, result.film.albedo, guide_normal(result))
 
 
 def picture_png(color: np.ndarray, scene: Scene | None = None) -> bytes:
