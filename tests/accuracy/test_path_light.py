@@ -3,7 +3,7 @@
 The Julia set of q^2 + 0 is the closed unit 4-ball, so with c = 0 the picture is a ball whose
 light has closed forms:
 - the white furnace: a grey Lambertian ball of albedo a in a uniform environment of
-  radiance 1 sends back a in every direction (convex: every bounce escapes), whatever the
+  radiance 1 (an image of 1s: the environment's own sampling) sends back a in every direction (convex: every bounce escapes), whatever the
   number of bounces - any bias in the sampling, the multiple importance weights or the
   Russian roulette shows as a departure from a;
 - a Lambertian ball under a distant light of colour C (the sky off): a C max(n . l, 0), n the
@@ -25,9 +25,27 @@ BALL = {"fractal": {"c": [0, 0, 0, 0]}, "camera": {"position": [0, 0, -3.2, 0], 
         "march": {"epsilon": 1e-6}}
 
 
+# Every ball is lit the same way - an environment image and one distant light, each black
+# where a test does not use it - so that all compile one program.
+DARK = [{"direction": [0, 1, 0], "color": [0, 0, 0]}]
+
+
+def sky_file(tmp_path, upper: float, lower: float):
+    """A 64x32 environment image of radiance ``upper`` above the horizon, ``lower`` below."""
+    import OpenImageIO as oiio
+    img = np.full((32, 64, 3), lower, np.float32)
+    img[:16] = upper
+    path = tmp_path / f"sky_{upper}_{lower}.exr"
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(64, 32, 3, "float"))
+    out.write_image(img)
+    out.close()
+    return str(path)
+
+
 def ball(shading: dict, samples: int, bounces: int = 4) -> pyjulia4d.RenderResult:
     d = {k: dict(v) for k, v in BALL.items()}
-    d["shading"] = {"integrator": "path", "bounces": bounces, "specular": 0.0, "metallic": 0.0, "environment": "uniform",
+    d["shading"] = {"integrator": "path", "bounces": bounces, "specular": 0.0, "metallic": 0.0, "lights": DARK,
                     "color": [0.5, 0.5, 0.5], **shading}
     d["image"] = {"width": W, "height": H, "samples": samples}
     return pyjulia4d.render(Scene.from_dict(d))
@@ -44,12 +62,14 @@ def judge(r, expected) -> None:
     assert abs(got.mean() - expected[full].mean()) < 4 * total_sd + 1e-6
 
 
-def test_white_furnace_returns_the_albedo() -> None:
-    r = ball({"light_color": [0, 0, 0], "ambient": 1.0, "sky": [1, 1, 1], "background": [1, 1, 1]}, samples=64)
+def test_white_furnace_returns_the_albedo(tmp_path) -> None:
+    white = sky_file(tmp_path, 1.0, 1.0)
+    r = ball({"light_color": [0, 0, 0], "ambient": 1.0, "sky": [1, 1, 1], "background": [1, 1, 1],
+              "environment": white}, samples=64)
     judge(r, np.full(r.color.shape, 0.5))
     # one bounce is direct light alone: the sky seen from a convex ball, also a
-    judge(ball({"light_color": [0, 0, 0], "ambient": 1.0, "background": [1, 1, 1]}, 16, bounces=1),
-          np.full(r.color.shape, 0.5))
+    judge(ball({"light_color": [0, 0, 0], "ambient": 1.0, "background": [1, 1, 1], "environment": white}, 64,
+               bounces=1), np.full(r.color.shape, 0.5))
 
 
 def pixel_truth(scene: Scene, radiance, n: int = 16) -> np.ndarray:
@@ -80,10 +100,10 @@ def lambert_truth(scene: Scene, light_dir, color, albedo: float) -> np.ndarray:
     return pixel_truth(scene, lambda nrm: albedo * np.asarray(color) * np.maximum(nrm @ l, 0)[:, None])
 
 
-def test_lambertian_ball_under_a_distant_light() -> None:
+def test_lambertian_ball_under_a_distant_light(tmp_path) -> None:
     light = [1.0, 1.5, -1.0]
-    r = ball({"light_color": [0, 0, 0], "ambient": 0.0, "lights": [{"direction": light + [0], "color": [0.9, 0.7, 0.5]}]},
-             samples=48, bounces=1)
+    r = ball({"light_color": [0, 0, 0], "ambient": 0.0, "environment": sky_file(tmp_path, 0.0, 0.0),
+              "lights": [{"direction": light + [0], "color": [0.9, 0.7, 0.5]}]}, samples=48, bounces=1)
     judge(r, lambert_truth(r.scene, light, [0.9, 0.7, 0.5], 0.5))
 
 
@@ -108,14 +128,6 @@ def test_lambertian_ball_under_a_sky_image(tmp_path) -> None:
     """An environment image of radiance 1 above the horizon and 0 below (the map's importance
     sampling, not a uniform sphere's): a Lambertian surface of normal n gets the irradiance
     pi (1 + n_y) / 2 of a uniform upper hemisphere, so sends back a (1 + n_y) / 2."""
-    import OpenImageIO as oiio
-    img = np.zeros((32, 64, 3), np.float32)
-    img[:16] = 1.0
-    path = tmp_path / "hemisphere.exr"
-    out = oiio.ImageOutput.create(str(path))
-    out.open(str(path), oiio.ImageSpec(64, 32, 3, "float"))
-    out.write_image(img)
-    out.close()
-    r = ball({"light_color": [0, 0, 0], "ambient": 1.0, "sky": [1, 1, 1], "environment": str(path)}, samples=48,
-             bounces=2)
+    r = ball({"light_color": [0, 0, 0], "ambient": 1.0, "sky": [1, 1, 1], "environment": sky_file(tmp_path, 1.0, 0.0)},
+             samples=48, bounces=2)
     judge(r, pixel_truth(r.scene, lambda nrm: np.repeat(0.5 * (1 + nrm[:, 1:2]) / 2, 3, axis=1)))

@@ -52,28 +52,30 @@ def one_sample(sc: Scene, s: int, lanes: int = 1):
 
 FEATURES = {
     "bounces": dict(shading={"bounces": 4, "roughness": 0.8}),
-    "next-event, lights": dict(shading={"lights": [{"direction": [1, 1, 0], "color": [1, 0.6, 0.3]},
-                                                   {"position": [0.5, 2, -1], "color": [0.3, 0.5, 1], "radius": 0.4}]}),
+    # one program for the lights, a soft one among them, the colour map's glow and a cut
+    "next-event, lights, glow, cut": dict(
+        shading={"lights": [{"direction": [1, 1, 0], "color": [1, 0.6, 0.3]},
+                            {"position": [0.5, 2, -1], "color": [0.3, 0.5, 1], "radius": 0.4}],
+                 "coloring": "trap", "emission": 1.5}, clip={"planes": [[0, 0, 1, 0]]}),
     "sky alone": dict(shading={"light_color": [0, 0, 0], "ambient": 1.0}),
     "uniform sky": dict(shading={"environment": "uniform"}),
     "ggx metal": dict(shading={"metallic": 1.0, "roughness": 0.15}),
     "sphere light, sun": dict(shading={"light_radius": 0.6, "lights": [{"direction": [1, 2, -1], "color": [1, 1, 1],
                                                                          "radius": 4.0}]}),
     "lens": dict(camera={"aperture": 0.15, "focus": 2.5}),
-    "colour map, glow, cut": dict(shading={"coloring": "trap", "emission": 1.5}, clip={"planes": [[0, 0, 1, 0]]}),
     "no estimate, fixed scan": dict(fractal={"algebra": "hypercomplex", "function": "sin"}, normals={"method": "zbuffer"},
                                     march={"method": "fixed", "z_resolution": 200}),
 }
 
 
-# the default run keeps the features that share the default scene's program and two that
-# compile their own (lights, a colour map with a cut); the rest run with -m slow
+# the default run keeps the features that share the default scene's program and one that
+# compiles its own (lights, a colour map's glow, a cut); the rest run with -m slow
 SLOW = ("uniform sky", "sphere light, sun", "no estimate, fixed scan")
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow if n in SLOW else ()) for n in FEATURES])
 def test_sample_matches_twin(name: str) -> None:
-    for s in (0, 7):
+    for s in ((0, 7) if name == "bounces" else (7,)):
         rad, R, A = one_sample(scene(**FEATURES[name]), s)
         close = np.all(np.abs(rad[:, :3] - R) <= 1e-5 * np.abs(R) + 1e-6, axis=1)
         assert close.mean() >= 0.99, (name, s, np.abs(rad[:, :3] - R).max())
@@ -81,6 +83,7 @@ def test_sample_matches_twin(name: str) -> None:
         assert R.sum() > 0   # something was lit: not a comparison of two black pictures
 
 
+@pytest.mark.slow
 def test_packets_march_the_same_paths() -> None:
     """The march and the Jacobian normals in packets (the renders' way, lanes.lanes_for)."""
     widths = packet_widths(double=True)
