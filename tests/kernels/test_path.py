@@ -24,7 +24,7 @@ from pyjulia4d.reference.path_sample import path_rand
 from pyjulia4d.scene.model import Scene
 from tests.harness import device, packet_widths
 
-W, H = 24, 18
+W, H = 16, 12
 
 
 def scene(**sections) -> Scene:
