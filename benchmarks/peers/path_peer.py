@@ -5,16 +5,23 @@ same c, camera and colour) lit by a white sky alone, with global illumination an
 field: pyjulia4d with shading.integrator = "path" (a uniform environment of radiance 1, 3
 bounces, a lens of radius --aperture focused on the target), Mandelbulber2 2.20 with its
 Monte Carlo algorithm (DOF_monte_carlo, DOF_MC_global_illumination, white background, main
-light off, DOF_radius --mb-dof, focus on the target), on its CPU path (Debian's build
-finds no OpenCL device here without a system driver).
+light off, DOF_radius --mb-dof, focus on the target), on its CPU path and its OpenCL path.
 
 Each renderer is measured against its own converged reference (--reference samples per
-pixel): the relative RMSE over the pixels the reference covers (its alpha above 0.5; both
-pictures linear, Mandelbulber2's decoded from its sRGB PNG), at each sample count of
---samples, with the CPU-seconds of the render (this process's for pyjulia4d, the child's for
-Mandelbulber2).  The sample count where each reaches --target (2 %) is interpolated
-log-log between the counts around it, and its CPU-seconds likewise; the result is each
-renderer's pixels per CPU-second at that noise, and their ratio.  Mandelbulber2 is never a
+pixel), rendered independently of the sweep (pyjulia4d's from sample 2^30 on, so no path is
+shared; Mandelbulber2 seeds each run afresh): the relative RMSE over the pixels the
+reference covers (its alpha above 0.5; both pictures linear, Mandelbulber2's decoded from its
+sRGB PNG).  Against an independent reference of N_ref samples the measured error is
+sqrt(e^2 + e_ref^2), and where both fall as 1/sqrt(samples), e_ref^2 = e^2 N / N_ref, so
+
+    e = measured x sqrt(N_ref / (N + N_ref))
+
+is each renderer's own error at N samples (the same correction for both; printed beside the
+measured one).  The sample count where each reaches --target (2 %) is interpolated log-log
+between the counts around it, and its CPU-seconds likewise (the render's for pyjulia4d, the
+child's for Mandelbulber2); the result is each renderer's pixels per CPU-second at that noise,
+and their ratio.  Mandelbulber2 runs on its CPU path and, where its OpenCL path starts (a
+system OpenCL driver such as Debian's pocl-opencl-icd), on that too.  It is never a
 dependency: where it is not installed (Debian: apt-get install mandelbulber2) the script
 says so and measures pyjulia4d alone.  Appends a section to benchmarks/results/path_peer.md.
 
@@ -38,7 +45,7 @@ if str(ROOT) not in sys.path:   # the checkout: its pyjulia4d, and benchmarks/ a
 
 from benchmarks.lib.args import Parser, size_of  # noqa: E402
 from benchmarks.lib.runlog import append_run, git_commit, utc_now  # noqa: E402
-from benchmarks.peers.peers import MATCHED, MB_CPU, _mb_render, mb_env, mb_settings  # noqa: E402
+from benchmarks.peers.peers import MATCHED, MB_CPU, MB_OPENCL, _mb_render, mb_env, mb_settings, mb_warm  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
 from pyjulia4d.pipeline.colormap import srgb_to_linear  # noqa: E402
@@ -53,9 +60,12 @@ def pj_scene(w: int, h: int, samples: int, aperture: float) -> Scene:
         f"camera.focus={FOCUS}", f"image.width={w}", f"image.height={h}", f"image.samples={samples}"])
 
 
-def pj_render(w, h, samples, aperture):
+REF_FIRST = 2 ** 30   # the reference's first sample: past any sweep's, so none is shared
+
+
+def pj_render(w, h, samples, aperture, first=0):
     c0 = os.times()
-    r = render(pj_scene(w, h, samples, aperture), calibrate=False)
+    r = render(pj_scene(w, h, samples, aperture), calibrate=False, first_sample=first)
     c1 = os.times()
     return r.color.astype(np.float64), r.alpha, (c1.user - c0.user) + (c1.system - c0.system)
 
@@ -71,11 +81,11 @@ def mb_fract(w: int, h: int, samples: int, dof: float) -> str:
     return s.replace("[main_parameters]\n", "[main_parameters]\nmain_light_intensity 0;\n")
 
 
-def mb_render(w, h, samples, dof, tmp: Path):
+def mb_render(w, h, samples, dof, tmp: Path, over: str = MB_CPU):
     from PIL import Image
     src = tmp / f"s{samples}.fract"
     src.write_text(mb_fract(w, h, samples, dof))
-    cpu, _ = _mb_render(src, w, h, MB_CPU, tmp / f"o{samples}", mb_env(tmp))
+    cpu, _ = _mb_render(src, w, h, over, tmp / f"o{samples}", mb_env(tmp))
     with Image.open(tmp / f"o{samples}.png") as im:
         a = np.asarray(im).astype(np.float64)
     top = 65535.0 if a.max() > 255 else 255.0
@@ -98,15 +108,23 @@ def at_target(rows, target):
     return None
 
 
-def sweep(name, run, counts, reference, target):
-    ref, alpha, ref_cpu = run(reference)
+def own_error(measured: float, samples: int, reference: int) -> float:
+    """The render's own error, less its independent reference's: measured x sqrt(N_ref / (N + N_ref))."""
+    return measured * math.sqrt(reference / (samples + reference))
+
+
+def sweep(name, run, run_ref, counts, reference, target):
+    ref, alpha, ref_cpu = run_ref(reference)
     mask = alpha > 0.5
-    rows = []
+    rows, measured = [], []
     for s in counts:
         img, _, cpu = run(s)
-        rows.append((s, rel_rmse(img, ref, mask), cpu))
-        print(f"{name:14s} {s:5d} samples: relative RMSE {100 * rows[-1][1]:6.2f} %  {cpu:7.2f} CPU-s", flush=True)
-    return rows, at_target(rows, target), ref_cpu, int(mask.sum())
+        m = rel_rmse(img, ref, mask)
+        measured.append(m)
+        rows.append((s, own_error(m, s, reference), cpu))
+        print(f"{name:18s} {s:5d} samples: relative RMSE {100 * m:6.2f} % measured, {100 * rows[-1][1]:6.2f} % its own  "
+              f"{cpu:7.2f} CPU-s", flush=True)
+    return rows, measured, at_target(rows, target), ref_cpu, int(mask.sum())
 
 
 def main() -> None:
@@ -120,12 +138,17 @@ def main() -> None:
     a = ap.parse_args()
     w, h = size_of(a.size)
     render(pj_scene(16, 12, 1, a.aperture))   # programs built before any timing
-    results = {"pyjulia4d": sweep("pyjulia4d", lambda s: pj_render(w, h, s, a.aperture), a.samples, a.reference,
-                                  a.target)}
+    results = {"pyjulia4d": sweep("pyjulia4d", lambda s: pj_render(w, h, s, a.aperture),
+                                  lambda s: pj_render(w, h, s, a.aperture, REF_FIRST), a.samples, a.reference, a.target)}
     if shutil.which("mandelbulber2"):
         with tempfile.TemporaryDirectory() as td:
-            results["Mandelbulber2 CPU"] = sweep("Mandelbulber2", lambda s: mb_render(w, h, s, a.mb_dof, Path(td)),
-                                                 a.samples, a.reference, a.target)
+            for name, over, opencl in (("Mandelbulber2 CPU", MB_CPU, False), ("Mandelbulber2 OpenCL", MB_OPENCL, True)):
+                why = mb_warm(w, h, Path(td), over, opencl)
+                if why is not None:
+                    print(f"{name} skipped: {why}")
+                    continue
+                run = lambda s, over=over: mb_render(w, h, s, a.mb_dof, Path(td), over)  # noqa: E731
+                results[name] = sweep(name, run, run, a.samples, a.reference, a.target)
     else:
         print("mandelbulber2 not installed (Debian: apt-get install mandelbulber2): measured pyjulia4d alone")
     lines = [f"\n## {utc_now()}, commit {git_commit()}\n\n",
@@ -133,20 +156,22 @@ def main() -> None:
              f"{' '.join(map(str, a.samples))}`: the matched default scene under a white sky, global illumination and "
              f"depth of field; each renderer against its own {a.reference}-sample reference; equal noise = "
              f"{100 * a.target:.0f} % relative RMSE.\n\n",
-             "| renderer | samples | relative RMSE | CPU-s |\n| --- | ---: | ---: | ---: |\n"]
+             "| renderer | samples | relative RMSE measured | its own | CPU-s |\n| --- | ---: | ---: | ---: | ---: |\n"]
     speed = {}
-    for name, (rows, hit, ref_cpu, px) in results.items():
-        lines += [f"| {name} | {s} | {100 * e:.2f} % | {c:.2f} |\n" for s, e, c in rows]
+    for name, (rows, measured, hit, ref_cpu, px) in results.items():
+        lines += [f"| {name} | {s} | {100 * m:.2f} % | {100 * e:.2f} % | {c:.2f} |\n"
+                  for (s, e, c), m in zip(rows, measured)]
         if hit is not None:
             speed[name] = w * h / hit[1]
     lines.append("\n")
-    for name, (rows, hit, ref_cpu, px) in results.items():
+    for name, (rows, measured, hit, ref_cpu, px) in results.items():
         lines.append(f"- {name}: reference {ref_cpu:.1f} CPU-s; " + (
             f"{100 * a.target:.0f} % at about {hit[0]:.0f} samples, {hit[1]:.2f} CPU-s: {speed[name]:.0f} pixels per "
             f"CPU-second\n" if hit else f"did not reach {100 * a.target:.0f} % within the counts measured\n"))
-    if len(speed) == 2:
-        lines.append(f"- ratio at equal noise: pyjulia4d {speed['pyjulia4d'] / speed['Mandelbulber2 CPU']:.1f}x "
-                     f"Mandelbulber2's pixels per CPU-second\n")
+    for name in speed:
+        if name != "pyjulia4d" and "pyjulia4d" in speed:
+            lines.append(f"- ratio at equal noise: pyjulia4d {speed['pyjulia4d'] / speed[name]:.1f}x {name}'s pixels "
+                         f"per CPU-second\n")
     text = "".join(lines)
     print(text, end="")
     append_run(ROOT / "benchmarks" / "results" / "path_peer.md",

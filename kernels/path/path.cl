@@ -2,6 +2,10 @@
  * work-item (shading.integrator = "path").  Each sample of each pixel of a tile is a path
  * of at most BOUNCES hits (Kajiya, "The Rendering Equation", 1986, §7: one path per sample):
  *
+ * A launch holds ``n_items`` = n_pix x k work-items: k samples of each of the tile's n_pix
+ * pixels (item i: pixel i % n_pix, sample ``sample`` + i / n_pix), so that a small tile
+ * still fills the device and pays each launch's fixed cost once for k samples.
+ *
  *   path_camera  the camera ray through a random point of the pixel and of the lens (a thin
  *                lens of radius ``aperture`` focused at ``focus`` along the view axis; 0:
  *                a pinhole), or none where the pixel already meets the noise target;
@@ -14,8 +18,8 @@
  *                hit on (Arvo & Kirk, "Particle Transport and Image Synthesis", 1990, §4);
  *   (march)      the shadow rays, the same march;
  *   path_shadow  a light's sample counts where its shadow ray reached it;
- *   path_film    each pixel's mean and its squared deviations, sample by sample (Welford,
- *                1962), from which the stated noise comes.
+ *   path_film    each pixel's mean and its squared deviations, sample by sample in order
+ *                (Welford, 1962), from which the stated noise comes; one item a pixel.
  *
  * Light: shading.light and each of shading.lights gives a white matte surface facing it
  * its colour (a point light without falloff, or a distant one: irradiance pi color); the
@@ -59,6 +63,17 @@ inline real4 to_world(pvec a, real4 right, real4 up, real4 forward)
     return a.x * right + a.y * up - a.z * forward;
 }
 
+/* the pixel (0 .. n_pix - 1) and the sample of launch item i */
+inline size_t item_pixel(size_t i, int n_pix)
+{
+    return i % (size_t)n_pix;
+}
+
+inline uint item_sample(size_t i, int n_pix, int sample)
+{
+    return (uint)sample + (uint)(i / (size_t)n_pix);
+}
+
 inline uint pixel_key(size_t i, int tile_w, int x0, int y0, int image_w)
 {
     int px = x0 + (int)(i % (size_t)tile_w), py = y0 + (int)(i / (size_t)tile_w);
@@ -76,7 +91,7 @@ inline float film_error(float m2, int n)
     return n > 1 ? sqrt(fmax(m2, 0.0f) / ((float)n * (float)(n - 1))) : INFINITY;
 }
 
-__kernel void path_camera(const int n_items, const int tile_w, const int x0, const int y0, const real4 eye,
+__kernel void path_camera(const int n_items, const int n_pix, const int tile_w, const int x0, const int y0, const real4 eye,
                           const real4 forward, const real4 right, const real4 up, const real tan_half_fov,
                           const int image_w, const int image_h, const real aperture, const real focus,
                           const real radius, const int sample, const float noise, const int min_samples,
@@ -87,24 +102,26 @@ __kernel void path_camera(const int n_items, const int tile_w, const int x0, con
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
         return;
-    int n = film_count[i];
-    if (noise > 0.0f && n >= min_samples && film_error(film_m2[i].w, n) <= noise) {
+    size_t ip = item_pixel(i, n_pix);
+    uint s = item_sample(i, n_pix, sample);
+    /* the noise target, from the film before this launch: the same launches on any tiling */
+    int n = film_count[ip];
+    if (noise > 0.0f && n >= min_samples && film_error(film_m2[ip].w, n) <= noise) {
         origins[i] = PATH_FAR(radius);
         dirs[i] = (real4)(1, 0, 0, 0);
         thru[i] = (float4)(0.0f);
         rad[i] = (float4)(0.0f, 0.0f, 0.0f, -1.0f);
         return;
     }
-    uint key = pixel_key(i, tile_w, x0, y0, image_w);
-    int px = x0 + (int)(i % (size_t)tile_w), py = y0 + (int)(i / (size_t)tile_w);
+    uint key = pixel_key(ip, tile_w, x0, y0, image_w);
+    int px = x0 + (int)(ip % (size_t)tile_w), py = y0 + (int)(ip / (size_t)tile_w);
     real u, v;
-    camera_uv(px, py, path_rand(key, (uint)sample, 0u), path_rand(key, (uint)sample, 1u), tan_half_fov, image_w,
-              image_h, &u, &v);
+    camera_uv(px, py, path_rand(key, s, 0u), path_rand(key, s, 1u), tan_half_fov, image_w, image_h, &u, &v);
     real4 d = camera_dir(u, v, forward, right, up);
     real4 o = eye;
     if (aperture > (real)0) {
         /* the thin lens: every ray through the pixel's point of the focal plane */
-        real2 l = aperture * path_disc(path_rand(key, (uint)sample, 2u), path_rand(key, (uint)sample, 3u));
+        real2 l = aperture * path_disc(path_rand(key, s, 2u), path_rand(key, s, 3u));
         real4 f = eye + d * (focus / DOT4(d, forward));
         o = eye + l.x * right + l.y * up;
         real4 e = f - o;
@@ -141,7 +158,7 @@ inline pvec hit_base(real4 p, real4 d, real bracket, julia_params jp, real radiu
     return clamp(PVEC((real)c.x, (real)c.y, (real)c.z), (real)0, (real)1);
 }
 
-__kernel void path_bounce(const int n_items, const int tile_w, const int x0, const int y0, const int image_w,
+__kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, const int x0, const int y0, const int image_w,
                           const int sample, const int bounce, const int bounces, __global const int *status,
                           __global const real4 *point, __global const real4 *normal,
                           __global const real *bracket, const real4 c, const int max_iter, const real bailout,
@@ -189,8 +206,8 @@ __kernel void path_bounce(const int n_items, const int tile_w, const int x0, con
     }
     if (bounce == 0)
         R.w = 1.0f;
-    uint key = pixel_key(i, tile_w, x0, y0, image_w);
-    uint s = (uint)sample;
+    uint key = pixel_key(item_pixel(i, n_pix), tile_w, x0, y0, image_w);
+    uint s = item_sample(i, n_pix, sample);
     julia_params jp = { c, bailout * bailout, (real)0, max_iter };
     real4 p = point[i];
     pvec v = -to_cam(d4, right, up, forward);
@@ -309,27 +326,34 @@ __kernel void path_shadow(const int n_items, __global const int *status, __globa
         rad[i].xyz += q.xyz;
 }
 
-__kernel void path_film(const int n_items, __global const float4 *rad, __global const float4 *albedo,
-                        __global const float4 *first_normal, __global float4 *film_mean, __global float4 *film_m2,
-                        __global float4 *film_albedo, __global float4 *film_normal, __global int *film_count)
+__kernel void path_film(const int n_items, const int batch, __global const float4 *rad,
+                        __global const float4 *albedo, __global const float4 *first_normal,
+                        __global float4 *film_mean, __global float4 *film_m2, __global float4 *film_albedo,
+                        __global float4 *film_normal, __global int *film_count)
 {
-    size_t i = get_global_id(0);
-    if (i >= (size_t)n_items)
+    size_t p = get_global_id(0);
+    if (p >= (size_t)n_items)
         return;
-    float4 x = rad[i];
-    if (x.w < 0.0f)
-        return;
-    int n = film_count[i] + 1;
-    float4 m = film_mean[i];
-    float4 dlt = x - m;
-    float4 m1 = m + dlt / (float)n;
-    float lum_old = film_lum(m), lum_new = film_lum(m1), lx = film_lum(x);
-    float4 q = film_m2[i];
-    q.xyz += dlt.xyz * (x.xyz - m1.xyz);
-    q.w += (lx - lum_old) * (lx - lum_new);
-    film_mean[i] = m1;
-    film_m2[i] = q;
-    film_albedo[i] += (albedo[i] - film_albedo[i]) / (float)n;
-    film_normal[i] += (first_normal[i] - film_normal[i]) / (float)n;
-    film_count[i] = n;
+    int n = film_count[p];
+    float4 m = film_mean[p], q = film_m2[p], a = film_albedo[p], nr = film_normal[p];
+    for (int j = 0; j < batch; j++) {   /* the pixel's samples of this launch, in order */
+        size_t i = p + (size_t)j * (size_t)n_items;
+        float4 x = rad[i];
+        if (x.w < 0.0f)
+            continue;
+        n += 1;
+        float4 dlt = x - m;
+        float4 m1 = m + dlt / (float)n;
+        float lum_old = film_lum(m), lum_new = film_lum(m1), lx = film_lum(x);
+        q.xyz += dlt.xyz * (x.xyz - m1.xyz);
+        q.w += (lx - lum_old) * (lx - lum_new);
+        m = m1;
+        a += (albedo[i] - a) / (float)n;
+        nr += (first_normal[i] - nr) / (float)n;
+    }
+    film_mean[p] = m;
+    film_m2[p] = q;
+    film_albedo[p] = a;
+    film_normal[p] = nr;
+    film_count[p] = n;
 }

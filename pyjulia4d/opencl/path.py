@@ -95,15 +95,21 @@ class PathRunner:
         self.shadow_args = Packed(sig.PATH_SHADOW, rec, pr)
         self.film_args = Packed(sig.PATH_FILM, rec, pr)
         n = max(t.n for t in plan.tiles)
+        m = n * plan.path.batch   # the paths of a launch: batch samples of each pixel
         q = self.queue
-        self.b = {k: cla.empty(q, n, pr.vec_dtype) for k in ("origins", "dirs", "s_origins", "s_dirs", "point",
+        self.b = {k: cla.empty(q, m, pr.vec_dtype) for k in ("origins", "dirs", "s_origins", "s_dirs", "point",
                                                               "normal")}
-        self.b.update({k: cla.empty(q, n, pr.scalar) for k in ("depth", "bracket", "unresolved")})
-        self.b.update({k: cla.empty(q, n, np.int32) for k in ("status", "samples", "flags", "film_count")})
-        self.b.update({k: cla.empty(q, n, cl.cltypes.float4) for k in (
-            "thru", "rad", "pending", "albedo", "first_normal", "film_mean", "film_m2", "film_albedo", "film_normal")})
+        self.b.update({k: cla.empty(q, m, pr.scalar) for k in ("depth", "bracket", "unresolved")})
+        self.b.update({k: cla.empty(q, m, np.int32) for k in ("status", "samples", "flags")})
+        self.b.update({k: cla.empty(q, m, cl.cltypes.float4) for k in ("thru", "rad", "pending", "albedo",
+                                                                      "first_normal")})
+        self.b["film_count"] = cla.empty(q, n, np.int32)
+        self.b.update({k: cla.empty(q, n, cl.cltypes.float4) for k in ("film_mean", "film_m2", "film_albedo",
+                                                                      "film_normal")})
 
     def march(self, n: int, tile: Tile, origins: str, dirs: str) -> list:
+        """The march of n rays: the batch's copies of the tile, one under the other (packets of
+        neighbouring pixels' rays, as the camera's march)."""
         b = self.b
         return [launch(self.queue, self.k["march"], n, *self.march_args(
             tile_w=tile.aw, origins=b[origins], dirs=b[dirs], **{k: b[k] for k in MARCH_OUT}),
@@ -119,10 +125,11 @@ class PathRunner:
                                                                    normal=b["normal"])))
         return ev
 
-    def sample(self, tile: Tile, s: int) -> list:
-        """Queue sample ``s`` of every pixel of ``tile``: its path, then its film."""
-        b, q, n = self.b, self.queue, tile.n
-        place = dict(tile_w=tile.aw, x0=tile.ax0, y0=tile.ay0)
+    def sample(self, tile: Tile, s: int, k: int) -> list:
+        """Queue samples ``s`` .. s + k - 1 of every pixel of ``tile``: their paths, then the film."""
+        b, q, npix = self.b, self.queue, tile.n
+        n = npix * k
+        place = dict(n_pix=npix, tile_w=tile.aw, x0=tile.ax0, y0=tile.ay0)
         ev = [launch(q, self.k["path_camera"], n, *self.camera_args(
             **place, sample=s, film_m2=b["film_m2"], film_count=b["film_count"], origins=b["origins"],
             dirs=b["dirs"], thru=b["thru"], rad=b["rad"]))]
@@ -137,26 +144,28 @@ class PathRunner:
             ev += self.march(n, tile, "s_origins", "s_dirs")
             ev.append(launch(q, self.k["path_shadow"], n, *self.shadow_args(
                 status=b["status"], depth=b["depth"], pending=b["pending"], rad=b["rad"])))
-        ev.append(launch(q, self.k["path_film"], n, *self.film_args(
-            rad=b["rad"], albedo=b["albedo"], first_normal=b["first_normal"], film_mean=b["film_mean"],
+        ev.append(launch(q, self.k["path_film"], npix, *self.film_args(
+            batch=k, rad=b["rad"], albedo=b["albedo"], first_normal=b["first_normal"], film_mean=b["film_mean"],
             film_m2=b["film_m2"], film_albedo=b["film_albedo"], film_normal=b["film_normal"],
             film_count=b["film_count"])))
         return ev
 
     def tile(self, tile: Tile, on_sample=None) -> tuple[dict[str, np.ndarray], list]:
         """Every sample of ``tile``'s pixels: its film over its box, shaped (ah, aw[, 4]), and
-        the kernels' events.  ``on_sample(tile)`` is called as each sample is done."""
+        the kernels' events.  ``on_sample(tile)`` is called for each sample done, as each
+        launch's samples are done."""
         b, q, n = self.b, self.queue, tile.n
         for k in ("film_mean", "film_m2", "film_albedo", "film_normal", "film_count"):
             cl.enqueue_fill_buffer(q, b[k].data, np.uint8(0), 0, b[k].nbytes)
         events = []
-        first = self.plan.path.first_sample
-        for s in range(first, first + self.plan.path.samples):
-            ev = self.sample(tile, s)
+        first, total, batch = self.plan.path.first_sample, self.plan.path.samples, self.plan.path.batch
+        for s in range(first, first + total, batch):
+            k = min(batch, first + total - s)
+            ev = self.sample(tile, s, k)
             q.flush()
             cl.wait_for_events([ev[-1]])
             events += ev
-            if on_sample is not None:
+            for _ in range(k if on_sample is not None else 0):
                 on_sample(tile)
         shape = (tile.ah, tile.aw)
         out = {k: b[k][:n].get().view(np.float32).reshape(*shape, 4)

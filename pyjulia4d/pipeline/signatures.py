@@ -154,7 +154,7 @@ REFLECT_COLOR = Signature("reflect_color", "shade/reflect", (
 TILE_PLACE = (P("int tile_w"), P("int x0"), P("int y0"))
 
 PATH_CAMERA = Signature("path_camera", "path/path", (
-    *TILE_PLACE, P("real4 eye", "camera.position"), P("real4 forward", "camera.forward"),
+    P("int n_pix"), *TILE_PLACE, P("real4 eye", "camera.position"), P("real4 forward", "camera.forward"),
     P("real4 right", "camera.right"), P("real4 up", "camera.up"), P("real tan_half_fov", "camera.tan_half_fov"),
     P("int image_w", "image.width"), P("int image_h", "image.height"), P("real aperture", "path.aperture"),
     P("real focus", "path.focus"), P("real radius", "march.radius"), P("int sample"), P("float noise", "path.noise"),
@@ -162,7 +162,7 @@ PATH_CAMERA = Signature("path_camera", "path/path", (
     P("global real4* origins"), P("global real4* dirs"), P("global float4* thru"), P("global float4* rad")))
 
 PATH_BOUNCE = Signature("path_bounce", "path/path", (
-    *TILE_PLACE, P("int image_w", "image.width"), P("int sample"), P("int bounce"), P("int bounces", "path.bounces"),
+    P("int n_pix"), *TILE_PLACE, P("int image_w", "image.width"), P("int sample"), P("int bounce"), P("int bounces", "path.bounces"),
     P("global const int* status"), P("global const real4* point"), P("global const real4* normal"),
     P("global const real* bracket"), *ORBIT, *BASIS, P("real4 light_pos", "shade.light"),
     P("float4 light_color", "shade.light_color"), P("float light_radius", "shade.light_radius"),
@@ -182,7 +182,7 @@ PATH_SHADOW = Signature("path_shadow", "path/path", (
     P("global float4* rad")))
 
 PATH_FILM = Signature("path_film", "path/path", (
-    P("global const float4* rad"), P("global const float4* albedo"), P("global const float4* first_normal"),
+    P("int batch"), P("global const float4* rad"), P("global const float4* albedo"), P("global const float4* first_normal"),
     P("global float4* film_mean"), P("global float4* film_m2"), P("global float4* film_albedo"),
     P("global float4* film_normal"), P("global int* film_count")))
 
