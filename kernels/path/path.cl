@@ -12,8 +12,9 @@
  *   (march)      march/march.cl with -D RAYS_FROM_BUFFERS, the render's own march;
  *   (normals)    the render's normals, the Jacobian's where the Z-buffer's were asked for;
  *   path_bounce  at a miss the environment (the background for a camera ray); at a hit one
- *                light's sample (next-event estimation: the key light, shading.lights, or
- *                the sky, picked uniformly) waiting on its shadow ray, and the next ray
+ *                light's sample (next-event estimation: the key light, shading.lights or
+ *                the sky, chosen by what each can give the point: light_weight) waiting on
+ *                its shadow ray, and the next ray
  *                drawn from the material (path/sample.cl), Russian roulette from the third
  *                hit on (Arvo & Kirk, "Particle Transport and Image Synthesis", 1990, §4);
  *   (march)      the shadow rays, the same march;
@@ -133,6 +134,24 @@ __kernel void path_camera(const int n_items, const int n_pix, const int tile_w, 
     rad[i] = (float4)(0.0f);
 }
 
+/* What a light (a position, or with lc.w != 0 a direction; size: a sphere's radius or a sun's
+ * angular radius in degrees) can give a white matte surface at o facing n, the share next-event
+ * estimation chooses it by: its luminance times a bound on the cosine over the cone it fills,
+ * cos(theta - alpha) <= n . l + sin(alpha), clamped to [0, 1] - zero only where no direction of
+ * the light is above the surface (Pharr, Jakob & Humphreys 2023, §12.6, light sampling by
+ * power; here bounded per point, so a light behind the surface is never drawn). */
+inline real light_weight(real4 lv, float4 lc, real size, real4 o, pvec n, real4 right, real4 up, real4 forward)
+{
+    real4 dv = lc.w != 0.0f ? lv : lv - o;
+    real dist = sqrt(DOT4(dv, dv));
+    pvec l = path_unit(to_cam(dv, right, up, forward));
+    real sin_a = (real)0;
+    if (size > (real)0)
+        sin_a = lc.w != 0.0f ? sin(fmin(size, (real)90) * (real)(PATH_PI / 180)) : fmin(size / fmax(dist, size), (real)1);
+    real lum = (real)0.2126 * lc.x + (real)0.7152 * lc.y + (real)0.0722 * lc.z;
+    return lum * clamp(DOT3(n, l) + sin_a, (real)0, (real)1);
+}
+
 /* The colour of a hit: the scene's, or the colour map's entry for its colour value *val
  * (shade/light.cl orbit_value, the inside end of its bracket for the escape count; 0 for
  * the flat colour) */
@@ -166,7 +185,7 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
                           const float4 light_color, const float light_radius, __global const real4 *lights_geo,
                           __global const float4 *lights_rgb, __global const float *lights_size,
                           const float4 color, const float4 background,
-                          const float4 sky, const real metallic, const real alpha2, const real f0s,
+                          const float4 sky, const real sky_weight, const real metallic, const real alpha2, const real f0s,
                           const real emission,
                           const real bias, const real radius, const real4 trap, __global const float4 *lut,
                           const int n_lut, __global real4 *origins, __global real4 *dirs,
@@ -228,20 +247,42 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
     real nv = fmax(DOT3(n, v), (real)1e-6);
     real ps = spec_share(base, metallic, f0s, nv);
     real4 o = p + bias * n4;
-    /* next-event estimation: one light, picked uniformly */
+    /* next-event estimation: one light, chosen in proportion to what it can give here */
     float sky_on = sky.x + sky.y + sky.z > 0.0f ? 1.0f : 0.0f;
-    int key_on = (light_color.x + light_color.y + light_color.z > 0.0f) ? 1 : 0;   /* a black key light: not drawn */
-    int n_point = key_on + EXTRA_LIGHT_COUNT;
-    int n_all = n_point + (int)sky_on;
-    if (n_all == 0) {   /* nothing lights the scene: a black path */
+    int key_on = (light_color.x + light_color.y + light_color.z > 0.0f) ? 1 : 0;
+    if (key_on + EXTRA_LIGHT_COUNT + (int)sky_on == 0) {   /* nothing lights the scene: a black path */
         rad[i] = R;
         return;
     }
-    int j = min((int)(path_rand(key, s, DIM(bounce, 0)) * (real)n_all), n_all - 1) + 1 - key_on;
-    pvec l;
-    float4 le;
-    real dist, wl;
-    if (j < 1 + EXTRA_LIGHT_COUNT) {
+    /* the key light is a point (light_pos: shade.light) */
+    real w_key = light_weight(light_pos, (float4)(light_color.xyz, 0.0f), (real)light_radius, o, n, right, up, forward);
+    real w_sky = sky_on > 0.0f ? sky_weight : (real)0;
+    real w_all = w_key + w_sky;
+    for (int e = 0; e < EXTRA_LIGHT_COUNT; e++)
+        w_all += light_weight(lights_geo[e], lights_rgb[e], (real)lights_size[e], o, n, right, up, forward);
+    /* the light j whose share of w_all holds the random number; none where no light can reach */
+    real u_pick = path_rand(key, s, DIM(bounce, 0)) * w_all;
+    int j = u_pick < w_key ? 0 : -1;
+    real w_j = w_key, w_cum = w_key;
+    for (int e = 0; e < EXTRA_LIGHT_COUNT; e++) {
+        real w_e = light_weight(lights_geo[e], lights_rgb[e], (real)lights_size[e], o, n, right, up, forward);
+        if (j < 0 && u_pick < w_cum + w_e) {
+            j = e + 1;
+            w_j = w_e;
+        }
+        w_cum += w_e;
+    }
+    if (j < 0 && w_sky > (real)0) {
+        j = 1 + EXTRA_LIGHT_COUNT;
+        w_j = w_sky;
+    }
+    real p_sky = w_all > (real)0 ? w_sky / w_all : (real)0;   /* the sky's share, for both ways to it */
+    pvec l = PVEC(0, 0, 1);
+    float4 le = (float4)(0.0f);
+    real dist = (real)INFINITY, wl = (real)0;
+    if (j < 0) {
+        /* no light faces this point: nothing to draw */
+    } else if (j < 1 + EXTRA_LIGHT_COUNT) {
         /* if-else, not ?: on vectors, here and below (see path_unit) */
         real4 lv = light_pos - o;
         float4 lc = (float4)(light_color.xyz, 0.0f);
@@ -275,15 +316,15 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
         real pl = SKY_PDF(n, l);
         float4 sl = SKY_RADIANCE(to_world(l, right, up, forward));
         le = pl > (real)0 ? (float4)(sl.xyz, 0.0f) / (float)pl : (float4)(0.0f);
-        /* both strategies' densities of l, the light's times its choice (1 / n_all) as at an
+        /* both strategies' densities of l, the light's times its choice (p_sky) as at an
          * escape below: weights that sum to one over the two ways to the sky; at the last
          * hit no ray is drawn from the material, and the light's sample takes it all */
         wl = bounce + 1 >= bounces ? (real)1
-                                   : power_weight(pl / (real)n_all, bsdf_eval(n, v, l, base, metallic, f0s, alpha2, ps).w);
+                                   : power_weight(pl * p_sky, bsdf_eval(n, v, l, base, metallic, f0s, alpha2, ps).w);
     }
     real4 fl = bsdf_eval(n, v, l, base, metallic, f0s, alpha2, ps);
-    if (fl.x + fl.y + fl.z > (real)0) {
-        float4 add = (float4)(T.xyz, 0.0f) * convert_float4(fl) * le * (float)(wl * (real)n_all);
+    if (j >= 0 && fl.x + fl.y + fl.z > (real)0) {
+        float4 add = (float4)(T.xyz, 0.0f) * convert_float4(fl) * le * (float)(wl * w_all / w_j);
         pending[i] = (float4)(add.xyz, (float)dist);
         s_origins[i] = o;
         s_dirs[i] = to_world(l, right, up, forward);
@@ -308,7 +349,7 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
         w /= q;
     }
     /* the weight the sky gets where this ray escapes: against the sky's own sample of it */
-    real psky = sky_on > 0.0f ? SKY_PDF(n, nd) / (real)n_all : (real)0;
+    real psky = sky_on > 0.0f ? SKY_PDF(n, nd) * p_sky : (real)0;
     thru[i] = (float4)(w.xyz, (float)power_weight(fb.w, psky));
     origins[i] = o;
     dirs[i] = to_world(nd, right, up, forward);

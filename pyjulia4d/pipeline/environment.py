@@ -44,6 +44,7 @@ class Environment:
     marginal: np.ndarray
     conditional: np.ndarray
     name: str
+    mean: float = 1.0   # the mean luminance over the sphere (each texel by its solid angle)
 
     @property
     def width(self) -> int:
@@ -109,6 +110,7 @@ def build(rgb: np.ndarray, name: str = "") -> Environment:
     h, w = rgb.shape[:2]
     theta = np.pi * (np.arange(h) + 0.5) / h
     weight = (rgb.astype(np.float64) @ LUMA) * np.sin(theta)[:, None]
+    mean = float(weight.sum() / (w * np.sin(theta).sum()))
     if not weight.sum() > 0:
         weight = np.ones_like(weight) * np.sin(theta)[:, None]
     rows = weight.sum(axis=1)
@@ -121,7 +123,7 @@ def build(rgb: np.ndarray, name: str = "") -> Environment:
     image[..., :3] = rgb
     for a in (image, marginal, conditional):
         a.setflags(write=False)
-    return Environment(image, marginal, conditional, name)
+    return Environment(image, marginal, conditional, name, mean)
 
 
 def texel_pdf(env: Environment, row: np.ndarray, col: np.ndarray) -> np.ndarray:

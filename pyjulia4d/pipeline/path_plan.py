@@ -57,6 +57,7 @@ class PathArgs:
     alpha2: float
     f0s: float
     sky: tuple[float, float, float, float]
+    sky_weight: float      # what the sky gives a white matte surface, the share light choice gives it
     emission: float        # shading.emission: the surface's own light, times its colour and 1 - its colour value
     normals: str           # the bounces' normals: "jacobian" or "gradient" (bounce_normals)
     environment: Environment | None = None   # shading.environment's image and its distribution; None: uniform
@@ -87,9 +88,20 @@ def path_args(scene: Scene, focus: float, first_sample: int = 0) -> PathArgs:
     return PathArgs(bounces=sh.bounces, samples=im.samples, first_sample=first_sample,
                     batch=launch_batch(im.width, im.height, im.samples), aperture=scene.camera.aperture, focus=focus,
                     noise=im.noise, min_samples=MIN_SAMPLES, metallic=sh.metallic, alpha2=a * a,
-                    f0s=0.08 * min(sh.specular, 12.5), sky=sky, emission=sh.emission, normals=bounce_normals(scene),
+                    f0s=0.08 * min(sh.specular, 12.5), sky=sky,
+                    sky_weight=sky_weight(sky, env), emission=sh.emission, normals=bounce_normals(scene),
                     environment=env,
                     env_x=axes[0], env_y=axes[1], env_z=axes[2])
+
+
+def sky_weight(sky, env: Environment | None) -> float:
+    """The sky's share in next-event estimation's choice of a light (kernels/path/path.cl
+    light_weight gives the lights'): what it gives a white matte surface under a sky of its
+    mean radiance, the luminance of ``sky`` times the image's mean luminance over the sphere
+    (1 for the uniform sky).  Any positive share keeps the estimate unbiased; one near the
+    truth spends the shadow rays where the light is."""
+    return float(np.dot(np.float32(sky[:3]).astype(np.float64), [0.2126, 0.7152, 0.0722])
+                 * (1.0 if env is None else env.mean))
 
 
 def bounce_normals(scene: Scene) -> str:

@@ -23,6 +23,24 @@ from pyjulia4d.reference.path_environment import EnvTwin
 from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
 
 
+def light_weight(g, c, size: float, o, n, to_cam):
+    """kernels/path/path.cl light_weight: what a light (a position g, or with c[3] != 0 a
+    direction; size a sphere's radius or a sun's angular radius in degrees) can give a white
+    matte surface at points o (k, 4) facing n (k, 3, camera coordinates): its luminance
+    times min(max(n . l + sin(alpha), 0), 1), a bound on the cosine over the cone it fills."""
+    dv = np.tile(g, (len(o), 1)) if c[3] != 0 else g - o
+    dist = np.linalg.norm(dv, axis=1)
+    ln = unit(to_cam(dv))
+    if size <= 0:
+        sin_a = np.zeros(len(o))
+    elif c[3] != 0:
+        sin_a = np.full(len(o), np.sin(min(size, 90.0) * PI / 180))
+    else:
+        sin_a = np.minimum(size / np.maximum(dist, size), 1.0)
+    lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+    return lum * np.clip(dot(n, ln) + sin_a, 0.0, 1.0)
+
+
 def dim(bounce: int, k: int) -> int:
     """The random dimension of draw k at a hit (path.cl DIM)."""
     return 4 + 8 * bounce + k
@@ -156,10 +174,21 @@ class PathTwin:
             nv = np.maximum(dot(nn, v), 1e-6)
             ps = spec_share(base, pa.metallic, pa.f0s, nv)
             ob = pt[k] + la.bias * n4
-            # next-event estimation: one light, uniformly
+            # next-event estimation: one light, chosen by what each can give the point (path.cl)
             if n_all == 0:   # nothing lights the scene
                 break
-            j = np.minimum((path_rand(ks, s, dim(b, 0)) * n_all).astype(int), n_all - 1) + 1 - key_on
+            wts = np.stack([light_weight(geo[i], rgb[i], sizes[i], ob, nn, self.to_cam) for i in range(len(geo))]
+                           + [np.full(k.size, pa.sky_weight if sky_on else 0.0)], axis=1)
+            w_all = wts.sum(axis=1)
+            u_pick = path_rand(ks, s, dim(b, 0)) * w_all
+            cum = np.cumsum(wts, axis=1)
+            # the first light whose running sum passes u (path.cl's walk: key, extra lights, sky);
+            # -1 where none can reach the point
+            j = np.where((u_pick[:, None] < cum).any(axis=1), np.argmax(u_pick[:, None] < cum, axis=1), -1)
+            j = np.where((j < 0) & (wts[:, -1] > 0), len(geo), j)
+            w_j = np.where(j >= 0, wts[np.arange(k.size), np.maximum(j, 0)], 1.0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                p_sky = np.where(w_all > 0, wts[:, -1] / np.where(w_all > 0, w_all, 1.0), 0.0)
             l = np.zeros((k.size, 3))
             le = np.zeros((k.size, 3))
             dist = np.full(k.size, np.inf)
@@ -191,10 +220,10 @@ class PathTwin:
                 with np.errstate(divide="ignore", invalid="ignore"):
                     le[m] = np.where((pl > 0)[:, None], sl / np.where(pl > 0, pl, 1.0)[:, None], 0.0)
                 _, pb = bsdf_eval(nn[m], v[m], l[m], base[m], pa.metallic, pa.f0s, pa.alpha2, ps[m])
-                wl[m] = 1.0 if b + 1 >= pa.bounces else power_weight(pl / n_all, pb)
+                wl[m] = 1.0 if b + 1 >= pa.bounces else power_weight(pl * p_sky[m], pb)
             fl, _ = bsdf_eval(nn, v, l, base, pa.metallic, pa.f0s, pa.alpha2, ps)
-            add = T[k] * fl * le * (wl * n_all)[:, None]
-            lit = fl.sum(axis=1) > 0
+            add = T[k] * fl * le * (wl * w_all / w_j)[:, None]
+            lit = (j >= 0) & (fl.sum(axis=1) > 0)
             if lit.any():
                 ls = np.nonzero(lit)[0]
                 sd, _, sst, _, _ = self.hits(ob[ls], self.to_world(l[ls]))
@@ -215,7 +244,7 @@ class PathTwin:
                 q = np.clip(w.max(axis=1), 0.05, 0.95)
                 go &= path_rand(ks, s, dim(b, 6)) < q
                 w = w / q[:, None]
-            psky = self.sky_pdf(nn, nd) / n_all if sky_on else np.zeros(k.size)
+            psky = self.sky_pdf(nn, nd) * p_sky if sky_on else np.zeros(k.size)
             alive = np.zeros(n, bool)
             alive[k[go]] = True
             T[k] = w

@@ -107,6 +107,23 @@ def test_lambertian_ball_under_a_distant_light(tmp_path) -> None:
     judge(r, lambert_truth(r.scene, light, [0.9, 0.7, 0.5], 0.5))
 
 
+def test_lambertian_ball_under_two_lights(tmp_path) -> None:
+    """Next-event estimation chooses a light by what it can give the point (path.cl
+    light_weight): a sun and a dimmer point light from the other side, each lighting the half
+    of the ball that faces it, sum to their closed forms.  Both are grey, so a sample's value
+    is the same whichever light it drew (each light's share is its part of the sum): a
+    light drawn seldom where it gives little cannot leave a pixel's stated noise short of
+    its error, as a coloured one can over 48 samples."""
+    sun, key = [1.0, 1.5, -1.0], np.array([-3.0, 0.5, -2.0])
+    r = ball({"light_color": [0.35, 0.35, 0.35], "light": key.tolist() + [0.0], "ambient": 0.0,
+              "environment": sky_file(tmp_path, 0.0, 0.0),
+              "lights": [{"direction": sun + [0], "color": [0.8, 0.8, 0.8]}]}, samples=48, bounces=1)
+    lk = lambda p: (key - p) / np.linalg.norm(key - p, axis=1, keepdims=True)   # noqa: E731
+    point = pixel_truth(r.scene, lambda nrm: 0.5 * 0.35 * np.maximum((nrm * lk(nrm)).sum(axis=1), 0)[:, None]
+                        * np.ones(3))
+    judge(r, lambert_truth(r.scene, sun, [0.8, 0.8, 0.8], 0.5) + point)
+
+
 def test_stated_noise_is_the_measured_error() -> None:
     """The standard error each pixel states at 16 samples against its actual distance from a
     256-sample render of the same scene: the RMS of the two within a factor 1.5.  The
