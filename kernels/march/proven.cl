@@ -79,6 +79,21 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
  * ran unproven for a third of their length, past 65536 floor segments, and were capped */
 #define FLOOR_RUN 32
 #define FLOOR_WIDEST ((real)0.001)
+/* A floor segment found open right after a proof - a lone near miss, where the ray passes
+ * the set closer than the floor, not a grazing run - is looked at again before it is passed:
+ * the march goes over it once more at a floor FINE_DIV times finer, passing what it proves
+ * there, and gives up at the first fine segment it cannot prove (passing the rest of the
+ * floor segment unproven, as before).  What a render states is the reach from its first
+ * unproven segment to its depth, so one near miss far in front of the surface widened a
+ * pixel's statement by all of that distance: on the 24 pairs' defaults at 48x36
+ * (benchmarks/accuracy/pair_accuracy.py) the look narrowed the stated p99 of the hypercomplex
+ * sin from 0.31 to 6.6e-4, of the cos from 0.081 to 3.4e-3 and of the quaternion cube from
+ * 4.7e-3 to 2.4e-4; the sets with dust barely move (their near misses lie closer still). */
+#define FINE_DIV ((real)16)
+/* the finest floor the look goes to, of the ray: 2^-20, 16 float32 spacings of t at a ray of
+ * length 4 (finer, t + h rounds back to t and the march stalls); the final preset's floor
+ * (1/200000) is past it, so the look serves draft and normal */
+#define FINE_LEAST ((real)9.5367431640625e-7)
 
 inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_params jp,
                        int z_resolution, int post_steps, int max_steps, lmask *status,
@@ -93,11 +108,14 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal widest = fmax(floor_w, span * FLOOR_WIDEST);
     lmask first = live & julia_inside(QRAY(o, d, near), jp);
     lmask active = live & !first, hit = first, miss = 0, n = 0;
+    /* the finer look at a lone open floor segment: its end, the floor before it (-inf: none) */
+    lreal fine_end = (lreal)-INFINITY, outer_floor = floor_w;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lreal t1 = fmin(t + h, far);
         lreal margin;
         lmask empty = enc_prove(o, d, t, t1, active, jp, &margin);
         n = L_SEL(n, n + 1, active);
+        lmask fine = fine_end > t;
         lmask at_floor = active & !empty & (h <= floor_here);
         lmask got = 0;
         if (L_ANY(at_floor)) {   /* FLOOR_POINTS points across it, in order: a thin part may hold the first */
@@ -113,8 +131,14 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
                 before = tj;
             }
         }
-        lmask open = at_floor & !got;
-        open_w = L_SEL(open_w, open_w + (t1 - t), open);
+        lmask found_open = at_floor & !got;
+        /* a lone one (run 0: a proof just before) is gone over again at the fine floor */
+        lmask again = found_open & !fine & (run == (real)0) & (floor_here >= span * (FINE_LEAST * FINE_DIV));
+        lmask open = found_open & !again;
+        /* a fine segment left open gives the look up: the rest of its floor segment passes with it */
+        lmask give_up = open & fine;
+        lreal t_end = L_SEL(t1, fmax(t1, fine_end), give_up);
+        open_w = L_SEL(open_w, open_w + (t_end - t), open);
         t_open = L_SEL(t_open, fmin(t_open, t), open);
         run = L_SEL(L_SEL(run, (lreal)0, empty), run + 1, open);
         lmask wider = open & (run >= (real)FLOOR_RUN);
@@ -122,7 +146,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         run = L_SEL(run, (lreal)0, wider);
         hit |= got;
         lmask pass = empty | open;
-        lmask done = pass & (t1 >= far);
+        lmask done = pass & (t_end >= far);
         miss |= done;
         lreal m = L_SEL((lreal)0, margin, margin == margin);   /* NaN: no guidance */
         lreal fac = sqrt(fmax(m * PROVEN_GAIN, (lreal)0));
@@ -131,7 +155,14 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         h = L_SEL(h, fmin(h * grow, span), empty);
         h = L_SEL(h, fmax(h * shrink, floor_here), active & !empty & !at_floor);
         h = L_SEL(h, floor_here, open);
-        t = L_SEL(t, t1, pass & !done);
+        t = L_SEL(t, t_end, pass & !done);
+        /* the fine look: begun, kept while t is short of its end, and ended (the floor back) */
+        outer_floor = L_SEL(outer_floor, floor_here, again);
+        fine_end = L_SEL(fine_end, t1, again);
+        lmask ended = (fine | again) & !(fine_end > t);
+        fine_end = L_SEL(fine_end, (lreal)-INFINITY, ended);
+        floor_here = L_SEL(L_SEL(floor_here, outer_floor, ended), outer_floor / FINE_DIV, fine_end > t);
+        h = L_SEL(L_SEL(h, fmax(h * shrink, floor_here), again), floor_here, give_up);
         active &= !(got | done);
     }
     *samples = L_SEL(*samples, n, live);

@@ -207,6 +207,8 @@ PROVEN_GAIN = 0.8
 FLOOR_POINTS = 8   # the points an unproven floor segment is tested at (march/proven.cl)
 FLOOR_RUN = 32     # unproven floor segments in a row that double the floor (march/proven.cl)
 FLOOR_WIDEST = 0.001   # of the ray: the widest the floor grows to
+FINE_DIV = 16.0        # a lone open floor segment is gone over again at a floor this much finer (march/proven.cl)
+FINE_LEAST = 2.0 ** -20   # of the ray: the finest floor that look goes to (march/proven.cl)
 
 
 def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
@@ -229,6 +231,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     first = julia_inside(o + near[:, None] * d, c, max_iter, bailout, formula)
     active, hit, miss = ~first, first.copy(), np.zeros(n, bool)
     count = np.zeros(n, np.int32)
+    # the finer look at a lone open floor segment: its end (-inf: none), the floor before it
+    fine_end, outer_floor = np.full(n, -np.inf), floor_w.copy()
     for _ in range(max_steps):
         k = np.nonzero(active)[0]
         if k.size == 0:
@@ -236,6 +240,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         t1 = np.minimum(t[k] + h[k], far[k])
         empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
         count[k] += 1
+        fine = fine_end[k] > t[k]
         at_floor = ~empty & (h[k] <= floor_here[k])
         got = np.zeros(k.size, bool)
         look = at_floor.copy()
@@ -251,8 +256,13 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
             got[g] = True
             look[g] = False
             before[j] = tj
-        opened = at_floor & ~got
-        open_w[k] = np.where(opened, open_w[k] + (t1 - t[k]), open_w[k])
+        found_open = at_floor & ~got
+        # a lone one: gone over at the fine floor, where that is no finer than FINE_LEAST of the ray
+        again = found_open & ~fine & (run[k] == 0) & (floor_here[k] >= span[k] * (FINE_LEAST * FINE_DIV))
+        opened = found_open & ~again
+        give_up = opened & fine   # a fine segment left open: the rest of its floor segment passes too
+        t_end = np.where(give_up, np.maximum(t1, fine_end[k]), t1)
+        open_w[k] = np.where(opened, open_w[k] + (t_end - t[k]), open_w[k])
         t_open[k] = np.where(opened, np.minimum(t_open[k], t[k]), t_open[k])
         run[k] = np.where(opened, run[k] + 1, np.where(empty, 0.0, run[k]))
         wider = opened & (run[k] >= FLOOR_RUN)
@@ -261,7 +271,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         run[k] = np.where(wider, 0.0, run[k])
         hit[k] |= got
         passed = empty | opened
-        done = passed & (t1 >= far[k])
+        done = passed & (t_end >= far[k])
         miss[k] |= done
         mg = np.where(np.isnan(margin), 0.0, margin)
         fac = np.sqrt(np.maximum(mg * PROVEN_GAIN, 0.0))   # the margin falls about as h^-2 (march/proven.cl)
@@ -269,7 +279,15 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
         h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_here[k]), h[k])
         h[k] = np.where(opened, floor_here[k], h[k])
-        t[k] = np.where(passed & ~done, t1, t[k])
+        t[k] = np.where(passed & ~done, t_end, t[k])
+        # the fine look: begun, kept while t is short of its end, and ended (the floor back)
+        outer_floor[k] = np.where(again, floor_here[k], outer_floor[k])
+        fine_end[k] = np.where(again, t1, fine_end[k])
+        ended = (fine | again) & ~(fine_end[k] > t[k])
+        fine_end[k] = np.where(ended, -np.inf, fine_end[k])
+        floor_here[k] = np.where(fine_end[k] > t[k], outer_floor[k] / FINE_DIV,
+                                 np.where(ended, outer_floor[k], floor_here[k]))
+        h[k] = np.where(give_up, floor_here[k], np.where(again, np.maximum(h[k] * shrink, floor_here[k]), h[k]))
         active[k] &= ~(got | done)
     status = np.where(hit, STATUS_HIT, np.where(miss, STATUS_MISS, STATUS_CAPPED)).astype(np.int32)
     width = np.full(n, np.inf)
