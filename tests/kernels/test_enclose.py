@@ -16,6 +16,8 @@ a relative 1e-12 for the samples' own rounding); kernel against twin with the fl
 classification slack of tests/kernels/test_march.py."""
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 import pytest
 
@@ -372,3 +374,33 @@ def test_grazing_rays_widen_the_floor_and_finish():
     slack = 1e-5 * (1 + depth)
     lo_k, hi_k, lo_r, hi_r = depth - unresolved, depth + bracket, rd - ru, rd + rb
     assert np.all(((lo_k <= hi_r + slack) & (lo_r <= hi_k + slack))[both])
+
+
+def test_a_lone_near_miss_is_looked_at_again(monkeypatch):
+    """A floor segment left open right after a proof is gone over at a floor 16 times finer
+    (march/proven.cl FINE_DIV): on rays of the hypercomplex sin's framed default view that pass
+    the set closer than the floor long before they hit it, kernel and twin state the same
+    narrow reach (the look proved the near miss empty), where without the look the twin
+    states at least 10 times more - the distance from the near miss to the surface."""
+    s = Scene.from_dict({"fractal": {"algebra": "hypercomplex", "function": "sin"}, "march": {"quality": "normal"},
+                         "camera": {"position": [5.3162, 4.46233, -5.95002, 0], "target": [0.80689, 0.45405, -0.43864, 0]},
+                         "image": {"width": 48, "height": 36}})
+    o, d = ref.generate_rays(camera_frame(s), 48, 36)
+    pick = np.array([251, 298, 300, 304, 351, 396, 450, 492])
+    o, d = o[pick].astype(np.float32).astype(float), d[pick].astype(np.float32).astype(float)
+    depth, status, bracket, unresolved = march_on_rays(s, o, d)
+    M = importlib.import_module("pyjulia4d.reference.march")
+
+    def twin():
+        rb, ru = np.zeros(len(o)), np.zeros(len(o))
+        rd, _, rs, _ = ref.march(o, d, march_args(s, method="proven"), bracket=rb, formula=formula_of(s.fractal),
+                                 unresolved=ru)
+        return rd, rs, ru
+
+    rd, rs, ru = twin()
+    assert np.all(status == 1) and np.all(rs == 1)
+    assert np.all(np.abs(depth - rd) <= 1e-4 * (1 + rd))
+    assert np.all(np.abs(unresolved - ru) <= 1e-4 + 0.1 * ru)
+    monkeypatch.setattr(M, "FINE_LEAST", 1.0)   # no floor is that coarse: no look
+    _, _, wide = twin()
+    assert np.median(wide / np.maximum(ru, 1e-6)) >= 10
