@@ -16,6 +16,11 @@ change, and how many previews arrive per second while a slider is dragged.
   its full size (the median over ``--changes`` changes of fractal.c[1]).
 - ``previews per second``: the slider of fractal.c[1] moved every 16 ms (an input event per
   display frame, as a drag makes them) for ``--drag-seconds``; pictures that arrived, per second.
+- ``change -> path-traced view of N paths`` (``--rest-batches K``, for a scene set to
+  shading.integrator = "path"): after a change the explorer shows the direct-lit preview,
+  then refines the picture at rest in batches of paths (4, then doubling: 4, 8, 16, ... paths
+  per pixel in all), each shown denoised where Open Image Denoise is installed; the time from
+  the change to each of the first K batches (median over ``--changes`` changes, at least 1).
 
 Times are the browser's (performance.now()), so the WebSocket, the PNG decoding and the page's
 own work are included.  Writes benchmarks/results/explore_latency.md (a section per run, with
@@ -49,8 +54,14 @@ RESULTS = ROOT / "benchmarks" / "results" / "explore_latency.md"
 # clock (performance.now(): milliseconds from the page's navigation start)
 EARLY = """
 window.__arrivals = [];
+// each picture: its time, its stage, and the paths per pixel its facts state (a path-traced batch's; '' else)
+const pathsOf = () => {
+    const f = document.getElementById('facts');
+    const m = f ? /paths per pixel\\s+([0-9-]+)/.exec(f.innerText) : null;
+    return m ? m[1] : '';
+};
 new MutationObserver((records) => {
-    for (const r of records) if (r.target.id === 'view') window.__arrivals.push([performance.now(), r.target.dataset.stage]);
+    for (const r of records) if (r.target.id === 'view') window.__arrivals.push([performance.now(), r.target.dataset.stage, pathsOf()]);
 }).observe(document, {subtree: true, attributes: true, attributeFilter: ['data-count']});
 """
 
@@ -90,6 +101,24 @@ const tick = setInterval(() => {
 """
 
 
+REST = """
+const [value, batches, done] = [arguments[0], arguments[1], arguments[arguments.length - 1]];
+const n0 = window.__arrivals.length;
+const field = document.getElementsByName('fractal.c[1]')[0];
+const t0 = performance.now();
+field.value = value;
+field.dispatchEvent(new Event('change', {bubbles: true}));
+const poll = () => {
+    const got = window.__arrivals.slice(n0).filter(a => a[2] !== '');   // the path-traced batches
+    if (got.length >= batches || got.some(a => a[1] === 'final'))
+        done(got.slice(0, batches).map(a => [a[0] - t0, a[2]]));
+    else if (performance.now() - t0 > 120000) done(got.map(a => [a[0] - t0, a[2]]));
+    else setTimeout(poll, 2);
+};
+poll();
+"""
+
+
 def browser():
     try:
         d = headless_chromium()
@@ -118,7 +147,7 @@ def launch(args: list[str], env: dict, d) -> tuple[subprocess.Popen, str, float,
 
 
 def run(changes: int, drag_seconds: float, overrides: list[str], device: str | None,
-        screenshot: Path | None = None, cold: bool = True) -> dict:
+        screenshot: Path | None = None, cold: bool = True, rest_batches: int = 0) -> dict:
     from selenium.webdriver.support.ui import WebDriverWait
 
     tmp = Path(tempfile.mkdtemp(prefix="explore-latency-"))
@@ -144,12 +173,15 @@ def run(changes: int, drag_seconds: float, overrides: list[str], device: str | N
         facts = d.find_element("id", "facts").text
         device_name = facts.split("device\n")[-1].strip()
         size = facts.split("size\n")[-1].split("\n")[0]
-        nexts, finals = [], []
-        for k in range(changes):
+        nexts, finals, rests = [], [], []
+        for k in range(changes if not rest_batches else 0):
             got = d.execute_async_script(CHANGE, f"{0.55 + 0.02 * (k % 10):.3f}")
             if got:
                 nexts.append(got[0] / 1000)
                 finals.append(got[1] / 1000)
+        for k in range(max(changes, 1) if rest_batches else 0):   # a path-traced scene: its batches at rest
+            rests.append([(t / 1000, paths) for t, paths in d.execute_async_script(
+                REST, f"{0.55 + 0.02 * (k % 10):.3f}", rest_batches)])
         frames, stages = d.execute_async_script(DRAG, drag_seconds)
         if screenshot is not None:   # the page at rest after the drag
             WebDriverWait(d, 120).until(
@@ -162,7 +194,8 @@ def run(changes: int, drag_seconds: float, overrides: list[str], device: str | N
         shutil.rmtree(tmp, ignore_errors=True)
     return {"cold_listen": cold_listen, "cold_first": cold_first, "warm_listen": warm_listen,
             "warm_first": warm_first, "page_ms": page_ms, "next": nexts, "final": finals,
-            "previews": frames / drag_seconds, "stages": sorted(set(stages)), "device": device_name, "size": size}
+            "previews": frames / drag_seconds, "stages": sorted(set(stages)), "device": device_name, "size": size,
+            "rests": rests}
 
 
 def seconds(x: float | None) -> str:
@@ -182,6 +215,13 @@ def table(r: dict, changes: int, drag_seconds: float) -> str:
         ("change -> final picture (median)", f"{med(r['final']):.3f} s" if r["final"] else "-", ""),
         (f"previews per second while dragging ({drag_seconds:g} s)", f"{r['previews']:.1f}", "at least 5"),
     ]
+    if r["rests"]:   # a path-traced scene: the change's own rows are its batches at rest
+        rows = [x for x in rows if not x[0].startswith("change")]
+        for k in range(max(len(x) for x in r["rests"])):
+            got = [x[k][0] for x in r["rests"] if len(x) > k]
+            paths = r["rests"][0][k][1]
+            rows.append((f"change -> path-traced view of {paths} paths per pixel (median of {len(got)})",
+                         f"{med(got):.2f} s", "a clean denoised view within 2 s at rest" if k == 0 else ""))
     lines = ["| measure | value | target |", "|---|---|---|"] + [f"| {a} | {b} | {c} |" for a, b, c in rows]
     return "\n".join(lines) + f"\n\nScene size {r['size']}, device {r['device']}; stages seen while dragging: " \
                               f"{', '.join(r['stages']) or 'none'}.\n"
@@ -196,10 +236,14 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=RESULTS)
     ap.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
                     help="also save the page at rest after the drag (docs/explore.md's picture)")
+    ap.add_argument("--rest-batches", type=int, default=0, metavar="K",
+                    help="a path-traced scene (--set shading.integrator=path): time the first K batches of "
+                         "paths after each change instead of its final picture")
     ap.add_argument("--keep-caches", action="store_true",
                     help="skip the start with empty caches: one start, with the caches as they are")
     a = ap.parse_args(argv)
-    r = run(a.changes, a.drag_seconds, a.overrides, a.device, a.screenshot, cold=not a.keep_caches)
+    r = run(a.changes, a.drag_seconds, a.overrides, a.device, a.screenshot, cold=not a.keep_caches,
+            rest_batches=a.rest_batches)
     text = table(r, a.changes, a.drag_seconds)
     print(text)
     scene = f" with {' '.join(a.overrides)}" if a.overrides else " (the default scene)"
@@ -207,6 +251,7 @@ def main(argv=None) -> int:
                f"\n## {utc_now()}, commit {git_commit()}{scene}\n\n"
                f"`python benchmarks/speed/explore_latency.py --changes {a.changes} --drag-seconds {a.drag_seconds:g}"
                f"{' --keep-caches' if a.keep_caches else ''}"
+               f"{f' --rest-batches {a.rest_batches}' if a.rest_batches else ''}"
                f"{''.join(' --set ' + o for o in a.overrides)}`\n\n{text}")
     return 0
 

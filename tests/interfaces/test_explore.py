@@ -640,9 +640,9 @@ def test_the_renderer_refuses_what_is_no_device(device):
 def test_path_batches_double_the_total_up_to_the_samples():
     from pyjulia4d.app.explore.loop import path_batches
     assert path_batches(1) == [(0, 1)]
-    assert path_batches(4) == [(0, 4)]
-    assert path_batches(16) == [(0, 4), (4, 4), (8, 8)]
-    assert path_batches(100) == [(0, 4), (4, 4), (8, 8), (16, 16), (32, 32), (64, 36)]
+    assert path_batches(2) == [(0, 2)]
+    assert path_batches(16) == [(0, 2), (2, 2), (4, 4), (8, 8)]
+    assert path_batches(100) == [(0, 2), (2, 2), (4, 4), (8, 8), (16, 16), (32, 32), (64, 36)]
     for s in (1, 5, 37, 256, 1000):
         b = path_batches(s)
         assert sum(c for _, c in b) == s and all(f == sum(c for _, c in b[:k]) for k, (f, _) in enumerate(b))
@@ -677,9 +677,11 @@ def test_a_path_traced_picture_refines_at_rest_to_the_render_of_the_scene(tmp_pa
         got.wait(lambda: any(m["stage"] == "final" for m, _ in got.pictures), 120)
         frames = [m for m, _ in got.pictures if m["generation"] == s.loop.generation]
         paths = [int(m["facts"]["paths"]) for m in frames if "paths" in m["facts"]]
-        assert paths == [4, 8, 16]
+        assert paths == [2, 4, 8, 16]
         noise = [float(m["facts"]["noise"].split()[1].rstrip(",")) for m in frames if "noise" in m["facts"]]
-        assert noise[-1] < noise[0]
+        # from the second batch on: the standard error a 2-path batch states is itself rough
+        # (one degree of freedom a channel), its p50 often below the truth
+        assert noise[-1] < noise[1]
         s.handle({"op": "focus", "x": 0.5, "y": 0.5})
         assert s.scene.camera.focus != "auto" and 0 < s.scene.camera.focus < 10
         assert not got.of("error"), got.of("error")

@@ -58,7 +58,7 @@ class Picture:
 def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str, Scene]]:
     """The renders one request makes: a preview of about ``preview_pixels`` pixels; at rest
     (``moving`` false) then half size and the full size, and the full size again with
-    image.samples where that is above 1."""
+    image.samples where that is above 1 (a path-traced scene: the preview, then its paths)."""
     w, h, s = scene.image.width, scene.image.height, scene.image.samples
     full = w * h
     k = min(1.0, math.sqrt(max(MIN_PREVIEW_PIXELS, preview_pixels) / full))
@@ -73,7 +73,9 @@ def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str,
     out = []
     if k < 1.0:
         out.append(("preview", sized(k)))
-    if 0.25 * full > 1.5 * k * k * full:   # a half-size stage well above the preview's size
+    # a half-size stage well above the preview's size; not before a path-traced picture's
+    # first batch of paths, which replaces it about a second later
+    if 0.25 * full > 1.5 * k * k * full and scene.shading.integrator == "direct":
         out.append(("refine", sized(0.5)))
     if (s > 1 or scene.image.adaptive) and scene.shading.integrator == "direct":
         out.append(("refine", sized(1.0)))
@@ -81,12 +83,16 @@ def stages(scene: Scene, moving: bool, preview_pixels: float) -> list[tuple[str,
     return out
 
 
-PATH_FIRST_BATCH = 4
+# the first batch of paths at rest: 2 per pixel, denoised, looked clean on the default scene
+# and came 1.3 s after a change at 640x480 on the 2-core CPU (4 paths took 2.1 s:
+# benchmarks/speed/explore_latency.py --rest-batches)
+PATH_FIRST_BATCH = 2
 
 
 def path_batches(samples: int) -> list[tuple[int, int]]:
-    """(first sample, count) of each batch a path-traced picture at rest is refined in: 4
-    samples, then as many again as there are (the total doubling), up to ``samples``."""
+    """(first sample, count) of each batch a path-traced picture at rest is refined in:
+    PATH_FIRST_BATCH samples, then as many again as there are (the total doubling), up to
+    ``samples``."""
     out, first, count = [], 0, PATH_FIRST_BATCH
     while first < samples:
         count = min(count, samples - first)
