@@ -79,7 +79,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="frame files, one run of # for the frame number: frames/julia_####.png or .exr "
                         "(default: <scene stem>_####.png)")
     a.add_argument("--frames", metavar="A:B", help="render frames A to B (inclusive; default all)")
-    a.add_argument("--video", metavar="OUT", help="also encode the frames into OUT.mp4 or OUT.webm")
+    a.add_argument("--video", metavar="OUT", help="also encode the frames into OUT.mp4, OUT.webm or an animated OUT.gif")
     a.add_argument("--width", metavar="W", help="frame width (same as --set image.width=W; not both)")
     a.add_argument("--height", metavar="H", help="frame height (same as --set image.height=H; not both)")
     a.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",

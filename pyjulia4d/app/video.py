@@ -1,5 +1,7 @@
 """Video from a sequence of frames: MP4 (H.264) or WebM (VP9), through imageio-ffmpeg,
-whose wheel ships its own ffmpeg (no system ffmpeg).
+whose wheel ships its own ffmpeg (no system ffmpeg), or an animated GIF through Pillow
+(no extra needed; each frame's own palette of 256 colours, Floyd-Steinberg dithered, looping
+forever; GIF times frames in hundredths of a second, so 24 fps plays at 25).
 
 PNG frames are taken as written (sRGB, 8 bits); EXR frames hold linear light and are
 encoded like a PNG is (colour clipped to [0, 1], sRGB-encoded, rounded: output.write_png).
@@ -23,6 +25,7 @@ CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
 # H.264's constant rate factor and VP9's constant quality (lower is better; both about
 # visually lossless for renders): smooth gradients of a render band at the defaults.
 QUALITY = {".mp4": ["-crf", "18", "-preset", "medium"], ".webm": ["-crf", "24", "-b:v", "0"]}
+FORMATS = (*CODECS, ".gif")
 
 
 def have_ffmpeg() -> bool:
@@ -31,7 +34,7 @@ def have_ffmpeg() -> bool:
 
 
 def check_video_path(path: str | os.PathLike) -> Path:
-    """Fail before rendering if ``path`` cannot take the video: .mp4 or .webm, in an
+    """Fail before rendering if ``path`` cannot take the video: .mp4, .webm or .gif, in an
     existing, writable directory."""
     raw = path_text(path, lambda got: OutputError(f"video path: expected {got}"))
     shown = shown_path(raw)
@@ -39,15 +42,15 @@ def check_video_path(path: str | os.PathLike) -> Path:
     if not raw or raw.endswith(("/", os.sep)):
         raise OutputError(f"{shown}: not a file name")
     ext = p.suffix.lower()
-    if ext not in CODECS:
+    if ext not in FORMATS:
         got = quoted_path(ext) if ext else "'(none)'"
-        raise OutputError(f"{shown}: unsupported video format {got} (use .mp4 or .webm)")
+        raise OutputError(f"{shown}: unsupported video format {got} (use .mp4, .webm or .gif)")
     check_directory(shown, p.parent)
     if p.is_dir():
         raise OutputError(f"{shown}: is a directory")
     if not os.access(p.parent, os.W_OK | os.X_OK):
         raise OutputError(f"{shown}: cannot create a file in {quoted_path(p.parent)}")
-    if not have_ffmpeg():
+    if ext in CODECS and not have_ffmpeg():
         raise OutputError(f"{shown}: video needs imageio-ffmpeg, which is not installed: pip install "
                           f"'pyjulia4d[video]'")
     return p
@@ -97,16 +100,18 @@ def _even(frame: np.ndarray) -> np.ndarray:
 
 
 def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: float) -> int:
-    """Encode ``frames`` ((H, W, 3) uint8, one size) at ``fps`` into ``path`` (.mp4 or
-    .webm), atomically; returns the number of frames written."""
-    import imageio_ffmpeg
-
+    """Encode ``frames`` ((H, W, 3) uint8, one size) at ``fps`` into ``path`` (.mp4, .webm
+    or .gif), atomically; returns the number of frames written."""
     p = check_video_path(path)
     ext = p.suffix.lower()
     it: Iterator[np.ndarray] = iter(frames)
     first = next(it, None)
     if first is None:
         raise OutputError(f"{shown_path(str(p))}: no frames to encode")
+    if ext == ".gif":
+        return _write_gif(p, first, it, fps)
+    import imageio_ffmpeg
+
     first = _even(first)
     h, w = first.shape[:2]
     n = 0
@@ -125,6 +130,32 @@ def write_video(path: str | os.PathLike, frames: Iterable[np.ndarray], fps: floa
         finally:
             writer.close()
     return n
+
+
+def _write_gif(p: Path, first: np.ndarray, rest: Iterator[np.ndarray], fps: float) -> int:
+    """An animated GIF of the frames through Pillow, looping forever: each frame quantised to
+    its own 256 colours (median cut, Floyd-Steinberg dithering), shown for 1 / fps rounded to
+    GIF's hundredths of a second (at least 2: browsers slow faster frames down to 10 fps)."""
+    from PIL import Image
+
+    count = [0]
+
+    def quantised():
+        for frame in (first, *rest):
+            if frame.shape != first.shape:
+                raise OutputError(f"{shown_path(str(p))}: frame {count[0]} is {frame.shape[1]}x{frame.shape[0]}, "
+                                  f"the first {first.shape[1]}x{first.shape[0]}: a video's frames share one size")
+            count[0] += 1
+            yield Image.fromarray(np.ascontiguousarray(frame[..., :3]), "RGB").quantize(
+                256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.FLOYDSTEINBERG)
+
+    hundredths = max(2, round(100.0 / fps))
+    with output_errors(p), atomic_write(p) as tmp:
+        frames = quantised()
+        head = next(frames)
+        head.save(tmp, format="GIF", save_all=True, append_images=frames, duration=10 * hundredths, loop=0,
+                  disposal=1, optimize=False)
+    return count[0]
 
 
 def video_from_files(path: str | os.PathLike, files: Iterable[str | os.PathLike], fps: float) -> int:

@@ -159,7 +159,7 @@ BAD_ARGS = {
     "no-hash": (["-o", "out.png"], "the file name needs one run of '#'"),
     "two-runs": (["-o", "a_##_##.png"], "found 2"),
     "bad-ext": (["-o", "f_##.jpg"], "unsupported output format '.jpg'"),
-    "video-ext": (["--video", "out.avi"], "out.avi: unsupported video format '.avi' (use .mp4 or .webm)"),
+    "video-ext": (["--video", "out.avi"], "out.avi: unsupported video format '.avi' (use .mp4, .webm or .gif)"),
     "video-dir": (["--video", "nowhere/out.mp4"], "directory 'nowhere' does not exist"),
     "workers": (["--workers", "-1"], "--workers: must be in [0, 1024], got -1"),
     "workers-text": (["--workers", "two"], "--workers: expected a whole number of workers"),
@@ -335,6 +335,29 @@ def test_video_plays_back_with_the_frames(tmp_path, capsys, ext):
         assert np.abs(frame.astype(float) - src).mean() < 4.0  # lossy, but these frames
     # consecutive frames differ (the set morphs) more than the codec's error
     assert np.abs(got[0].astype(float) - got[5].astype(float)).mean() > 10.0
+    assert not any(p.name.startswith(".") for p in tmp_path.iterdir())
+
+
+def test_a_gif_loops_the_frames(tmp_path, capsys):
+    """--video OUT.gif: an animated GIF through Pillow, each frame the rendered one within its
+    own palette's dithering, at animation.fps in GIF's hundredths of a second, looping."""
+    from PIL import Image, ImageSequence
+
+    scene = morph_file(tmp_path, frames=6, w=48, h=36)
+    pattern = str(tmp_path / "f" / "m_##.png")
+    gif = tmp_path / "m.gif"
+    assert cli.main(["animate", str(scene), "-o", pattern, "--video", str(gif), "--workers", "0"]) == 0
+    assert f"video {gif} (6 frames at 12 fps)" in capsys.readouterr().out
+    with Image.open(gif) as im:
+        assert im.format == "GIF" and im.n_frames == 6 and im.info.get("loop") == 0
+        frames = [np.asarray(f.convert("RGB")).astype(float) for f in ImageSequence.Iterator(im)]
+        durations = [f.info["duration"] for f in ImageSequence.Iterator(im)]
+    assert durations == [80] * 6   # 1 / 12 s in hundredths: 8
+    for k, frame in enumerate(frames):
+        src = _pixels(Path(pattern.replace("##", f"{k:02d}")))[..., :3].astype(float)
+        assert frame.shape == src.shape
+        assert np.abs(frame - src).mean() < 4.0   # 256 colours, dithered
+    assert np.abs(frames[0] - frames[5]).mean() > 10.0
     assert not any(p.name.startswith(".") for p in tmp_path.iterdir())
 
 
