@@ -7,6 +7,7 @@ has is scene/model.py's CHECKS.
 """
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
@@ -77,6 +78,46 @@ def show(v: Any, limit: int = 60) -> str:
 def show_key(key: str) -> str:
     """A user-given key or path as it goes into a message: itself when plain, else repr."""
     return key if key and key.isprintable() and len(key) <= 80 else show(key, 80)
+
+
+def closest(got: Any, options) -> str | None:
+    """The option ``got`` was most likely meant as: the one it begins (3 letters at least),
+    else the closest by difflib's ratio (at least 0.6), case ignored; None if none is."""
+    if not isinstance(got, str) or not got.isprintable() or len(got) > 80:
+        return None
+    by_lower = {o.lower(): o for o in options}
+    g = got.lower()
+    begun = [o for low, o in by_lower.items() if len(g) >= 3 and low.startswith(g)]
+    if len(begun) == 1:
+        return begun[0]
+    near = difflib.get_close_matches(g, list(by_lower), n=1, cutoff=0.6)
+    return by_lower[near[0]] if near else None
+
+
+def did_you_mean(got: Any, options) -> str:
+    """"; did you mean 'x'?" for the option closest to ``got`` (closest), else ""."""
+    near = closest(got, options)
+    return f"; did you mean {near!r}?" if near is not None else ""
+
+
+def unknown_key(dotted: str, checks: Mapping) -> SceneError:
+    """The error for a key no section has, with the closest known one (``checks``: section ->
+    key -> check): the same key in another section, else the closest key of its own section,
+    else the key in the closest section."""
+    section, dot, key = str(dotted).partition(".")
+    near = None
+    if not dot:
+        near = closest(section, list(checks))
+    elif section in checks:
+        elsewhere = [f"{sec}.{key}" for sec, keys in checks.items() if key in keys]
+        k = closest(key, list(checks[section]))
+        near = elsewhere[0] if elsewhere else (f"{section}.{k}" if k is not None else None)
+    else:
+        sec = closest(section, list(checks))
+        if sec is not None:
+            k = key if key in checks[sec] else closest(key, list(checks[sec]))
+            near = f"{sec}.{k}" if k is not None else sec
+    return SceneError(show_key(str(dotted)), "unknown key" + (f"; did you mean {near!r}?" if near and near != dotted else ""))
 
 
 def scalar(text: str) -> Any:
@@ -165,14 +206,19 @@ class Choice:
 
     verbatim = True  # an override's VALUE is the word itself
 
-    def __init__(self, *options: str) -> None:
+    def __init__(self, *options: str, fold_case: bool = False) -> None:
         self.options = options
+        self.fold_case = fold_case   # names whose case is no part of them (the colour maps': viridis, Spectral)
         quoted = [f'"{o}"' for o in options]
         self.valid = quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
 
     def __call__(self, key: str, v: Any) -> str:
+        if self.fold_case and isinstance(v, str) and v not in self.options:
+            same = [o for o in self.options if o.lower() == v.lower()]
+            v = same[0] if len(same) == 1 else v
         if not isinstance(v, str) or v not in self.options:
-            raise SceneError(key, f"expected one of {', '.join(map(repr, self.options))}, got {show(v)}")
+            raise SceneError(key, f"expected one of {', '.join(map(repr, self.options))}, got {show(v)}"
+                                  f"{did_you_mean(v, self.options)}")
         return v
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from pyjulia4d.geometry.vec4 import Degenerate, orthonormalise, unit_or_none
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.ranges import CHECKS
-from pyjulia4d.scene.checks import SceneError, Integer, OrWord, Real, Vector, show, show_key
+from pyjulia4d.scene.checks import Integer, OrWord, Real, SceneError, Vector, did_you_mean, show, show_key
 from pyjulia4d.scene.text import override_key, override_list, read_scene_table
 
 
@@ -244,7 +244,8 @@ def _tracks(keyframes: Any, dropped: set[str]) -> tuple[list[Track], int]:
             check = CHECKS.get(section, {}).get(key)
             name = f"{where}.{show_key(dotted)}"
             if check is None:
-                raise SceneError(name, "unknown key")
+                raise SceneError(name, "unknown key" + did_you_mean(dotted, [f"{a}.{b}" for a, ks in CHECKS.items()
+                                                                              for b in ks]))
             if dotted in FIXED_KEYS:
                 raise SceneError(name, "cannot change between frames (every frame of a sequence has "
                                        "one size); set it in [image]")

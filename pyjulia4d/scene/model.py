@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Iterable, Literal, Mapping, Union
 
 from pyjulia4d.scene import rules
-from pyjulia4d.scene.checks import SceneError, show, show_key
+from pyjulia4d.scene.checks import SceneError, show, show_key, unknown_key
 from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, auto_values, preset_values
 from pyjulia4d.scene.ranges import CHECKS, Light, Vec3, Vec4, check_section
 from pyjulia4d.scene.text import override_list, parse_override, read_scene_table, toml_value
@@ -291,12 +291,12 @@ class Scene:
                 raise SceneError(section, "a keyframed scene: render its frames with "
                                           "'pyjulia4d animate' (or --frames N:N for one)")
             if section not in CHECKS:
-                raise SceneError(show_key(str(section)), "unknown key")
+                raise unknown_key(str(section), CHECKS)
             if not isinstance(table, Mapping):
                 raise SceneError(section, f"expected a table, got {show(table)}")
             for key, value in table.items():
                 if key not in CHECKS[section]:
-                    raise SceneError(show_key(f"{section}.{key}"), "unknown key")
+                    raise unknown_key(f"{section}.{key}", CHECKS)
                 raw[section][key] = value
         # A quality preset fills the march keys the same source does not set itself;
         # a later source (an override) wins over an earlier one.
@@ -347,7 +347,7 @@ class Scene:
         for dotted, value in changes.items():
             section, _, key = dotted.partition(".")
             if section not in CHECKS or key not in CHECKS[section]:
-                raise SceneError(dotted, "unknown key")
+                raise unknown_key(dotted, CHECKS)
             data[section][key] = value
         return Scene.from_dict(data)
 

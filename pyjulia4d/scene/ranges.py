@@ -124,7 +124,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "ao": Real(0.0, 1.0),
         "ao_distance": Real(1e-4, 10.0),
         "coloring": Choice("flat", "iteration", "trap", "w"),
-        "colormap": Choice(*COLORMAPS),
+        "colormap": Choice(*COLORMAPS, fold_case=True),
         "trap": Vector((3, 4), -COORD, COORD),
         "fog": Real(0.0, 100.0),
         "sky": Vector((3,), 0.0, 1e3),

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from pyjulia4d.files import path_text
-from pyjulia4d.scene.checks import SceneError, scalar, show, show_key
+from pyjulia4d.scene.checks import SceneError, scalar, show, show_key, unknown_key
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -51,7 +51,7 @@ def parse_override(text: str, checks: Mapping[str, Mapping[str, Any]]) -> tuple[
         raise SceneError("--set", f"missing key in {show(text)}, expected SECTION.KEY=VALUE")
     section, _, key = dotted.partition(".")
     if section not in checks or key not in checks[section]:
-        raise SceneError(show_key(dotted), "unknown key")
+        raise unknown_key(dotted, checks)
     s = raw.strip()
     if checks[section][key].verbatim:
         return section, key, s

@@ -101,7 +101,9 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
     if kind == "Choice":
         opts = check.options
         vals += [rng.choice(opts).upper(), rng.choice(opts)[:-1], rng.choice(opts) + "x", "1", "0"]
-        return [v for v in vals if v.strip() not in opts]
+        # a name whose case is no part of it (the colour maps') is valid in any case
+        folded = {o.lower() for o in opts} if check.fold_case else set()
+        return [v for v in vals if v.strip() not in opts and v.strip().lower() not in folded]
     if kind == "Lights":   # "" and "[]" are valid (no lights)
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["position", "position 1,2", "direction 0,0,0", "position 1,2,3 direction 1,0,0",

@@ -361,3 +361,28 @@ def test_render_an_image_whose_scene_is_bad(tmp_path: Path, capsys, monkeypatch,
     err = capsys.readouterr().err
     assert err.startswith(f"pyjulia4d: error: {message}") and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["src.png"]
+
+
+@pytest.mark.parametrize("build, hint", [
+    (lambda: Scene.from_dict({"shading": {"colour": [1, 0, 0]}}), "; did you mean 'shading.color'?"),
+    (lambda: Scene.default().with_overrides(["camra.fov=30"]), "; did you mean 'camera.fov'?"),
+    (lambda: Scene.default().with_overrides(["shading.fov=30"]), "; did you mean 'camera.fov'?"),
+    (lambda: Scene.default().with_overrides(["march.z_res=300"]), "; did you mean 'march.z_resolution'?"),
+    (lambda: Scene.from_dict({"fractal": {"algebra": "quaternian"}}), "; did you mean 'quaternion'?"),
+    (lambda: Scene.from_dict({"shading": {"coloring": "Iteration"}}), "; did you mean 'iteration'?"),
+])
+def test_an_unknown_key_or_word_names_the_one_meant(build, hint) -> None:
+    with pytest.raises(SceneError) as e:
+        build()
+    assert str(e.value).endswith(hint) and "\n" not in str(e.value)
+
+
+def test_nothing_is_suggested_where_nothing_is_close() -> None:
+    with pytest.raises(SceneError) as e:
+        Scene.default().with_overrides(["march.qqqqqq=1"])
+    assert str(e.value) == "march.qqqqqq: unknown key"
+
+
+def test_colour_map_names_take_any_case() -> None:
+    assert Scene.from_dict({"shading": {"colormap": "SPECTRAL"}}).shading.colormap == "Spectral"
+    assert Scene.default().with_overrides(["shading.colormap=Viridis"]).shading.colormap == "viridis"
