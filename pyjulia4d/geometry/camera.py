@@ -87,14 +87,31 @@ def camera_frame(scene: Scene) -> Frame:
     return Frame(pos, fwd, right, up, math.tan(math.radians(cam.fov) / 2.0))
 
 
-def light_position(scene: Scene) -> np.ndarray | None:
+def light_to_world(scene: Scene, frame: Frame | None, p, direction: bool = False) -> np.ndarray:
+    """A light's position or direction in world space: given in the scene's coordinates
+    (shading.light_space = "scene", to_world), or in the camera's (``frame``: x right, y up,
+    z towards the viewer, w along the camera's fourth axis; a position from the eye)."""
+    if scene.shading.light_space != "camera":
+        return to_world(scene, p, direction)
+    fr = frame if frame is not None else camera_frame(scene)
+    q = np.zeros(4)
+    q[:len(p)] = np.asarray(p, float)
+    fourth = cross4(fr.right, fr.up, fr.forward)
+    fourth /= np.linalg.norm(fourth)
+    if fourth @ to_world(scene, unit(scene.camera.limbo), direction=True) < 0:
+        fourth = -fourth
+    v = q[0] * fr.right + q[1] * fr.up - q[2] * fr.forward + q[3] * fourth
+    return v if direction else fr.position + v
+
+
+def light_position(scene: Scene, frame: Frame | None = None) -> np.ndarray | None:
     """World position of the positioned light, or None for the light at the eye."""
     if isinstance(scene.shading.light, str):
         return None
-    return to_world(scene, scene.shading.light)
+    return light_to_world(scene, frame, scene.shading.light)
 
 
-def extra_lights(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+def extra_lights(scene: Scene, frame: Frame | None = None) -> tuple[np.ndarray, np.ndarray]:
     """shading.lights for the kernels (shade/shade.cl, shade/light.cl): (geo, rgb), geo[j]
     the world position, or the unit world direction towards a distant light; rgb[j] its
     colour times intensity, and w = 1 for a distant light.  One inert row when there are none
@@ -104,9 +121,9 @@ def extra_lights(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     rgb = np.zeros((max(1, len(lights)), 4))
     for j, light in enumerate(lights):
         if light.position is not None:
-            geo[j] = to_world(scene, light.position)
+            geo[j] = light_to_world(scene, frame, light.position)
         else:
-            d = to_world(scene, light.direction, direction=True)
+            d = light_to_world(scene, frame, light.direction, direction=True)
             geo[j] = d / np.linalg.norm(d)
             rgb[j, 3] = 1.0
         rgb[j, :3] = np.asarray(light.color) * light.intensity

@@ -98,9 +98,9 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
     """The argument records of every kernel of ``scene`` (Plan's march, clip, normals,
     light_args, shade)."""
     sh = scene.shading
-    lp = light_position(scene)
+    lp = light_position(scene, frame)
     light = light_parameters(scene, radius)
-    geo, rgb = extra_lights(scene)
+    geo, rgb = extra_lights(scene, frame)
     point_light = not isinstance(sh.light, str)
     return dict(
         march=march_args(scene, radius),

@@ -141,6 +141,7 @@ class Shading:
     light: Union[Vec4, Literal["eye"]] = (-2.0, 5.0, -4.0, 0.0)
     light_color: Vec3 = (1.0, 1.0, 1.0)
     light_radius: float = 0.0      # path: the key light's sphere (scene units): soft shadows; 0 a point
+    light_space: str = "scene"     # light and lights' coordinates: "scene" (fixed in it) or "camera" (moving with it)
     shadow: str = "soft"           # "none" | "hard" | "soft" (shade/light.cl)
     shadow_softness: float = 16.0  # k of the penumbra min(k d / t): larger is sharper
     ao: float = 0.6                # ambient occlusion strength, 0 = off

@@ -119,6 +119,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "light": OrWord("eye", Vector((3, 4), -COORD, COORD)),
         "light_color": Vector((3,), 0.0, 1e3),
         "light_radius": Real(0.0, 1e3),
+        "light_space": Choice("scene", "camera"),
         "shadow": Choice("none", "hard", "soft"),
         "shadow_softness": Real(1.0, 1e3),
         "ao": Real(0.0, 1.0),

@@ -184,3 +184,28 @@ def test_the_march_is_compiled_once_at_its_width():
     assert "CONE_START" not in p.config.defines and "SPECULAR" not in p.march_config.defines
     assert kernel_config.shade_config(s.with_overrides(["march.quality=final"])) == p.config
     assert "normals/gradient" in kernel_config.shade_config(s.with_overrides(["normals.method=gradient"])).pieces
+
+
+def test_lights_in_camera_space_move_with_the_camera():
+    """shading.light_space = "camera": a light at [x, y, z] is x along the picture's right,
+    y up and z towards the viewer from the eye (a direction likewise), so it keeps its place
+    in the picture as the camera moves; rendered, it is the scene-space light at the world
+    point it names, to the bit."""
+    from pyjulia4d.geometry.camera import camera_frame, light_position
+
+    keys = ["shading.light_space=camera", "shading.light=1,2,3", "shading.lights=direction 0,0,1",
+            "image.width=32", "image.height=24"]
+    for pos in ("1.8,1.6,-2.2,0", "-2.5,0.5,1.5,0.3"):
+        s = Scene.default().with_overrides(keys + [f"camera.position={pos}"])
+        f = camera_frame(s)
+        v = light_position(s, f) - f.position
+        assert np.allclose([v @ f.right, v @ f.up, -(v @ f.forward)], [1, 2, 3])
+        plan = make_plan(s, device(), 1)
+        assert np.allclose(plan.shade.lights_geo[0], -f.forward)
+    s = Scene.default().with_overrides(keys[:3] + keys[3:])
+    world = light_position(s, camera_frame(s))
+    same = s.with_overrides(["shading.light_space=scene", "shading.light=" + ",".join(map(repr, map(float, world))),
+                             "shading.lights=direction " + ",".join(map(repr, map(float, -camera_frame(s).forward)))])
+    a, b = render(s), render(same)
+    assert np.array_equal(a.color, b.color)
+    assert not np.array_equal(a.color, render(s.with_overrides(["shading.light_space=scene"])).color)
