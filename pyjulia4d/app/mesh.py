@@ -53,6 +53,8 @@ class MeshResult:
     # thinnest_wall's (thickness, where (x, y, z)), or (bound, None): no wall thinner than bound;
     # None where not asked for
     wall: tuple | None = None
+    moved: float = 0.0           # the farthest smoothing moved a vertex off its bracket (slice units)
+    decimated: bool = False      # vertices placed by decimation: no longer on the brackets
 
     @property
     def voxel_volume(self) -> float:
@@ -69,9 +71,15 @@ class MeshResult:
             wall = (f"; no wall thinner than {thick:.3g}" if where is None else
                     f"; thinnest wall about {thick:.3g} (to within 3 grid spacings, {3 * h:.2g}) at "
                     f"({where[0]:.4g}, {where[1]:.4g}, {where[2]:.4g})")
-        return (f"{len(m.faces)} triangles, {len(m.vertices)} vertices, {vol}, vertices within "
-                f"{self.widest_bracket:.2g} of the surface, grid {self.plan.n}^3 at spacing "
-                f"{self.plan.spacing:.4g}{wall}")
+        if self.decimated:
+            where = "vertices placed by decimation (their distance from the surface is not bounded)"
+        elif self.moved > 0:
+            where = (f"vertices within {self.widest_bracket + self.moved:.2g} of the surface (bracketed to "
+                     f"{self.widest_bracket:.2g}, then moved up to {self.moved:.2g} by smoothing)")
+        else:
+            where = f"vertices within {self.widest_bracket:.2g} of the surface"
+        return (f"{len(m.faces)} triangles, {len(m.vertices)} vertices, {vol}, {where}, grid {self.plan.n}^3 "
+                f"at spacing {self.plan.spacing:.4g}{wall}")
 
 
 def estimate_seconds(plan: MeshPlan) -> float:
@@ -217,8 +225,11 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
     mesh = trimesh.Trimesh(xyz, np.asarray(grid.faces), process=False)
     if mesh.is_watertight and mesh.volume < 0:
         mesh.invert()
+    moved = 0.0
     if smooth:
+        before = np.array(mesh.vertices)
         trimesh.smoothing.filter_taubin(mesh, iterations=smooth)
+        moved = float(np.max(np.linalg.norm(np.asarray(mesh.vertices) - before, axis=1))) if len(before) else 0.0
     if decimate < 1.0:   # new vertices: coloured at themselves (within h of the surface)
         keep = round(len(mesh.faces) * decimate)
         if keep < 4:   # a tetrahedron's: fewer closes nothing (1e-300 wrote an empty file)
@@ -235,7 +246,7 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
         wall = thinnest_wall(mask, plan)
         seconds["walls"] = time.perf_counter() - t
     seconds["total"] = time.perf_counter() - t0
-    return MeshResult(mesh, plan, count, widest, seconds, wall)
+    return MeshResult(mesh, plan, count, widest, seconds, wall, moved, decimate < 1.0)
 
 
 def _executor(plan: MeshPlan, device: Any, executor: str):

@@ -146,6 +146,13 @@ def test_smoothing_keeps_it_closed_and_its_volume():
     r1 = mesh_mod.build_mesh(SCENES["default"], 40, harness.device(), smooth=10)
     assert r1.mesh.is_watertight and len(r1.mesh.faces) == len(r0.mesh.faces)
     assert abs(r1.mesh.volume - r0.mesh.volume) < 0.05 * r0.mesh.volume
+    # what the closing line says of the vertices stays true: smoothing moved them off their
+    # brackets by the largest move, and it says so
+    moved = float(np.max(np.linalg.norm(np.asarray(r1.mesh.vertices) - np.asarray(r0.mesh.vertices), axis=1)))
+    assert r1.moved == pytest.approx(moved, rel=1e-9) and moved > 10 * r0.widest_bracket
+    assert f"vertices within {r0.widest_bracket:.2g} of the surface," in r0.summary()
+    assert f"moved up to {moved:.2g} by smoothing" in r1.summary()
+    assert f"vertices within {r1.widest_bracket + moved:.2g} of the surface" in r1.summary()
 
 
 @pytest.mark.parametrize("args,says", [
