@@ -102,6 +102,9 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--decimate", metavar="SHARE", default="1",
                    help="keep this share of the triangles, in (0, 1] (default 1: all; quadric decimation may "
                         "open the mesh: the closing line says whether it is watertight)")
+    m.add_argument("--size", metavar="MM", default=None,
+                   help="scale the mesh so its longest side prints at MM millimetres (STL, PLY and OBJ in "
+                        "millimetres, glTF in metres; default: scene units)")
     m.add_argument("--walls", action="store_true",
                    help="also report the thinnest wall, for printing (grids up to 1024 a side)")
     m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
@@ -294,12 +297,14 @@ def _real(text: str) -> float | str:
 
 def _mesh(args: argparse.Namespace) -> int:
     """mesh: SCENE -> OUT.stl|ply|obj|glb (app/mesh.py); every argument checked before the device."""
-    from pyjulia4d.app.mesh import build_mesh, check_decimate, check_mesh_path, check_smooth, check_walls, write_mesh
+    from pyjulia4d.app.mesh import (build_mesh, check_decimate, check_mesh_path, check_size, check_smooth, check_walls,
+                                    write_mesh)
     from pyjulia4d.pipeline.mesh_plan import check_resolution, make_mesh_plan
 
     resolution = check_resolution(_whole(args.resolution))
     smooth = check_smooth(_whole(args.smooth))
     decimate = check_decimate(_real(args.decimate))
+    size = check_size(None if args.size is None else _real(args.size))
     scene = _scene_of(args.scene, args.overrides)
     make_mesh_plan(scene, resolution)   # a slice outside the set's ball: refused before the device
     check_walls(args.walls, resolution)
@@ -308,8 +313,8 @@ def _mesh(args: argparse.Namespace) -> int:
     device = select_device(args.device)
     result = build_mesh(scene, resolution, device, smooth, args.force, progress=True,
                         warn=lambda text: _say(f"pyjulia4d: warning: {text}"), decimate=decimate, walls=args.walls)
-    write_mesh(out, result)
-    print(f"wrote {out} in {result.seconds['total']:.2f} s: {result.summary()}")
+    scaled = write_mesh(out, result, size)
+    print(f"wrote {out} in {result.seconds['total']:.2f} s: {result.summary()}{scaled}")
     return 0
 
 

@@ -109,6 +109,20 @@ def check_smooth(value: Any) -> int:
     return value
 
 
+MAX_SIZE_MM = 1e5   # a 100 m print is no print
+
+
+def check_size(value: Any) -> float | None:
+    """--size: the printed length of the mesh's longest side in millimetres, (0, MAX_SIZE_MM];
+    None keeps scene units."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= MAX_SIZE_MM:
+        raise SceneError("--size", f"expected the longest side in millimetres, in (0, {MAX_SIZE_MM:g}], "
+                                   f"got {show(value, 80)}")
+    return float(value)
+
+
 def check_decimate(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= 1.0:
         raise SceneError("--decimate", f"expected the share of triangles to keep, in (0, 1], got {show(value, 80)}")
@@ -298,16 +312,37 @@ def vertex_colours(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.nda
     return np.concatenate([rgb, np.full((len(world), 1), 255.0)], axis=1).astype(np.uint8)
 
 
-def write_mesh(path: str | Path, result: MeshResult) -> None:
+# the length a file's unit stands for: STL, PLY and OBJ have none and slicers read millimetres;
+# glTF's is the metre
+UNIT_MM = {"stl": 1.0, "ply": 1.0, "obj": 1.0, "glb": 1000.0}
+
+
+def write_mesh(path: str | Path, result: MeshResult, size_mm: float | None = None) -> str:
     """The mesh in the format of ``path``'s suffix, atomically (files.atomic_write); the path
-    checked first (check_mesh_path)."""
+    checked first (check_mesh_path).  ``size_mm``: scaled so that its longest side prints at
+    that many millimetres (in the file's unit: millimetres, metres for .glb).  Returns what
+    the scale is, for the closing line ("" in scene units)."""
     from pyjulia4d.app.output import OutputError, write_file
 
     path = check_mesh_path(path)
     if not isinstance(result, MeshResult):
         raise OutputError(f"{path}: expected a MeshResult to write, got {type(result).__name__}")
+    size_mm = check_size(size_mm)
     kind = FORMATS[path.suffix.lower()]
+    mesh, said = result.mesh, ""
+    if size_mm is not None:
+        longest = float(np.max(mesh.extents)) if len(mesh.vertices) else 0.0
+        if not longest > 0:
+            raise SceneError("--size", "the mesh has no extent to scale")
+        mm_per_unit = size_mm / longest
+        mesh = mesh.copy()
+        mesh.apply_scale(mm_per_unit / UNIT_MM[kind])
+        said = (f"; scaled to {size_mm:g} mm along its longest side (1 scene unit = {mm_per_unit:.4g} mm"
+                f"{', in metres: glTF' if kind == 'glb' else ''})")
+        if result.wall is not None and result.wall[1] is not None:
+            said += f", thinnest wall about {result.wall[0] * mm_per_unit:.3g} mm"
     # vertex normals where the format has them (trimesh writes them only when asked)
     extra = {"ply": {"vertex_normal": True}, "obj": {"include_normals": True},
              "glb": {"include_normals": True}}.get(kind, {})
-    write_file(path, result.mesh.export(file_type=kind, **extra))
+    write_file(path, mesh.export(file_type=kind, **extra))
+    return said

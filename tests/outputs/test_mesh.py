@@ -162,6 +162,9 @@ def test_smoothing_keeps_it_closed_and_its_volume():
     (["--smooth", "1001"], "--smooth: expected a whole number of smoothing passes"),
     (["--decimate", "0"], "--decimate: expected the share of triangles to keep, in (0, 1], got 0.0"),
     (["--decimate", "half"], "--decimate: expected the share of triangles to keep, in (0, 1], got 'half'"),
+    (["--size", "0"], "--size: expected the longest side in millimetres, in (0, 100000], got 0.0"),
+    (["--size", "nan"], "--size: expected the longest side in millimetres"),
+    (["--size", "1e9"], "--size: expected the longest side in millimetres"),
     (["-o", "x.fbx"], "x.fbx: unsupported mesh format '.fbx' (use .stl, .ply, .obj or .glb)"),
     (["-o", "x"], "x: unsupported mesh format '(none)'"),
     (["-o", "nodir/x.stl"], "x.stl: directory 'nodir' does not exist"),
@@ -178,6 +181,21 @@ def test_bad_mesh_input_is_one_line_status_2_and_no_file(tmp_path, capsys, monke
     err = capsys.readouterr().err
     assert err.startswith("pyjulia4d: error: ") and says in err and err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("ext, unit_mm", [("stl", 1.0), ("glb", 1000.0)])
+def test_a_sized_mesh_prints_at_its_size(tmp_path, capsys, ext, unit_mm):
+    """--size MM: the longest side MM millimetres in the file's unit (a slicer reads STL in
+    millimetres, glTF is in metres), the closing line giving the scale."""
+    import trimesh
+    from pyjulia4d.app.cli import main
+
+    out = tmp_path / f"m.{ext}"
+    assert main(["mesh", "--resolution", "24", "--size", "80", "-o", str(out)]) == 0
+    line = capsys.readouterr().out
+    got = trimesh.load(str(out), force="mesh")
+    assert max(got.extents) == pytest.approx(80.0 / unit_mm, rel=1e-6)
+    assert "scaled to 80 mm along its longest side (1 scene unit = " in line
 
 
 def test_the_command_writes_the_mesh_it_reports(tmp_path, capsys, monkeypatch):
