@@ -30,8 +30,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pyjulia4d.geometry.navigate import frame
-from pyjulia4d.geometry.camera import slice_rotation
-from pyjulia4d.geometry.vec4 import unit
+from pyjulia4d.geometry.camera import slice_map
 
 LAYOUTS = ("pyjulia4d", "compositing")
 MISS_DEPTH = 1e10          # Blender's depth where nothing was hit
@@ -95,8 +94,7 @@ def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray | Band], d
             ch[f"ViewLayer.Combined.{name}"] = combined(k)
         ch["ViewLayer.Combined.A"] = result.alpha
     f, r, u, _, _ = frame(scene.camera)
-    rot = slice_rotation(scene.slice.normal)
-    offset = scene.slice.distance * unit(scene.slice.normal)
+    rot, offset = slice_map(scene)
     if result.depth is not None:
         # along the view axis: the depth along each pixel's centre ray times the ray's cosine
         # with the view direction, 1 / |forward + u right + v up| (kernels/rays.cl)

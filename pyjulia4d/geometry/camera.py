@@ -56,12 +56,44 @@ class Frame:
     tan_half_fov: float
 
 
+# the planes of slice.turn, in its order: xy, xz, xw, yz, yw, zw
+TURN_PLANES = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
+
+
+def turn_matrix(turn) -> np.ndarray:
+    """The 4D rotation of slice.turn: G = G_zw G_yw G_yz G_xw G_xz G_xy, each G_ab turning
+    axis a towards axis b by its angle in degrees (a' = a cos - b sin, b' = a sin + b cos), the
+    xy turn first.  Read-only, made once per turn."""
+    return _turn(tuple(float(x) for x in np.ravel(turn)))
+
+
+@functools.lru_cache(maxsize=64)
+def _turn(turn: tuple[float, ...]) -> np.ndarray:
+    g = np.eye(4)
+    for (a, b), deg in zip(TURN_PLANES, turn):
+        if deg:
+            c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+            r = np.eye(4)
+            r[a, a], r[a, b], r[b, a], r[b, b] = c, -s, s, c
+            g = r @ g
+    g.setflags(write=False)
+    return g
+
+
+def slice_map(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """(R, offset): scene coordinates p -> world R p + offset.  R = G S, S the rotation that
+    takes e_w to the slice's normal (slice_rotation), G slice.turn's (turn_matrix); offset =
+    G distance n/|n|.  The camera and the lights ride along: the picture turns through 4D."""
+    g = turn_matrix(scene.slice.turn)
+    return g @ slice_rotation(scene.slice.normal), g @ (scene.slice.distance * unit(scene.slice.normal))
+
+
 def to_world(scene: Scene, p, direction: bool = False) -> np.ndarray:
-    """Camera/light coordinates -> world: R p (+ distance n/|n| for positions)."""
-    r = slice_rotation(scene.slice.normal)
+    """Camera/light coordinates -> world: R p (+ the offset for positions): slice_map."""
+    r, offset = slice_map(scene)
     v = r @ np.asarray(p, float)
     if not direction:
-        v = v + scene.slice.distance * unit(scene.slice.normal)
+        v = v + offset
     return v
 
 
@@ -156,6 +188,6 @@ def clip_planes(scene: Scene) -> list[tuple[np.ndarray, float]]:
         n = np.array([nx, ny, nz, 0.0])
         ln = float(np.linalg.norm(n))
         m = to_world(scene, n / ln, direction=True)
-        shift = scene.slice.distance * unit(scene.slice.normal)
+        shift = slice_map(scene)[1]
         out.append((m, float(off) / ln + float(m @ shift)))
     return out

@@ -14,8 +14,7 @@ import math
 
 import numpy as np
 
-from pyjulia4d.geometry.camera import camera_frame, march_radius, slice_rotation
-from pyjulia4d.geometry.vec4 import unit
+from pyjulia4d.geometry.camera import camera_frame, march_radius, slice_map
 from pyjulia4d.scene.checks import COORD, SceneError
 from pyjulia4d.scene.model import Scene
 
@@ -25,8 +24,8 @@ MARGIN = 0.9
 
 def to_scene(scene: Scene, x) -> np.ndarray:
     """World point -> scene (slice) coordinates: the inverse of camera.to_world."""
-    r = slice_rotation(scene.slice.normal)
-    return r.T @ (np.asarray(x, float) - scene.slice.distance * unit(scene.slice.normal))
+    r, offset = slice_map(scene)
+    return r.T @ (np.asarray(x, float) - offset)
 
 
 def _within_reach(scene: Scene, eye: np.ndarray, radius: float, what: str) -> None:

@@ -14,8 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyjulia4d.geometry.camera import set_radius, slice_rotation
-from pyjulia4d.geometry.vec4 import unit
+from pyjulia4d.geometry.camera import set_radius, slice_map
 from pyjulia4d.pipeline.kernel_config import KernelConfig, mesh_config
 from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.model import Scene
@@ -85,8 +84,8 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
                                            f"the slice holds nothing to mesh")
     r = math.sqrt(radius * radius - d * d)
     h = 2.0 * r / (n - 3)
-    rot = slice_rotation(scene.slice.normal)
+    rot, offset = slice_map(scene)
     return MeshPlan(scene=scene, n=n, origin=(-r - h,) * 3, spacing=h, axes=rot[:, :3].T.copy(),
-                    offset=d * unit(scene.slice.normal), radius=radius, c=tuple(f.c), max_iter=f.max_iter,
+                    offset=offset, radius=radius, c=tuple(f.c), max_iter=f.max_iter,
                     bailout=f.bailout, steps=REFINE_STEPS, config=mesh_config(scene),
                     block=max(1, min(n, BLOCK_POINTS // (n * n))))

@@ -36,6 +36,7 @@ MEANINGS = {
     "camera.focus": "path: the distance along the view axis held sharp; auto = the surface at the centre",
     "slice.normal": "normal of the 3D hyperplane the camera looks into (POV-Ray's slice)",
     "slice.distance": "the hyperplane's distance from the origin",
+    "slice.turn": "degrees the slice and camera turn through 4D in the planes xy, xz, xw, yz, yw, zw",
     "march.quality": "draft, normal or final: measured march presets (proven marches); custom: the march keys as "
                      "given; auto: the distance estimate where it bounds the distance (connected sets), else normal",
     "march.method": "fixed (z-resolution scan), de (distance estimate) or auto (de where it exists)",

@@ -86,10 +86,12 @@ class Camera:
 
 @dataclass(frozen=True)
 class Slice:
-    """[slice]: the hyperplane dot(normal, p) = distance that cuts the 4D set."""
+    """[slice]: the hyperplane dot(normal, p) = distance that cuts the 4D set, turned through
+    4D by ``turn``: degrees in the planes xy, xz, xw, yz, yw, zw (geometry/camera.turn_matrix)."""
 
     normal: Vec4 = (0.0, 0.0, 0.0, 1.0)
     distance: float = 0.0
+    turn: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
         check_section(self, "slice")

@@ -92,6 +92,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
     "slice": {
         "normal": Vector((4,), -COORD, COORD, nonzero=True),
         "distance": Real(-COORD, COORD),
+        "turn": Vector((6,), -3600.0, 3600.0),
     },
     "march": {
         "quality": Choice(*QUALITIES),

@@ -64,6 +64,7 @@ GROUPS: tuple[tuple[str, tuple[Control, ...]], ...] = (
     ("Slice", (
         Control("slice.normal", "normal", 4, lo=-1.0, hi=1.0, step=0.01),
         Control("slice.distance", "distance", lo=-2.0, hi=2.0, step=0.001),
+        Control("slice.turn", "turn (degrees: xy, xz, xw, yz, yw, zw)", 6, lo=-180.0, hi=180.0, step=0.5),
     )),
     ("Camera", (
         Control("camera.position", "position", 4, slider=False, step=0.001),

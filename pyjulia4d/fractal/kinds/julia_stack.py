@@ -48,6 +48,9 @@ def check(scene: Any) -> None:
     if any(sl.normal[:3]):
         raise SceneError("slice.normal", "a Julia set stack is the same at every w: slice it by w = const "
                          "only, normal (0, 0, 0, 1)")
+    if any(sl.turn[k] % 360 for k in (2, 4, 5)):   # xw, yw, zw
+        raise SceneError("slice.turn", "a Julia set stack is the same at every w: turn it in xy, xz and yz "
+                         "only (the xw, yw and zw angles whole turns)")
     if len(cam.limbo) == 4 and any(cam.limbo[:3]):
         raise SceneError("camera.limbo", "a Julia set stack is the same at every w: keep the rays in w = const, "
                          "limbo (0, 0, 0, 1)")
