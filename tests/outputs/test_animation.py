@@ -97,8 +97,41 @@ def test_keys_not_keyframed_stay_and_integers_round():
     assert all(anim.scene(n).camera == anim.base.camera for n in range(5))
 
 
-def test_a_keyed_camera_is_reorthonormalised_every_frame():
-    anim = load(EXAMPLES / "w_rotation.toml")
+KEYED_CAMERA = """
+[camera]
+position = [1.8, 1.6, -2.2, 0.0]
+target = [0.0, 0.0, 0.0, 0.0]
+[animation]
+frames = 25
+[[keyframe]]
+frame = 0
+camera.position = [1.8, 1.6, -2.2, 0.0]
+camera.limbo = [0.0, 0.0, 0.0, 1.0]
+[[keyframe]]
+frame = 6
+camera.position = [1.558846, 1.6, -2.2, 0.9]
+camera.limbo = [-0.5, 0.0, 0.0, 0.866025]
+[[keyframe]]
+frame = 12
+camera.position = [0.9, 1.6, -2.2, 1.558846]
+camera.limbo = [-0.866025, 0.0, 0.0, 0.5]
+[[keyframe]]
+frame = 18
+camera.position = [0.0, 1.6, -2.2, 1.8]
+camera.limbo = [-1.0, 0.0, 0.0, 0.0]
+[[keyframe]]
+frame = 24
+camera.position = [-0.9, 1.6, -2.2, 1.558846]
+camera.limbo = [-0.866025, 0.0, 0.0, -0.5]
+"""
+
+
+def test_a_keyed_camera_is_reorthonormalised_every_frame(tmp_path):
+    """The camera turned about the set in the x-w plane by keyframed positions and limbos,
+    every 30 degrees (the way before slice.turn): each frame's up and limbo orthonormal."""
+    scene = tmp_path / "keyed.toml"
+    scene.write_text(KEYED_CAMERA)
+    anim = load(scene)
     assert not anim.base.camera.fit  # the keyframes place the camera: no framing pass
     for n in range(0, anim.frames, 5):
         cam = anim.scene(n).camera
@@ -109,6 +142,18 @@ def test_a_keyed_camera_is_reorthonormalised_every_frame():
         assert abs(up @ f) < 1e-12 and abs(limbo @ f) < 1e-12 and abs(up @ limbo) < 1e-12
     # a quarter turn: the picture's x axis has become w (limbo = -e_x)
     assert np.allclose(anim.scene(18).camera.limbo, (-1, 0, 0, 0), atol=1e-6)
+
+
+def test_a_turn_through_w_is_two_keyframes():
+    """examples/w_rotation.toml: slice.turn's xw angle keyed linearly from 0 to 355 degrees,
+    5 degrees a frame; its frame at 90 degrees sees what the keyed camera's quarter turn saw
+    (the camera turned into w: position (0, 1.6, -2.2, 1.8), limbo -e_x)."""
+    from pyjulia4d.geometry.camera import camera_frame
+
+    anim = load(EXAMPLES / "w_rotation.toml")
+    assert anim.frames == 72 and [anim.scene(n).slice.turn[2] for n in (0, 1, 18, 71)] == pytest.approx([0, 5, 90, 355])
+    fr = camera_frame(anim.scene(18))
+    assert np.allclose(fr.position, (0.0, 1.6, -2.2, 1.8), atol=1e-9)
 
 
 @pytest.mark.parametrize("name", ["c_morph", "w_rotation", "slice_sweep"])
