@@ -2,11 +2,14 @@
 (Ödegaard & Wennergren §4 finds near and far the same way: from what a first pass sees).
 
 The pass looks along the scene's view direction at the whole bounding ball (96 x 72 rays,
-depth and position only); the new target is the centroid of the 4D points it hit and the
-new distance the smallest at which every one of them lies within 90 % of the field of
-view, but no nearer than where half a pixel of the pass fills it (what the pass cannot
-resolve; a set seen as a single hit is framed at that distance), both turned back into the
-scene's (slice) coordinates.  A pass that hits nothing leaves the camera alone.
+depth and position only).  The camera then looks along the same direction at a target on
+the viewed hyperplane, moved across the view until the hits' extents in the picture lie
+evenly about its centre, from the smallest distance at which every hit lies within
+camera.margin (90 % by default) of the half-width and half-height of the picture - a wider
+camera.fov comes nearer, a narrower one stands back, the set filling the same share - but
+no nearer than where half a pixel of the pass fills the view (what the pass cannot resolve;
+a set seen as a single hit is framed at that distance); both turned back into the scene's
+(slice) coordinates.  A pass that hits nothing leaves the camera alone.
 """
 from __future__ import annotations
 
@@ -19,7 +22,7 @@ from pyjulia4d.scene.checks import COORD, SceneError
 from pyjulia4d.scene.model import Scene
 
 PROBE = (96, 72)
-MARGIN = 0.9
+CENTRE_ROUNDS = 4   # the centring's rounds: each halves what perspective left off centre, or better
 
 
 def to_scene(scene: Scene, x) -> np.ndarray:
@@ -72,15 +75,27 @@ def fit_camera(scene: Scene, render_fn) -> tuple[Scene, dict]:
     c = pts.mean(axis=0)
     # back onto the viewed hyperplane exactly (the hits are float32)
     c = centre + sum(((c - centre) @ v) * v for v in (fr.right, fr.up, fr.forward))
-    rel = pts - c
-    x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
     # the pass sees the set to within one of its pixels: no nearer than where half a probe
     # pixel at the hits' depth fills the view (one hit or a few together would otherwise
     # put the camera on its target, a camera with no direction)
     half_pixel = float(np.max((pts - eye) @ fr.forward)) * tan_v / PROBE[1]
-    dist = max(float(np.max(np.abs(x) / (MARGIN * tan_h) - z)),
-               float(np.max(np.abs(y) / (MARGIN * tan_v) - z)),
-               half_pixel / (MARGIN * min(tan_v, tan_h)), 1e-6)
+    margin = scene.camera.margin
+
+    def distance(c: np.ndarray) -> float:
+        """The nearest camera distance from c that holds every hit within the margin."""
+        rel = pts - c
+        x, y, z = rel @ fr.right, rel @ fr.up, rel @ fr.forward
+        return max(float(np.max(np.abs(x) / (margin * tan_h) - z)), float(np.max(np.abs(y) / (margin * tan_v) - z)),
+                   half_pixel / (margin * min(tan_v, tan_h)), 1e-6)
+
+    dist = distance(c)
+    for _ in range(CENTRE_ROUNDS):   # centred in the picture: the hits' extents even about the middle
+        rel = pts - c
+        depth = rel @ fr.forward + dist
+        u, v = (rel @ fr.right) / depth, (rel @ fr.up) / depth
+        mid_u, mid_v = 0.5 * (u.max() + u.min()), 0.5 * (v.max() + v.min())
+        c = c + dist * (mid_u * fr.right + mid_v * fr.up)
+        dist = distance(c)
     pos = c - dist * fr.forward
     _within_reach(scene, pos, radius, "the framed camera")
     record.update(distance=dist, target=[float(v) for v in c])

@@ -32,6 +32,7 @@ MEANINGS = {
     "camera.fov": "full vertical field of view, degrees",
     "camera.fit": "frame the set from a quick 96x72 first pass, keeping the view direction "
                   "(default true when no camera.position is given)",
+    "camera.margin": "with fit: the share of the picture's half-width and half-height the set may fill",
     "camera.aperture": "path: the thin lens's radius in scene units; 0 is a pinhole (all sharp)",
     "camera.focus": "path: the distance along the view axis held sharp; auto = the surface at the centre",
     "slice.normal": "normal of the 3D hyperplane the camera looks into (POV-Ray's slice)",

@@ -74,6 +74,8 @@ class Camera:
     # read by from_dict/from_toml (or the command line) that gives no camera.position and
     # no camera.fit gets true (Scene.from_dict)
     fit: bool = False
+    # with fit: the share of the picture's half-width and half-height the set may fill
+    margin: float = 0.9
     # the path tracer's thin lens (shading.integrator = "path"): its radius in scene units (0:
     # a pinhole, all in focus), focused at a distance along the view axis or, "auto", on the
     # surface at the picture's centre (pipeline/path_plan.resolve_focus)

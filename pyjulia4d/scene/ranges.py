@@ -86,6 +86,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "limbo": Vector((3, 4), -COORD, COORD, nonzero=True),
         "fov": Real(1e-6, 179.9),
         "fit": Bool(),
+        "margin": Real(0.05, 1.0),
         "aperture": Real(0.0, 1e3),
         "focus": OrWord("auto", Real(1e-6, 1e7)),
     },

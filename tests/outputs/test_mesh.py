@@ -255,7 +255,10 @@ def test_orbit_colourings_take_the_values_the_render_takes(coloring):
     from pyjulia4d.reference.formula import formula_of
     from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
 
+    # a camera of its own: the hits sample the side of the set it sees, and framing is not
+    # what this measures
     scene = Scene.from_dict({"fractal": {"c": [-0.75, 0.11, 0.0, 0.0]}, "image": {"width": 64, "height": 48},
+                             "camera": {"position": [1.8, 1.6, -2.2, 0.0]},
                              "shading": {"coloring": coloring, "trap": [0.3, 0.2, 0.0, 0.0]}})
     shot = render(scene, device=harness.device())
     s = shot.scene

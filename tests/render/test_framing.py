@@ -57,7 +57,7 @@ def test_a_pass_with_one_hit_frames_it_at_a_pixel_of_the_pass():
     pixel fills the view (it had gone to 1e-6 from its target, a camera with no direction,
     which the scene's checks refused), and the framed scene renders."""
     import dataclasses
-    from pyjulia4d.pipeline.framing import MARGIN, PROBE
+    from pyjulia4d.pipeline.framing import PROBE
 
     s = Scene.default().with_overrides(["camera.fit=true", "image.width=64", "image.height=48"])
     point = np.array([0.1, -0.2, 0.3, 0.0])
@@ -77,7 +77,23 @@ def test_a_pass_with_one_hit_frames_it_at_a_pixel_of_the_pass():
     np.testing.assert_allclose(target, point, atol=1e-6)
     tan_v = fr.tan_half_fov
     z = float((point - seen["eye"]) @ fr.forward)           # the hit's depth in the pass
-    want = z * tan_v / PROBE[1] / (MARGIN * min(tan_v, tan_v * 64 / 48))
+    want = z * tan_v / PROBE[1] / (s.camera.margin * min(tan_v, tan_v * 64 / 48))
     assert np.linalg.norm(eye - target) == pytest.approx(want, rel=1e-6)
     r = render(fitted)
     assert r.scene.camera == fitted.camera
+
+
+@pytest.mark.parametrize("extra, fill", [([], 0.9), (["camera.margin=0.5"], 0.5)])
+def test_the_framed_set_is_centred_within_its_margin(extra, fill):
+    """camera.fit centres what it frames: the set's extents in the picture even about its
+    middle (to a pixel or two: the pass is 96x72), filling camera.margin of the half-width or
+    half-height, whichever binds."""
+    from pyjulia4d import render as render_scene
+
+    w, h = 160, 120
+    r = render_scene(Scene.from_dict({"image": {"width": w, "height": h}}).with_overrides(extra))
+    ys, xs = np.nonzero(r.alpha > 0)
+    left, right, top, bottom = xs.min(), w - 1 - xs.max(), ys.min(), h - 1 - ys.max()
+    assert abs(left - right) <= 2 and abs(top - bottom) <= 2, (left, right, top, bottom)
+    share = max((xs.max() - xs.min() + 1) / w, (ys.max() - ys.min() + 1) / h)
+    assert abs(share - fill) <= 0.04, share
