@@ -91,6 +91,22 @@ GROUPS: tuple[tuple[str, tuple[Control, ...]], ...] = (
         Control("shading.fog", "fog", lo=0.0, hi=5.0),
         Control("shading.coloring", "colouring", widget="select"),
         Control("shading.colormap", "colour map", widget="select"),
+        Control("shading.trap", "orbit trap", 4, lo=-2.0, hi=2.0, step=0.01),
+        Control("shading.reflection", "reflection", lo=0.0, hi=1.0),
+        Control("shading.background", "background (linear)", 3, lo=0.0, hi=1.0, step=0.01),
+    )),
+    ("Light", (
+        Control("shading.light_color", "key light colour", 3, lo=0.0, hi=2.0, step=0.01),
+        Control("shading.light_space", "lights move with", widget="select"),
+        Control("shading.sky", "sky (linear)", 3, lo=0.0, hi=2.0, step=0.01),
+        Control("shading.integrator", "integrator", widget="select"),
+        Control("shading.bounces", "bounces (path)", lo=1, hi=8, step=1),
+        Control("shading.roughness", "roughness (path)", lo=0.0, hi=1.0),
+        Control("shading.metallic", "metallic (path)", lo=0.0, hi=1.0),
+        Control("shading.emission", "glow (path)", lo=0.0, hi=5.0),
+        Control("camera.aperture", "lens aperture (path)", lo=0.0, hi=0.3, step=0.001),
+        Control("image.exposure", "exposure (stops)", lo=-4.0, hi=4.0, step=0.1),
+        Control("image.tonemap", "tone map", widget="select"),
     )),
 )
 
