@@ -14,7 +14,7 @@ import warnings
 from pathlib import Path
 from typing import Any, Iterator, NoReturn, Sequence
 
-from pyjulia4d.app.output import check_output_path, render_header, write_image
+from pyjulia4d.app.output import check_output_path, closing_line, render_header, write_image
 from pyjulia4d.pipeline.progress import clear_stop, request_stop
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError, one_line, show_key
@@ -65,6 +65,9 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene value, e.g. --set fractal.c=-0.2,0.8,0,0 (repeatable; 'pyjulia4d keys' lists every key, its default and valid range)")
     r.add_argument("--device", metavar="SPEC", help="OpenCL device: P:D index, cpu, gpu, or part of its name")
+    r.add_argument("--verbose", action="store_true",
+                   help="end with the whole report: why the device, pixels hit, guards fired, the depth bracket "
+                        "and error in full, unproven pixels (the image's header holds it either way)")
     r.add_argument("--channels", metavar="LIST",
                    help="EXR channel groups to compute and write, comma-separated from RGBA, Z (depth and "
                         "its bracket), N (normal), P (4D position); default all.  Z alone skips normals "
@@ -238,22 +241,15 @@ def _render(args: argparse.Namespace) -> int:
         store = store_for(scene, outputs, out)
         result = render(scene, device=device, progress=True, force=args.force, outputs=outputs, store=store)
     header, tail = render_header(scene, result)
-    rendered = getattr(result, "scene", None) or scene
-    if scene.camera.fit and rendered is not scene:
-        pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
-        tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
     if store is not None:
         store.release()   # the report's arrays, read whole
     write_image(out, result, header, None if store is None else store.release)
-    w, h = scene.image.width, scene.image.height
     why = ""
-    if args.device is None and args.workers is None and args.scheduler is None and hasattr(device, "int_ptr"):
+    if args.verbose and args.device is None and args.workers is None and args.scheduler is None \
+            and hasattr(device, "int_ptr"):
         from pyjulia4d.opencl.devices import default_reason
         why = f" ({default_reason(device)})"
-    print(
-        f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}{why}, "
-        f"{100 * result.hit_fraction:.1f}% of pixels hit{tail}"
-    )
+    print(closing_line(out, scene, result, tail, args.verbose, why))
     return 0
 
 

@@ -357,6 +357,27 @@ def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:
     return {"pyjulia4d.scene": rendered.to_toml(), **report}, tail
 
 
+def closing_line(out: Path, scene: Any, result: Any, tail: str, verbose: bool, why: str = "") -> str:
+    """The render command's last line.  At a glance: the output, size, time and device, the
+    error the render states in one figure (RenderResult.brief) and the camera camera.fit
+    chose.  ``verbose``: the whole report (``tail``, render_header's) after ``why`` the device."""
+    from pyjulia4d.scene.quality import stated_p99
+
+    rendered = getattr(result, "scene", None) or scene
+    w, h = scene.image.width, scene.image.height
+    framed = ""
+    if scene.camera.fit and rendered is not scene:
+        pos = ", ".join(f"{v:.4g}" for v in rendered.camera.position)
+        tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
+        framed = f"; framed from [{pos}]"
+    head = f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}"
+    if verbose:
+        return f"{head}{why}, {100 * result.hit_fraction:.1f}% of pixels hit{tail}"
+    # a preset's bound is named only where the user chose the preset
+    chosen = stated_p99(scene.march.quality) if scene.march.quality != "auto" else None
+    return head + (result.brief(chosen) if hasattr(result, "brief") else "") + framed
+
+
 def read_header(path: str | Path) -> dict[str, str] | None:
     """An image's header entries (PNG text chunks, EXR string attributes), as write_image
     wrote them; None if it cannot be read (OutputError if ``path`` is no path at all)."""

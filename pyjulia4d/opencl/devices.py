@@ -233,7 +233,7 @@ def default_reason(dev: cl.Device) -> str:
     passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
     if kind == "CPU" and passed and runtime_rank(dev) < len(CPU_PREFERENCE):
         why = f"{idx}, the default: no GPU; of the CPU runtimes that compile, {dev.platform.name.strip()} " \
-              f"is preferred (faster on every pair measured: benchmarks/speed/cpu_runtimes.py) over {', '.join(passed)}"
+              f"is preferred (the faster on every pair measured) over {', '.join(passed)}"
     elif kind == "CPU" and passed:
         why = f"{idx}, the default: no GPU; the first of the CPU runtimes that compile ({idx}, {', '.join(passed)})"
     else:

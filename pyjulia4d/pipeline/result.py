@@ -184,6 +184,26 @@ class RenderResult:
                      f"the set's pixels, {lo if lo == hi else f'{lo}-{hi}'} paths per pixel)")
         return header, tail
 
+    def brief(self, stated_p99: float | None = None) -> str:
+        """The closing line's short tail (the full one behind --verbose: report): the rays
+        capped, the depth error stated (or, for a march that proves nothing in front, the
+        bracket and how to prove it), a path-traced picture's noise, and what to do where
+        one is above the preset the user chose (``stated_p99``: its bound, None without one)."""
+        e, b = self.error_stats(), self.bracket_stats()
+        parts = [f"{self.capped} rays capped at march.max_steps"] if self.capped else []
+        if self.proven and not math.isnan(e["p99"]):
+            above = stated_p99 is not None and e["p99"] > stated_p99
+            parts.append(f"depth error p99 {e['p99']:.2g}" + (
+                f", above the preset's {stated_p99:.0e} (a finer march.quality proves more)" if above else ""))
+        elif not self.proven and not math.isnan(b["p99"]):
+            parts.append(f"depth bracket p99 {b['p99']:.2g}, the space in front not proven "
+                         f"(march.quality=normal proves it)")
+        if self.film is not None:
+            n = self.film.noise_stats()
+            lo, hi = int(self.film.paths.min()), int(self.film.paths.max())
+            parts.append(f"noise p99 {n['p99']:.2g} at {lo if lo == hi else f'{lo}-{hi}'} paths per pixel")
+        return "".join("; " + x for x in parts)
+
     @property
     def capped(self) -> int:
         """Pixels whose march ran into the step cap (counted, never hidden)."""

@@ -198,8 +198,10 @@ def test_render_success(tmp_path, monkeypatch, fake_render, capsys) -> None:
     monkeypatch.chdir(tmp_path)
     assert cli.main(["render", "--width", "8", "--height", "6", "--set", "fractal.max_iter=5"]) == 0
     out = capsys.readouterr().out
-    assert out == "rendered julia.png (8x6) in 1.23 s on fake device, 41.2% of pixels hit\n"
-    [(scene, device, progress)] = fake_render.calls
+    assert out == "rendered julia.png (8x6) in 1.23 s on fake device\n"
+    assert cli.main(["render", "--width", "8", "--height", "6", "--verbose"]) == 0
+    assert capsys.readouterr().out == "rendered julia.png (8x6) in 1.23 s on fake device, 41.2% of pixels hit\n"
+    (scene, device, progress), _ = fake_render.calls
     assert scene.fractal.max_iter == 5 and device == "device<None>" and progress is True
     assert Image.open(tmp_path / "julia.png").size == (8, 6)
 

@@ -31,7 +31,7 @@ from pyjulia4d.scene.ranges import CHECKS
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
 SEED = 20261125
 KEYS = [f"{s}.{k}" for s, table in CHECKS.items() for k in table]
-OPTIONS = ["--output", "--width", "--height", "--set", "--device", "--force", "--help"]
+OPTIONS = ["--output", "--width", "--height", "--set", "--device", "--force", "--help", "--verbose"]
 
 
 @dataclass

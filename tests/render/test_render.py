@@ -44,7 +44,8 @@ def cli(*args, cwd):
 
 
 def test_cli_renders_exr_with_all_channels(tmp_path):
-    p = cli("--width", "40", "--height", "30", "--set", "fractal.c=-0.8,0.4,0,0", "-o", "out.exr", cwd=tmp_path)
+    p = cli("--width", "40", "--height", "30", "--set", "fractal.c=-0.8,0.4,0,0", "-o", "out.exr", "--verbose",
+            cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert p.stdout.count("\n") == 1 and "% of pixels hit" in p.stdout
     f = OpenEXR.File(str(tmp_path / "out.exr"), separate_channels=True)
@@ -70,7 +71,7 @@ def test_cli_renders_exr_with_all_channels(tmp_path):
 def test_cli_reports_guards_that_fired(tmp_path):
     """The eye inside the set: every pixel is a hit at the eye; the closing line counts it."""
     p = cli("--width", "8", "--height", "6", "--set", "camera.position=0.05,0.1,-0.1,0",
-            "--set", "camera.target=0,0,1,0", "-o", "in.png", cwd=tmp_path)
+            "--set", "camera.target=0,0,1,0", "-o", "in.png", "--verbose", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     # the eye is the first inside point of every ray: depth 0, bracket 0 (exact)
     assert p.stdout.strip().endswith("100.0% of pixels hit; guards fired: eye_hit 48; "
@@ -78,7 +79,7 @@ def test_cli_reports_guards_that_fired(tmp_path):
 
 
 def test_cli_reports_the_bracket_and_the_preset_bound(tmp_path):
-    p = cli("--width", "32", "--height", "24", "--set", "march.quality=final", "-o", "f.exr", cwd=tmp_path)
+    p = cli("--width", "32", "--height", "24", "--set", "march.quality=final", "-o", "f.exr", "--verbose", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "; depth error p50 " in p.stdout and "preset's stated" in p.stdout
     hdr = OpenEXR.File(str(tmp_path / "f.exr")).header()
@@ -174,12 +175,32 @@ def test_image_too_large_for_memory_refused_before_rendering():
 def test_cli_says_whether_the_preset_target_was_met(tmp_path):
     # a proven preset: the closing line gives the error the render proves and compares it
     # with the preset's target; a march that proves nothing says so
-    p = cli("--width", "16", "--height", "12", "--set", "march.quality=draft", "-o", "n.png", cwd=tmp_path)
+    p = cli("--width", "16", "--height", "12", "--set", "march.quality=draft", "-o", "n.png", "--verbose",
+            cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "depth error p50" in p.stdout and "the preset's stated" in p.stdout
-    p = cli("--width", "16", "--height", "12", "--set", "march.method=fixed", "-o", "f.png", cwd=tmp_path)
+    p = cli("--width", "16", "--height", "12", "--set", "march.method=fixed", "-o", "f.png", "--verbose", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "not proven empty" in p.stdout
+
+
+def test_the_closing_line_reads_at_a_glance(tmp_path):
+    """Without --verbose: the time, size and device, the error the render states in one
+    figure, and what to do where it is above a preset the user chose - no preset is named
+    where none was chosen, no device reasoning, no repository path; the full report is in
+    the image's header."""
+    p = cli("--width", "32", "--height", "24", "--set", "fractal.algebra=cquat", "--set", "fractal.function=cube",
+            "-o", "a.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    line = p.stdout.strip()
+    assert line.startswith("rendered a.png (32x24) in ") and "; depth error p99 " in line
+    assert "preset" not in line and "benchmarks/" not in line and "the default:" not in line and len(line) < 200
+    p = cli("--width", "32", "--height", "24", "--set", "fractal.algebra=cquat", "--set", "fractal.function=cube",
+            "--set", "march.quality=normal", "-o", "b.png", cwd=tmp_path)
+    assert "above the preset's 1e-03 (a finer march.quality proves more)" in p.stdout
+    from pyjulia4d.app.output import read_header
+    hdr = read_header(tmp_path / "a.png")
+    assert hdr["pyjulia4d.depth_error"] and hdr["pyjulia4d.guards"]
 
 
 def test_program_binaries_cached_on_disk(tmp_path, monkeypatch):
@@ -331,7 +352,7 @@ def test_closing_line_says_which_device_and_why(tmp_path):
     why = default_reason(dev)
     idx = next(i for i, _, d in indexed_devices() if d.int_ptr == dev.int_ptr)
     assert why.startswith(f"{idx}, the default: ")
-    p = cli("--width", "8", "--height", "6", "-o", "a.png", cwd=tmp_path)
+    p = cli("--width", "8", "--height", "6", "-o", "a.png", "--verbose", cwd=tmp_path)
     assert p.returncode == 0 and f"({why})" in p.stdout, p.stdout
     p = cli("--width", "8", "--height", "6", "-o", "b.png", "--device", idx, cwd=tmp_path)
     assert p.returncode == 0 and "the default" not in p.stdout, p.stdout
