@@ -314,7 +314,8 @@ class Lights:
     numbers; a direction not all 0) and optional color (3 numbers in [0, 1e3]) and intensity
     (in [0, 1e3]), and for the path tracer a radius (in [0, 1e3]: a positioned light's sphere,
     scene units; a distant one's angular radius, degrees).  On the command line: "position
-    x,y,z[,w] color r,g,b intensity k radius r; direction x,y,z[,w] ..." ("" or "[]": none)."""
+    x,y,z[,w] color r,g,b intensity k radius r; direction x,y,z[,w] ..." ("" or "[]": none),
+    or the scene file's TOML inline array of inline tables ("[{position = [1, 2, 3]}, ...]")."""
 
     verbatim = True
     FIELDS = ("position", "direction", "color", "intensity", "radius")
@@ -323,8 +324,8 @@ class Lights:
         self.most = most
         self.make = make   # the light's type (scene.model.Light), built from the checked fields
         self.valid = (f"up to {most} tables {{position = [x, y, z, w] or direction = [x, y, z, w], "
-                      f"color = [r, g, b], intensity = k, radius = r}} (--set: position x,y,z,w color r,g,b "
-                      f"intensity k radius r; ...)")
+                      f"color = [r, g, b], intensity = k, radius = r}} (--set: the same TOML, or position x,y,z,w "
+                      f"color r,g,b intensity k radius r; ...)")
         self.point = Vector((3, 4), -COORD, COORD)
         self.direction = Vector((3, 4), -COORD, COORD, nonzero=True)
         self.color = Vector((3,), 0.0, 1e3)
@@ -343,10 +344,20 @@ class Lights:
             lights.append(table)
         return lights
 
+    def _toml(self, key: str, text: str) -> list:
+        """The value as TOML writes it in a scene file: an inline array of inline tables."""
+        import tomllib
+
+        try:
+            return tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError as e:
+            raise SceneError(key, f"not a TOML array of light tables ({' '.join(str(e).split())[:100]})") from None
+
     def __call__(self, key: str, v: Any) -> tuple:
         if isinstance(v, str):
             text = v.strip()
-            v = [] if text in ("", "[]") else self._parse(key, text)
+            toml = text.startswith("[") and "{" in text
+            v = [] if text in ("", "[]") else self._toml(key, text) if toml else self._parse(key, text)
         if not isinstance(v, (list, tuple)):
             raise SceneError(key, f"expected a list of light tables, got {show(v)}")
         if len(v) > self.most:

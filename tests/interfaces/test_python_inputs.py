@@ -386,3 +386,12 @@ def test_nothing_is_suggested_where_nothing_is_close() -> None:
 def test_colour_map_names_take_any_case() -> None:
     assert Scene.from_dict({"shading": {"colormap": "SPECTRAL"}}).shading.colormap == "Spectral"
     assert Scene.default().with_overrides(["shading.colormap=Viridis"]).shading.colormap == "viridis"
+
+
+def test_lights_take_the_scene_files_toml_on_the_command_line() -> None:
+    toml = Scene.default().with_overrides(
+        ["shading.lights=[{position = [1, 2, 3], color = [1, 0, 0]}, {direction = [0, 1, 0], intensity = 2}]"])
+    words = Scene.default().with_overrides(["shading.lights=position 1,2,3 color 1,0,0; direction 0,1,0 intensity 2"])
+    assert toml.shading.lights == words.shading.lights and len(toml.shading.lights) == 2
+    with pytest.raises(SceneError, match="not a TOML array of light tables"):
+        Scene.default().with_overrides(["shading.lights=[{position = [1, 2, 3]"])
