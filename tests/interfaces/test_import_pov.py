@@ -113,6 +113,21 @@ def test_hypercomplex_pwr(tmp_path, capsys):
     assert 0.0 < np.mean(ref.render(s).alpha > 0) < 1.0
 
 
+def test_reflection_and_more_lights_are_taken(tmp_path, capsys):
+    """finish { reflection } becomes shading.reflection, and the light_sources after the
+    first become shading.lights, each where POV-Ray puts it, in its colour."""
+    rc, out, err = _import(tmp_path, "#version 3.7;\n" + CAMERA +
+                           "light_source { <-2, 5, -4> color rgb <1, 1, 1> }\n"
+                           "light_source { <3, 1, -2> color rgb <0.3, 0.4, 0.8> }\n"
+                           "julia_fractal { <-0.2, 0.8, 0, 0> quaternion sqr max_iteration 8 "
+                           "finish { reflection 0.25 } }", capsys, "--width", "16", "--height", "12")
+    assert rc == 0, err
+    sh = Scene.from_toml(out).shading
+    assert sh.reflection == 0.25 and sh.light[:3] == (-2.0, 5.0, -4.0)
+    assert len(sh.lights) == 1 and sh.lights[0].position[:3] == (3.0, 1.0, -2.0)
+    assert sh.lights[0].color == (0.3, 0.4, 0.8)
+
+
 def test_slice_and_distance(tmp_path, capsys):
     body = "#version 3.7;\n" + CAMERA + "julia_fractal { <-0.2, 0.8, 0, 0> slice N, D }"
     # a w-only normal: exact; POV-Ray normalises it and keeps the distance

@@ -47,9 +47,11 @@ Parse_Julia_Fractal and Parse_Camera, fractal.cpp, quaternion.cpp, hypercomplex.
   mirrors included; others are refused).  On the camera and the light they are applied.
 * pigment { color rgb <r,g,b> } -> shading.color; finish ambient, diffuse, specular,
   roughness (shininess = 1/roughness; POV-Ray's specular is Blinn-Phong too), with
-  POV-Ray 3.7's defaults (0.1, 0.6, 0, 0.05) for what a given finish leaves out;
-  light_source position and colour -> shading.light (in camera coordinates),
-  shading.light_color, its shadows -> shading.shadow ("hard", or "none" for
+  POV-Ray 3.7's defaults (0.1, 0.6, 0, 0.05) for what a given finish leaves out, and
+  reflection (a number, or a grey) -> shading.reflection;
+  the first light_source's position and colour -> shading.light (in the scene's
+  coordinates) and shading.light_color, up to three more -> shading.lights (point lights,
+  their colours), their shadows -> shading.shadow ("hard", or "none" for
   shadowless or no_shadow), shading.ao = 0 (POV-Ray has no ambient occlusion);
   background -> shading.background.  Colours are taken as linear (POV-Ray 3.7 with
   assumed_gamma 1.0, as pyjulia4d shades).  No pigment: pyjulia4d's colour is kept

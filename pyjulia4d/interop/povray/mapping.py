@@ -10,6 +10,7 @@ import numpy as np
 
 from pyjulia4d.interop.povray.reader import FRACTAL_TOLERANCE, POV_DEFAULT_RIGHT, POV_FINISH, Camera, SceneReader
 from pyjulia4d.scene.model import Scene
+from pyjulia4d.scene.ranges import MAX_LIGHTS as MAX_EXTRA_LIGHTS   # shading.lights, besides shading.light
 from pyjulia4d.interop.povray.tokens import PovError
 
 
@@ -235,13 +236,20 @@ def map_shading(r: SceneReader, j, inv, smap: SliceMap, out: Converted) -> None:
         out.put("shading.diffuse", f["diffuse"])
         out.put("shading.specular", f["specular"])
         out.put("shading.shininess", 1.0 / f["roughness"], "1 / roughness")
+        if "reflection" in f:
+            out.put("shading.reflection", f["reflection"], "finish reflection")
     if r.lights:
         lt = r.lights[0]
-        if len(r.lights) > 1:
-            out.warns.append(f"{where}:{r.lights[1].line}: {len(r.lights)} light sources: pyjulia4d has one light, "
-                         f"the first (line {lt.line}) is used")
         out.put("shading.light", _vec(smap.point(inv.point(lt.position))), f"light_source (line {lt.line})")
         out.put("shading.light_color", _vec(lt.color))
+        more = r.lights[1:1 + MAX_EXTRA_LIGHTS]
+        if more:   # the others as shading.lights, point lights at their places
+            lines = ", ".join(str(x.line) for x in more)
+            out.put("shading.lights", [{"position": _vec(smap.point(inv.point(x.position))), "color": _vec(x.color)}
+                                       for x in more], f"light_source (line{'s' if len(more) > 1 else ''} {lines})")
+        if len(r.lights) > 1 + MAX_EXTRA_LIGHTS:
+            out.warns.append(f"{where}:{r.lights[1 + MAX_EXTRA_LIGHTS].line}: {len(r.lights)} light sources: "
+                             f"pyjulia4d takes {1 + MAX_EXTRA_LIGHTS}, the first {1 + MAX_EXTRA_LIGHTS} are used")
         if lt.shadowless or j.no_shadow:
             out.put("shading.shadow", "none", "shadowless" if lt.shadowless else "no_shadow on the julia_fractal")
         else:

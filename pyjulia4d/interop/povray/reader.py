@@ -280,7 +280,7 @@ class SceneReader(ExpressionReader):
                 raise self.err(f"light_source: {self.shown(t)} cannot be read", t)
         if ignored:
             self.warnings.append(f"{self.where}:{start.line}: light_source {', '.join(ignored)} ignored: "
-                                 f"pyjulia4d has one point light")
+                                 f"pyjulia4d's lights are points and suns")
         self.lights.append(Light(start.line, trans.point(pos), col[:3], shadowless))
 
     def julia(self, start: Tok) -> Julia:
@@ -390,6 +390,18 @@ class SceneReader(ExpressionReader):
                 if w == "roughness" and v <= 0:
                     raise self.err("finish: roughness must be positive", tt)
                 f[w] = float(v)
+            elif w == "reflection":   # a mirror share: pyjulia4d's one bounce (shading.reflection)
+                tt = self.peek()
+                if self.peek().text == "{":
+                    raise self.err("finish: a reflection block cannot be mapped (give reflection a number)", tt)
+                v = self.expr()
+                if is_vec(v):
+                    if len(set(v[:3])) != 1:
+                        raise self.err("finish: a coloured reflection cannot be mapped", tt)
+                    v = v[0]
+                if not 0.0 <= float(v) <= 1.0:
+                    raise self.err("finish: reflection must lie in [0, 1]", tt)
+                f["reflection"] = float(v)
             elif w == "brilliance":
                 tt = self.peek()
                 if self.number(w) != 1:
@@ -399,7 +411,7 @@ class SceneReader(ExpressionReader):
                 raise self.err(f"unterminated 'finish {{' opened at line {start.line}", t)
             else:
                 raise self.err(f"finish: {self.shown(t)} cannot be mapped (only ambient, diffuse, specular, "
-                               f"roughness)", t)
+                               f"roughness, reflection)", t)
         return f
 
     def texture(self, start: Tok, j: Julia) -> None:
