@@ -301,13 +301,13 @@ def colouring_values(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.n
 def vertex_colours(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.ndarray:
     """(m, 4) uint8 sRGB colours of the vertices, as the render colours a hit (shade/shade.cl):
     shading.color for "flat", else the colour map at colouring_values."""
-    from pyjulia4d.pipeline.colormap import linear_to_srgb, lookup, table
+    from pyjulia4d.pipeline.colormap import linear_to_srgb, lookup, spec_of, table_of
 
     val = colouring_values(scene, world, inner)
     if val is None:
         base = np.broadcast_to(np.asarray(scene.shading.color, np.float64), (len(world), 3))
     else:
-        base = lookup(table(scene.shading.colormap).astype(np.float64), val)
+        base = lookup(table_of(spec_of(scene.shading)).astype(np.float64), val)
     rgb = np.rint(linear_to_srgb(np.clip(base, 0.0, 1.0)) * 255)
     return np.concatenate([rgb, np.full((len(world), 1), 255.0)], axis=1).astype(np.uint8)
 

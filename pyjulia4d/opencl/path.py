@@ -65,7 +65,7 @@ class PathRunner:
         # march.near and march.far the camera's rays take
         rec["march"] = dataclasses.replace(plan.march, near=-1.0, far=-1.0)
         sa = plan.shade
-        lut = colormap.table(sa.colormap) if sa.colormap is not None else np.zeros((2, 4), np.float32)
+        lut = colormap.table_of(sa.colormap) if sa.colormap is not None else np.zeros((2, 4), np.float32)
         lights = dict(lights_geo=constant(self.queue, np.array([pr.v4(g) for g in sa.lights_geo])),
                       lights_rgb=constant(self.queue, np.array([float4(c) for c in sa.lights_rgb])),
                       lights_size=constant(self.queue, np.asarray(sa.lights_size, np.float32)))

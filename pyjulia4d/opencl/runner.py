@@ -162,7 +162,7 @@ class TileRunner:
         # each kernel's arguments (pipeline/signatures.py) packed from the plan's records once;
         # a launch gives only its tile's place and buffers
         rec = plan.records()
-        lut = colormap.table(plan.shade.colormap) if plan.shade.colormap is not None else None
+        lut = colormap.table_of(plan.shade.colormap) if plan.shade.colormap is not None else None
         march_defines = plan.march_config.defines
         self.lut = constant(self.queue, (lut if lut is not None else np.zeros((2, 4), np.float32))
                             .view(cl.cltypes.float4).ravel())

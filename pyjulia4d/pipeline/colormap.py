@@ -1,10 +1,18 @@
-"""Colour maps for shading.coloring: a matplotlib colour map sampled into a table the shade
-kernel interpolates (kernels/shade/shade.cl, -D COLORMAP).  matplotlib's maps are sRGB
+"""Colour maps for shading.coloring: a matplotlib colour map, or the user's own gradient
+(shading.gradient: colour stops, as Blender's colour ramp), sampled into a table the shade
+kernel interpolates (kernels/shade/shade.cl, -D COLORMAP).  The maps and the stops are sRGB
 colours; the kernels shade in linear light and the PNG writer encodes sRGB, so the table
-holds the maps' colours converted to linear light: a fully lit hit shows the map's own
-colour."""
+holds their colours converted to linear light: a fully lit hit shows the map's own colour.
+
+The colour value v (in [0, 1]) can be moved and stretched first: v' = color_offset +
+color_scale v, then clamped to [0, 1], repeated (v' mod 1) or mirrored (a triangle wave of
+period 2), as shading.color_repeat says.  That map is baked into the table, sampled finely
+enough for the repeats (TABLE_SIZE entries a period), so the kernels and the float64
+executor look it up as they look up a plain map."""
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -107,6 +115,57 @@ def lookup(lut: np.ndarray, values: np.ndarray) -> np.ndarray:
     k = np.minimum(x.astype(int), len(lut) - 2)
     fr = (x - k)[:, None]
     return lut[k, :3] * (1 - fr) + lut[k + 1, :3] * fr
+
+
+TABLE_MOST = 16384   # entries: 64 periods of TABLE_SIZE
+
+
+@dataclass(frozen=True)
+class ColorSpec:
+    """What the colour table is made of: a map's name, or the user's stops ((position, r, g,
+    b) sRGB, positions rising from 0 to 1), and the map of the colour value onto them."""
+    name: str
+    stops: tuple | None = None
+    offset: float = 0.0
+    scale: float = 1.0
+    repeat: str = "clamp"
+
+
+def spec_of(shading) -> ColorSpec:
+    """The ColorSpec of a [shading] (scene.model.Shading)."""
+    stops = tuple(tuple(float(x) for x in s) for s in shading.gradient) or None
+    return ColorSpec(shading.colormap, stops, float(shading.color_offset), float(shading.color_scale),
+                     shading.color_repeat)
+
+
+def wrap(v: np.ndarray, repeat: str) -> np.ndarray:
+    """v onto [0, 1]: clamped, repeated (v mod 1) or mirrored (a triangle wave of period 2)."""
+    if repeat == "repeat":
+        return np.mod(v, 1.0)
+    if repeat == "mirror":
+        return 1.0 - np.abs(np.mod(v, 2.0) - 1.0)
+    return np.clip(v, 0.0, 1.0)
+
+
+@lru_cache(maxsize=64)
+def table_of(spec: ColorSpec) -> np.ndarray:
+    """(n, 4) float32 linear RGB, alpha 1: the colour at evenly spaced colour values v in
+    [0, 1] of the map or stops, after the value's map (the module docstring)."""
+    periods = 1.0 if spec.repeat == "clamp" else max(1.0, abs(spec.scale))
+    n = int(min(TABLE_MOST, max(TABLE_SIZE, TABLE_SIZE * math.ceil(periods))))
+    v = wrap(spec.offset + spec.scale * np.linspace(0.0, 1.0, n), spec.repeat)
+    if spec.stops is not None:
+        st = np.asarray(spec.stops, np.float64)
+        srgb = np.stack([np.interp(v, st[:, 0], st[:, k]) for k in (1, 2, 3)], axis=1)
+    else:
+        import matplotlib
+
+        srgb = np.asarray(matplotlib.colormaps[spec.name](v), np.float64)[:, :3]
+    rgba = np.ones((n, 4))
+    rgba[:, :3] = srgb_to_linear(np.clip(srgb, 0.0, 1.0))
+    out = np.ascontiguousarray(rgba, np.float32)
+    out.setflags(write=False)
+    return out
 
 
 @lru_cache(maxsize=None)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyjulia4d.pipeline import kernel_config, workload
+from pyjulia4d.pipeline import colormap, kernel_config, workload
 from pyjulia4d.pipeline.records import ClipArgs, LightArgs, MarchArgs, NormalsArgs, ShadeArgs, march_args
 from pyjulia4d.pipeline.path_plan import PathArgs, path_args, path_config, path_march_config, resolve_focus
 from pyjulia4d.pipeline.workload import resolve_outputs
@@ -113,7 +113,7 @@ def kernel_arguments(scene: Scene, frame: Frame, radius: float) -> dict:
                         background=tuple(sh.background), light_color=tuple(sh.light_color), sky=tuple(sh.sky),
                         ambient=sh.ambient, diffuse=sh.diffuse, specular=sh.specular, shininess=sh.shininess,
                         fog=sh.fog, fog_start=fog_start(frame.position, radius), reflection=sh.reflection,
-                        colormap=sh.colormap if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb,
+                        colormap=colormap.spec_of(sh) if sh.coloring != "flat" else None, lights_geo=geo, lights_rgb=rgb,
                         n_lights=len(sh.lights), light_radius=sh.light_radius,
                         lights_size=np.array([lt.radius for lt in sh.lights] or [0.0])))
 

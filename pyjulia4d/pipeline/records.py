@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -102,7 +103,7 @@ class ShadeArgs:
     fog: float
     fog_start: float       # the eye's distance to the bounding ball (fog_start)
     reflection: float
-    colormap: str | None   # shading.colormap where a colour map is used, else None
+    colormap: Any          # the colour table's spec (colormap.ColorSpec) where a colouring uses one, else None
     lights_geo: np.ndarray     # shading.lights (camera.extra_lights; one inert row where there are none)
     lights_rgb: np.ndarray
     n_lights: int = 0          # how many shading.lights there are

@@ -82,7 +82,7 @@ def execute(plan: Plan, t0: float | None = None) -> RenderResult:
         la = plan.light_args
         terms = light_terms(point, normal, status, bracket, frame, ma, la, sa.light, F) if la.used else None
         vis_extra = extra_visibility(point, normal, status, frame, ma, la, sa, F) if la.extra_shadow != "none" else None
-        lut = colormap.table(sa.colormap) if sa.colormap is not None else None
+        lut = colormap.table_of(sa.colormap) if sa.colormap is not None else None
         rgba = shade(status, normal, point, frame, sa, terms, lut, vis_extra, refl)
         return rgba, depth, point, status, smp, normal, guard, bracket, unresolved
 

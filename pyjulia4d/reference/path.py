@@ -55,7 +55,7 @@ class PathTwin:
         self.march = dataclasses.replace(plan.march, near=-1.0, far=-1.0)
         self.planes = list(plan.clip.planes)
         sa = plan.shade
-        self.lut = colormap.table(sa.colormap).astype(np.float64) if sa.colormap is not None else None
+        self.lut = colormap.table_of(sa.colormap).astype(np.float64) if sa.colormap is not None else None
         pa = plan.path
         self.env = EnvTwin(pa.environment, pa.env_x, pa.env_y, pa.env_z) if pa.environment is not None else None
 

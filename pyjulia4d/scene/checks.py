@@ -222,6 +222,50 @@ class Choice:
         return v
 
 
+class Stops:
+    """A colour gradient of ``least`` to ``most`` stops [position, r, g, b]: positions in [0, 1]
+    rising (or equal: a hard edge), sRGB colours in [0, 1]; [] for none.  On the command
+    line the same TOML array of arrays."""
+
+    verbatim = True
+
+    def __init__(self, least: int, most: int) -> None:
+        self.least, self.most = least, most
+        self.valid = (f"[] or {least} to {most} stops [position, r, g, b], positions in [0, 1] rising, "
+                      f"sRGB colours in [0, 1]")
+
+    def __call__(self, key: str, v: Any) -> tuple:
+        if isinstance(v, str):
+            import tomllib
+
+            text = v.strip()
+            try:
+                v = [] if text in ("", "[]") else tomllib.loads(f"v = {text}")["v"]
+            except tomllib.TOMLDecodeError as e:
+                raise SceneError(key, f"not a TOML array of stops ({' '.join(str(e).split())[:100]})") from None
+        if not isinstance(v, (list, tuple)):
+            raise SceneError(key, f"expected a list of stops [position, r, g, b], got {show(v)}")
+        if not v:
+            return ()
+        if not self.least <= len(v) <= self.most:
+            raise SceneError(key, f"expected {self.least} to {self.most} stops, got {len(v)}")
+        out = []
+        for i, stop in enumerate(v):
+            where = f"{key}[{i}]"
+            if not isinstance(stop, (list, tuple)) or len(stop) != 4:
+                raise SceneError(where, f"expected [position, r, g, b], got {show(stop)}")
+            nums = []
+            for x in stop:
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or not 0 <= x <= 1:
+                    raise SceneError(where, f"expected numbers in [0, 1], got {show(stop)}")
+                nums.append(float(x))
+            if out and nums[0] < out[-1][0]:
+                raise SceneError(where, f"position {nums[0]:g} is below the stop before's {out[-1][0]:g}: "
+                                        f"positions rise")
+            out.append(tuple(nums))
+        return tuple(out)
+
+
 class Vector:
     """A fixed-length list of numbers, each in [lo, hi]; a 3-vector where 4 are allowed
     gets w = 0.  ``nonzero``: a direction, any length but 0 (it is normalised by its

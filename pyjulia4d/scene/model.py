@@ -152,6 +152,10 @@ class Shading:
     ao_distance: float = 0.1       # how far along the normal occlusion is sampled
     coloring: str = "flat"         # "flat" | "iteration" | "trap" | "w"
     colormap: str = "viridis"      # a matplotlib colour map (COLORMAPS)
+    gradient: tuple = ()           # the user's own stops (position, r, g, b), sRGB; () the colour map
+    color_offset: float = 0.0      # the colour value's map: offset + scale v, then clamped,
+    color_scale: float = 1.0       # repeated or mirrored (pipeline/colormap.py)
+    color_repeat: str = "clamp"
     trap: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the orbit trap's point (coloring = "trap")
     fog: float = 0.0               # depth cueing: fade to the background by exp(-fog distance)
     sky: Vec3 = (1.0, 1.0, 1.0)    # colour of the ambient light (times ambient and occlusion)

@@ -10,7 +10,7 @@ from typing import Any
 
 from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS, KINDS
 from pyjulia4d.scene.checks import (COORD, INT_MAX, Bool, Checker, Choice, ImageFile, Integer, Lights, OrWord, Planes,
-                                    Real, SceneError, Vector, Whole)
+                                    Real, SceneError, Stops, Vector, Whole)
 from pyjulia4d.scene.quality import QUALITIES
 
 Vec3 = tuple[float, float, float]
@@ -128,6 +128,10 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "ao_distance": Real(1e-4, 10.0),
         "coloring": Choice("flat", "iteration", "trap", "w"),
         "colormap": Choice(*COLORMAPS, fold_case=True),
+        "gradient": Stops(2, 16),
+        "color_offset": Real(-1e3, 1e3),
+        "color_scale": Real(-1e3, 1e3),
+        "color_repeat": Choice("clamp", "repeat", "mirror"),
         "trap": Vector((3, 4), -COORD, COORD),
         "fog": Real(0.0, 100.0),
         "sky": Vector((3,), 0.0, 1e3),

@@ -113,6 +113,10 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
     if kind == "Planes":   # "" and "[]" are valid (no planes)
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["1,0,0", "0,0,0,1", "1,0,0,nan", "1,0,0,2e6", ";".join(["1,0,0,0"] * 5), "1,0,0,0;x"]
+    if kind == "Stops":   # "" and "[]" are valid (no gradient)
+        vals = [v for v in vals if v.strip() not in ("", "[]")]
+        return vals + ["[[0, 1, 0, 0]]", "[[0.5, 1, 0, 0], [0.2, 0, 0, 1]]", "[[0, 1, 0, 0], [1, 2, 0, 0]]",
+                       "[[0, 1, 0], [1, 0, 0, 1]]", "[[0, 1, 0, 0], [1, nan, 0, 0]]", "[[0, 1, 0, 0], [1"]
     if word:
         vals += [word.upper(), word + "s", f"[{word}]"]
     if inner_kind == "Real":
@@ -195,6 +199,9 @@ def _toml_wrong_types(key: str) -> list[str]:
     if kind == "Planes":   # [] is valid (no planes)
         vals = [v for v in vals if v != "[]"] + ["[[0, 0, 0, 1]]", "[1, 2, 3, 4]", "[[1, 0, 0, nan]]",
                                                 "[[1, 0, 0, true]]"]
+    if kind == "Stops":   # [] is valid (no gradient)
+        vals = [v for v in vals if v != "[]"] + ["[[0, 1, 0, 0]]", "[[0.5, 1, 0, 0], [0.2, 0, 0, 1]]",
+                                                "[[0, 1, 0, 0], [1, true, 0, 0]]", "[0, 1, 0, 0]"]
     if kind == "Bool":     # true is a boolean key's own type
         vals = [v for v in vals if v != "true"] + ["1", '"yes"']
     return vals

@@ -4,6 +4,7 @@ reference interfaces - each a one-line error naming the argument before anything
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import Path
 
 import pytest
@@ -395,3 +396,16 @@ def test_lights_take_the_scene_files_toml_on_the_command_line() -> None:
     assert toml.shading.lights == words.shading.lights and len(toml.shading.lights) == 2
     with pytest.raises(SceneError, match="not a TOML array of light tables"):
         Scene.default().with_overrides(["shading.lights=[{position = [1, 2, 3]"])
+
+
+@pytest.mark.parametrize("value, says", [
+    ([[0, 1, 0, 0]], "expected 2 to 16 stops, got 1"),
+    ([[0.5, 1, 0, 0], [0.2, 0, 0, 1]], "positions rise"),
+    ([[0, 1, 0, 0], [1, 2, 0, 0]], "expected numbers in [0, 1]"),
+    ([[0, 1, 0], [1, 0, 0, 1]], "expected [position, r, g, b]"),
+    ("[[0, 1, 0, 0], [1", "not a TOML array of stops"),
+])
+def test_a_bad_gradient_is_one_line(value, says) -> None:
+    with pytest.raises(SceneError, match=re.escape(says)) as e:
+        Scene.from_dict({"shading": {"gradient": value}})
+    assert "\n" not in str(e.value)

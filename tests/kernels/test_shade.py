@@ -77,6 +77,30 @@ def test_colormaps_exist_in_matplotlib():
         assert name in matplotlib.colormaps, name
 
 
+def test_a_colour_table_maps_the_value_then_the_gradient():
+    """colormap.table_of: a map's table unchanged where the value is not mapped (the renders of
+    before, bit for bit); with color_scale, color_offset and color_repeat the table holds the
+    map at offset + scale v, clamped, repeated or mirrored; a gradient's stops are its colours
+    there (linear light)."""
+    from pyjulia4d.pipeline import colormap as cm
+
+    assert np.array_equal(cm.table_of(cm.ColorSpec("viridis")), cm.table("viridis"))
+    base = cm.table("viridis").astype(np.float64)
+    v = np.linspace(0.013, 0.987, 97)
+    for repeat, want in (("clamp", np.clip(0.2 + 3 * v, 0, 1)), ("repeat", np.mod(0.2 + 3 * v, 1)),
+                         ("mirror", 1 - np.abs(np.mod(0.2 + 3 * v, 2) - 1))):
+        got = cm.lookup(cm.table_of(cm.ColorSpec("viridis", None, 0.2, 3.0, repeat)).astype(np.float64), v)
+        seam = np.abs(np.mod(0.2 + 3 * v + 0.5, 1) - 0.5) < 0.01   # a wrap between two entries
+        err = np.abs(got - cm.lookup(base, want)).max(axis=1)
+        # matplotlib's viridis is 256 flat bins: tables sampled at other values differ by a bin
+        assert err[~seam].max() < 0.025, (repeat, err[~seam].max())
+    stops = ((0.0, 0.0, 0.0, 0.0), (0.25, 1.0, 0.0, 0.0), (0.75, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0))
+    tab = cm.table_of(cm.ColorSpec("viridis", stops)).astype(np.float64)
+    got = cm.lookup(tab, np.array([0.0, 0.25, 0.75, 1.0]))
+    # a stop between two entries is a kink the table rounds by its spacing, 1/255
+    np.testing.assert_allclose(got, cm.srgb_to_linear(np.array([s[1:] for s in stops])), atol=0.02)
+
+
 def test_colormap_table_is_linear_light():
     from pyjulia4d.pipeline import colormap
     t = colormap.table("viridis")
@@ -107,6 +131,8 @@ LIGHT_SCENES = {
     "eye-and-lights-hard-fixed": ["march.method=fixed", "shading.light=eye", "shading.shadow=hard",
                                   "shading.lights=position -2,3,-3 intensity 0.7; direction 1,1,-1,0.2"],
     "reflection": ["shading.reflection=0.5", "shading.background=0.2,0.3,0.5"],
+    "gradient": ["shading.coloring=trap", "shading.gradient=[[0, 0.1, 0, 0.2], [0.5, 1, 0.4, 0], [1, 1, 1, 0.8]]",
+                 "shading.color_scale=3", "shading.color_offset=0.1", "shading.color_repeat=mirror"],
     "reflection-fixed-cut-eye": ["march.method=fixed", "shading.light=eye", "shading.reflection=0.3",
                                  "clip.planes=0,0,-1,0.1", "normals.method=gradient"],
     "mandelbrot-trap": ["fractal.kind=mandelbrot", "fractal.max_iter=10", "shading.coloring=trap",
@@ -121,7 +147,7 @@ LIGHT_SCENES = {
 
 # the default run samples the light scenes (each builds programs of its own from cold); the
 # rest, whose switches the sampled ones share, run with -m slow
-LIGHT_SAMPLE = ("default", "fog+trap+cut", "three-lights-soft", "reflection-fixed-cut-eye", "hypercomplex")
+LIGHT_SAMPLE = ("default", "fog+trap+cut", "three-lights-soft", "reflection-fixed-cut-eye", "hypercomplex", "gradient")
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=[] if n in LIGHT_SAMPLE else [pytest.mark.slow])
