@@ -76,6 +76,9 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     n = check_resolution(resolution)
+    if scene.clip.planes:   # refused, not ignored: a mesh without the cut the render shows is not that set
+        raise SceneError("clip.planes", "the mesh does not cut the set by clip planes (the render does); "
+                                        "mesh it whole with --set clip.planes= and cut it in your slicer")
     f = scene.fractal
     radius = set_radius(scene)   # the set's ball (the estimate march's shell is no part of the set)
     d = float(scene.slice.distance)

@@ -163,6 +163,7 @@ def test_smoothing_keeps_it_closed_and_its_volume():
     (["--decimate", "0"], "--decimate: expected the share of triangles to keep, in (0, 1], got 0.0"),
     (["--decimate", "half"], "--decimate: expected the share of triangles to keep, in (0, 1], got 'half'"),
     (["--size", "0"], "--size: expected the longest side in millimetres, in (0, 100000], got 0.0"),
+    (["--set", "clip.planes=0,1,0,0"], "clip.planes: the mesh does not cut the set by clip planes"),
     (["--size", "nan"], "--size: expected the longest side in millimetres"),
     (["--size", "1e9"], "--size: expected the longest side in millimetres"),
     (["-o", "x.fbx"], "x.fbx: unsupported mesh format '.fbx' (use .stl, .ply, .obj or .glb)"),
