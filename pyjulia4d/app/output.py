@@ -123,6 +123,22 @@ def to_levels(x: np.ndarray, bits: int) -> np.ndarray:
     return np.rint(np.clip(x, 0.0, 1.0) * 65535.0).astype(np.uint16)
 
 
+def straight_colour(color: np.ndarray, alpha: np.ndarray, background) -> np.ndarray:
+    """The colour a PNG's or TIFF's straight alpha wants: a pixel the set covers in part was
+    rendered as a c + (1 - a) background (its samples that missed saw the background), so its
+    own colour is (colour - (1 - a) background) / a; pixels wholly covered or wholly missed
+    keep theirs.  ``color`` is copied only where some pixel is covered in part."""
+    a = np.asarray(alpha)
+    part = (a > 0) & (a < 1)
+    if not part.any():
+        return color
+    out = np.array(color, np.float32)
+    ap = a[part].astype(np.float32)[:, None]
+    bg = np.asarray(background, np.float32)[None, :3]
+    out[part] = np.maximum((out[part] - (1 - ap) * bg) / ap, 0.0)
+    return out
+
+
 def rgba_levels(color: np.ndarray, alpha: np.ndarray | None, bits: int = 8) -> np.ndarray:
     """(H, W, 4) integers of ``bits`` (8 or 16) from ``color`` (H, W, 3), linear light, and
     ``alpha`` (H, W) in [0, 1]: the colour clipped to [0, 1] and sRGB-encoded (the renderer
@@ -167,7 +183,7 @@ def write_png(
     bits: int = 8,
 ) -> None:
     """RGBA PNG of ``bits`` per channel (8 or 16: image.bits) from ``color`` and ``alpha``
-    (rgba_levels).  ``text`` entries become iTXt chunks (UTF-8, unlike tEXt's Latin-1).
+    (rgba_levels; RGB where ``alpha`` is None: image.alpha false).  ``text`` entries become iTXt chunks (UTF-8, unlike tEXt's Latin-1).
     Pillow writes 8 bits; pypng 16, its chunks with the text added before IEND."""
     rgba = np.ascontiguousarray(rgba_levels(color, alpha, bits))
     if bits == 8:
@@ -185,7 +201,7 @@ def write_png(
 
     h, w = rgba.shape[:2]
     buf = io.BytesIO()
-    png.Writer(w, h, greyscale=False, alpha=True, bitdepth=16).write_packed(
+    png.Writer(w, h, greyscale=False, alpha=rgba.shape[2] == 4, bitdepth=16).write_packed(
         buf, (row.astype(">u2").tobytes() for row in rgba))
     chunks = list(png.Reader(bytes=buf.getvalue()).chunks())
     chunks[-1:-1] = [(b"iTXt", _itxt(k, v)) for k, v in (text or {}).items()]
@@ -208,8 +224,8 @@ def write_tiff(
 
     rgba = np.ascontiguousarray(rgba_levels(color, alpha, bits))
     with atomic_write(path) as tmp:
-        tifffile.imwrite(tmp, rgba, photometric="rgb", extrasamples=["unassalpha"], compression="zlib",
-                         description=json.dumps(dict(text or {})), metadata=None)
+        tifffile.imwrite(tmp, rgba, photometric="rgb", extrasamples=["unassalpha"] if rgba.shape[2] == 4 else None,
+                         compression="zlib", description=json.dumps(dict(text or {})), metadata=None)
 
 
 EXR_BAND_ROWS = 64   # rows written at a time (write_exr)
@@ -320,10 +336,15 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
     try:
         if _suffix(p) in (".png",) + TIFF:
             from pyjulia4d.pipeline.tonemap import display
-            color = result.color
-            if scene is not None and color is not None:   # exposure and tone map: the picture's, not an EXR's
+            color, alpha = result.color, result.alpha
+            if scene is not None and color is not None:
+                if not scene.image.alpha:   # opaque: the picture on shading.background, as rendered
+                    alpha = None
+                elif alpha is not None:     # straight alpha: the background out of the edges' colour
+                    color = straight_colour(color, alpha, scene.shading.background)
+                # exposure and tone map: the picture's, not an EXR's
                 color = display(color, scene.image.exposure, scene.image.tonemap)
-            (write_png if _suffix(p) == ".png" else write_tiff)(p, color, result.alpha, header, bits)
+            (write_png if _suffix(p) == ".png" else write_tiff)(p, color, alpha, header, bits)
         else:
             from pyjulia4d.app.exr_layout import exr_output
 

@@ -86,6 +86,7 @@ MEANINGS = {
     "image.samples": "rays per pixel (stratified), or paths per pixel (path); colour and alpha are their mean",
     "image.adaptive": "with samples > 1: supersample only pixels on an edge",
     "image.bits": "bits per channel of a PNG or TIFF (sRGB-encoded); EXR is float32",
+    "image.alpha": "a PNG or TIFF with alpha (the set alone, clean edges) or opaque (on shading.background)",
     "image.exr": "an EXR's channels: pyjulia4d's own, or Blender's multilayer passes (premultiplied RGBA, depth, normal, position)",
     "image.noise": "path: stop a pixel's samples once its stated noise (standard error of the luminance) is this low; 0 off",
     "image.exposure": "stops of brightness before the tone map (PNG, TIFF, video; never EXR)",

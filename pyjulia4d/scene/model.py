@@ -185,6 +185,7 @@ class Image:
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
     bits: int = 8         # per channel of a PNG or TIFF (app/output.py); EXR is float32 always
+    alpha: bool = True    # a PNG's or TIFF's alpha (straight: the background taken out of edge pixels); false: opaque
     exr: str = "pyjulia4d"   # an EXR's channels: pyjulia4d's own, or the passes compositors read (app/exr_layout.py)
     noise: float = 0.0    # path: stop a pixel's samples once its stated noise is this low (0: take them all)
     exposure: float = 0.0   # stops of brightness applied before the tone map

@@ -150,6 +150,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "samples": Integer(1, 65536),
         "adaptive": Bool(),
         "bits": Whole(8, 16),
+        "alpha": Bool(),
         "exr": Choice("pyjulia4d", "compositing"),
         "noise": Real(0.0, 1.0),
         "exposure": Real(-20.0, 20.0),

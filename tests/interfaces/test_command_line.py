@@ -67,7 +67,7 @@ def test_keys_section_and_bad_section(capsys) -> None:
     assert cli.main(["keys", "image"]) == 0
     out = capsys.readouterr().out
     assert [ln.split(" = ")[0] for ln in out.splitlines() if not ln.startswith(" ")] == \
-        ["image.width", "image.height", "image.samples", "image.adaptive", "image.bits",
+        ["image.width", "image.height", "image.samples", "image.adaptive", "image.bits", "image.alpha",
          "image.exr", "image.noise", "image.exposure", "image.tonemap", "image.denoise"]
     assert cli.main(["keys", "octonion"]) == 2
     err = capsys.readouterr().err

@@ -1,6 +1,7 @@
 """PNG/EXR writers: content, metadata, atomicity."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import threading
@@ -263,3 +264,31 @@ def test_signal_while_creating_the_temp_file_is_deferred(tmp_path, monkeypatch, 
         done.set()
         other.join()
     assert len(calls) == call and _names(tmp_path) == []
+
+
+def test_png_edges_are_the_sets_own_colour_or_opaque(tmp_path):
+    """Straight alpha: an edge pixel the set covers in part holds the set's colour, the
+    background its missed samples saw taken out, so composited over that background it is the
+    render again (to 8-bit rounding); with image.alpha = false the PNG is opaque RGB, the
+    picture on shading.background as rendered."""
+    from pyjulia4d import Scene, render
+    from pyjulia4d.pipeline.colormap import linear_to_srgb, srgb_to_linear
+
+    s = Scene.default().with_overrides(["shading.background=0,0.8,0", "image.samples=4", "image.width=96",
+                                        "image.height=72"])
+    r = render(s)
+    out = tmp_path / "a.png"
+    output.write_image(out, r)
+    px = np.asarray(Image.open(out)).astype(np.float64) / 255
+    a = r.alpha.astype(np.float64)
+    part = (a > 0.2) & (a < 0.8)
+    assert part.sum() > 20
+    over = px[..., :3] * 0 + srgb_to_linear(px[..., :3]) * a[..., None] + (1 - a[..., None]) * np.array([0, 0.8, 0])
+    got, want = linear_to_srgb(over[part]), linear_to_srgb(np.clip(r.color[part], 0, 1))
+    assert np.abs(got - want).max() < 3 / 255 / np.min(a[part]) + 1e-3
+    opaque = tmp_path / "o.png"
+    output.write_image(opaque, dataclasses.replace(r, scene=s.with_overrides(["image.alpha=false"])))
+    with Image.open(opaque) as im:
+        assert im.mode == "RGB"
+        rgb = np.asarray(im).astype(np.float64) / 255
+    assert np.abs(rgb - linear_to_srgb(np.clip(r.color, 0, 1))).max() <= 0.5 / 255 + 1e-6
