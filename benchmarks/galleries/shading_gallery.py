@@ -1,5 +1,6 @@
 """README's shading gallery: the default scene plain, with shadows and ambient occlusion,
-with each colouring, antialiased and cut open, rendered side by side.
+with each colouring, antialiased, cut open, in a gradient of its own and turned through w,
+rendered side by side.
 
 Writes benchmarks/results/shading/<name>.png (320x240 by default), a contact sheet
 sheet.png with the name under each picture, and appends a section with each picture's
@@ -41,6 +42,10 @@ SCENES = {
     "cut open (z >= 0 kept)": ["clip.planes=0,0,-1,0"],
     "cut open, orbit trap, 4 samples": ["clip.planes=0,0,-1,0", "shading.coloring=trap",
                                         "shading.colormap=inferno", "image.samples=4"],
+    "own gradient, mirrored 3 times (trap)": [
+        "shading.coloring=trap", "shading.color_scale=3", "shading.color_repeat=mirror",
+        "shading.gradient=[[0, 0.05, 0.02, 0.1], [0.5, 0.8, 0.3, 0.1], [1, 1, 0.9, 0.6]]"],
+    "turned 30 degrees from x into w": ["slice.turn=0,0,30,0,0,0"],
 }
 
 
