@@ -62,7 +62,8 @@ def main(argv=None) -> int:
     folder.mkdir(parents=True, exist_ok=True)
     rows, tiles = [], []
     for name, over in SCENES.items():
-        s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}"])
+        # framed (camera.fit from the default camera's direction): the whole set in each picture
+        s = Scene.default().with_overrides(["camera.fit=true"] + over + [f"image.width={w}", f"image.height={h}"])
         render(s)                                   # build
         t0 = time.perf_counter()
         r = render(s)
