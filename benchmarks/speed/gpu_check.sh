@@ -11,9 +11,15 @@
 #
 # Nothing of this is a dependency: without a GPU it says so and stops (status 3).
 # PY names the Python there (default python3); WHEEL_PY its version for --fetch (3.12);
-# DEVICE=cpu runs the same checks on the CPU, a dry run of this script.
+# DEVICE=cpu runs the same checks on the CPU, a dry run of this script; DEVICE=oclgrind on
+# the OpenCL simulator, with tiny sizes (tests/devices/test_gpu_check.py runs it so, so that
+# it cannot rot).  SIZES (default "640x480 3840x2160"), PATH_SIZE (640x480: the path
+# tracer's paths per second, at PATH_SAMPLES paths per pixel), THROUGHPUT_SIZE (640x480),
+# WIDTHS (the throughput's packet widths, default 1: a GPU runs one ray per work-item),
+# REPEATS (10), THROUGHPUT_SCENES (3), PEAK_ITEMS (the FMA peak kernel's work-items, 65536)
+# and TESTS (the kernel test files) shrink it.
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 PY=${PY:-python3}
 OUT=${OUT:-benchmarks/results/gpu}
 DEVICE=${DEVICE:-gpu}
@@ -51,21 +57,34 @@ if ! grep -qs nvidia /etc/OpenCL/vendors/*.icd; then
 fi
 export PYJULIA4D_CACHE=/tmp/gpu_cache PYTHONUNBUFFERED=1
 "$PY" -m pyjulia4d devices 2>&1 | tee "$OUT/devices.txt"
-if [ "$DEVICE" = gpu ] && ! "$PY" -c "import pyopencl as cl, sys; sys.exit(not any(d.type & cl.device_type.GPU for p in cl.get_platforms() for d in p.get_devices()))" 2>/dev/null; then
+# a GPU that is not a simulator (Oclgrind presents itself as one): pyjulia4d's own choice
+if [ "$DEVICE" = gpu ] && ! "$PY" -c "from pyjulia4d.opencl.devices import select_device; select_device('gpu')" 2>/dev/null; then
     echo "gpu_check: no OpenCL GPU found (nvidia-smi: $(nvidia-smi -L 2>&1 | head -1)); nothing run"
     exit 3
 fi
 export PYJULIA4D_DEVICE=$DEVICE
+SIZES=${SIZES:-640x480 3840x2160}
+REPEATS=${REPEATS:-10}
+TESTS=${TESTS:-tests/kernels/test_rays.py tests/kernels/test_iterate.py tests/kernels/test_march.py \
+    tests/kernels/test_cone.py tests/kernels/test_normals.py tests/kernels/test_shade.py tests/kernels/test_path.py \
+    tests/kernels/test_variants.py tests/kernels/test_algebras.py tests/kernels/test_kinds.py \
+    tests/render/test_render.py tests/render/test_bit_identity.py}
 status=0
 # each kernel stage against its float64 twin, the variants, whole renders and the bit-for-bit
 # checks, on the GPU (each test file picks the device from PYJULIA4D_DEVICE)
-timeout 300 "$PY" -m pytest -q -n "${JOBS:-8}" -p no:cacheprovider tests/kernels/test_rays.py tests/kernels/test_iterate.py \
-    tests/kernels/test_march.py tests/kernels/test_cone.py tests/kernels/test_normals.py tests/kernels/test_shade.py tests/kernels/test_variants.py \
-    tests/kernels/test_algebras.py tests/kernels/test_kinds.py tests/render/test_render.py tests/render/test_bit_identity.py 2>&1 \
-    | tee "$OUT/tests.txt" | tail -25 || status=1
-for size in 640x480 3840x2160; do
-    timeout 120 "$PY" benchmarks/speed/render_time.py --device "$DEVICE" --repeats 10 --out "$OUT" \
+timeout 300 "$PY" -m pytest -q -n "${JOBS:-8}" -p no:cacheprovider $TESTS 2>&1 \
+    | tee "$OUT/tests.txt" | tail -25
+[ "${PIPESTATUS[0]}" = 0 ] || status=1
+for size in $SIZES; do
+    timeout 120 "$PY" benchmarks/speed/render_time.py --device "$DEVICE" --repeats "$REPEATS" --out "$OUT" \
         --set "image.width=${size%x*}" --set "image.height=${size#*x}" || status=1
 done
-timeout 200 "$PY" benchmarks/speed/throughput.py --device "$DEVICE" --repeats 3 --out "$OUT" 2>&1 | tail -30 || status=1
+# the path tracer: its paths per second on the default scene
+size=${PATH_SIZE:-640x480}
+timeout 300 "$PY" benchmarks/speed/render_time.py --device "$DEVICE" --repeats "$REPEATS" --out "$OUT" \
+    --set "image.width=${size%x*}" --set "image.height=${size#*x}" --set shading.integrator=path \
+    --set "image.samples=${PATH_SAMPLES:-16}" || status=1
+timeout 200 "$PY" benchmarks/speed/throughput.py --device "$DEVICE" --repeats 3 --size "${THROUGHPUT_SIZE:-640x480}" \
+    --widths "${WIDTHS:-1}" --scenes "${THROUGHPUT_SCENES:-3}" --peak-items "${PEAK_ITEMS:-65536}" --out "$OUT" 2>&1 | tail -30
+[ "${PIPESTATUS[0]}" = 0 ] || status=1
 exit $status

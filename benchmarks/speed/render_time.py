@@ -4,7 +4,8 @@
 
 The first render builds the OpenCL program (reported separately as "first");
 the median of the following renders is the steady-state time, whole render and
-kernels alone.  Writes render_time.md (appends a row per run) with device, date
+kernels alone; a path-traced scene's paths per second (width x height x image.samples over
+the median) beside its keys.  Writes render_time.md (appends a row per run) with device, date
 and git commit; with no --set it also saves default.png, README's picture.
 """
 from __future__ import annotations
@@ -42,8 +43,11 @@ def main(argv=None) -> None:
     whole = statistics.median(r.seconds for r in runs)
     kern = statistics.median(r.kernel_seconds for r in runs)
     w, h = scene.image.width, scene.image.height
+    what = ' '.join(a.set) or 'default'
+    if scene.shading.integrator == "path":   # the path tracer's rate: every pixel's paths over the median
+        what += f" ({w * h * scene.image.samples / whole:.3g} paths/s)"
     row = (f"| {datetime.date.today()} | {git_commit()} | {first.device_name} | {w}x{h} | "
-           f"{' '.join(a.set) or 'default'} | {first_s:.2f} | {whole:.3f} | {kern:.3f} | "
+           f"{what} | {first_s:.2f} | {whole:.3f} | {kern:.3f} | "
            f"{first.hit_fraction:.1%} |")
     head = ("| date | commit | device | size | overrides | first render s (with build) | "
             "median render s | median kernels s | hit |\n|---|---|---|---|---|---|---|---|---|\n")

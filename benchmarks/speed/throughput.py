@@ -20,7 +20,8 @@ derivative: 2 more), so the share of peak is it/s x 20 / peak.
 
 Writes benchmarks/results/throughput.md (appends a section per run: device, date, commit).
 
-    python benchmarks/speed/throughput.py [--repeats 5] [--device SPEC] [--size 640x480]
+    python benchmarks/speed/throughput.py [--repeats 5] [--device SPEC] [--size 640x480] [--widths 1,4,8,16]
+                                          [--scenes 3] [--peak-items 65536]
 """
 from __future__ import annotations
 
@@ -98,14 +99,13 @@ import json, sys, time
 import numpy as np
 import pyopencl as cl
 from pyjulia4d.opencl.devices import build, select_device
-spec, width, double, src = sys.argv[1] or None, int(sys.argv[2]), sys.argv[3] == "1", sys.stdin.read()
+spec, width, double, n, src = sys.argv[1] or None, int(sys.argv[2]), sys.argv[3] == "1", int(sys.argv[4]), sys.stdin.read()
 dev = select_device(spec)
 ctx = cl.Context([dev]); q = cl.CommandQueue(ctx)
 opts = [f"-DW={width}"] + (["-DDOUBLE"] if double else [])
 prg = build(cl.Program(ctx, src), opts)
 k = prg.fma_peak
 dt = np.float64 if double else np.float32
-n = 1 << 16
 out = cl.Buffer(ctx, cl.mem_flags.WRITE_ONLY, n * 8)
 k(q, (n,), (64,), out, dt(0.999999), dt(1e-7)); q.finish()
 ts = []
@@ -117,11 +117,11 @@ print(json.dumps({"flops": 2.0 * width * 8 * 512 * n / t, "seconds": t}))
 """
 
 
-def fma_peak(spec: str | None, width: int, double: bool) -> dict:
-    """flop/s of the FMA kernel at one width, measured in a child process (a crash of the
-    OpenCL compiler or runtime is reported, not suffered)."""
+def fma_peak(spec: str | None, width: int, double: bool, items: int = 1 << 16) -> dict:
+    """flop/s of the FMA kernel at one width over ``items`` work-items, measured in a child
+    process (a crash of the OpenCL compiler or runtime is reported, not suffered)."""
     w = 1 if width == 1 else width
-    p = subprocess.run([sys.executable, "-c", CHILD, spec or "", str(w), "1" if double else "0"],
+    p = subprocess.run([sys.executable, "-c", CHILD, spec or "", str(w), "1" if double else "0", str(items)],
                        input=FMA_SOURCE, capture_output=True, text=True, cwd=ROOT, timeout=300)
     if p.returncode != 0:
         why = f"signal {-p.returncode}" if p.returncode < 0 else (p.stderr.strip().splitlines() or ["?"])[-1]
@@ -186,6 +186,9 @@ def main(argv=None) -> int:
     ap.add_argument("--device", default=None)
     ap.add_argument("--size", default="640x480")
     ap.add_argument("--widths", default="1,4,8,16")
+    ap.add_argument("--scenes", type=int, default=len(SCENES), help=f"the first N of the {len(SCENES)} scenes")
+    ap.add_argument("--peak-items", type=int, default=1 << 16,
+                    help="work-items of the FMA peak kernel (default 65536; a simulator takes a few hundred)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")
@@ -196,7 +199,7 @@ def main(argv=None) -> int:
     peak = {}
     for prec in ("single", "double"):
         for width in (int(x) for x in a.widths.split(",")):
-            r = fma_peak(a.device, width, prec == "double")
+            r = fma_peak(a.device, width, prec == "double", max(64, a.peak_items // 64 * 64))
             label = "float" if prec == "single" else "double"
             lines.append(f"| {prec} | {label}{'' if width == 1 else width} | "
                          + (f"{r['flops']:.3g}" if "error" not in r else f"failed: {r['error']}") + " |")
@@ -207,7 +210,7 @@ def main(argv=None) -> int:
               "march kernel s (median) | iterations/s | share of the FMA peak (20 flops each) | "
               "pixels hit |", "|---|---|---|---|---|---|---|---|"]
     auto = {prec: lanes_for(dev, "packet", prec == "double") for prec in ("single", "double")}
-    for name, over in SCENES.items():
+    for name, over in list(SCENES.items())[:max(1, a.scenes)]:
         for prec in ("single", "double"):
             s = Scene.default().with_overrides(over + [f"image.width={w}", f"image.height={h}",
                                                        f"render.float={prec}"])

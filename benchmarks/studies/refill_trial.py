@@ -61,6 +61,7 @@ def main(argv=None) -> int:
     import pyopencl.array as cla
 
     from pyjulia4d import Scene, render
+    from pyjulia4d.opencl.build import options
     from pyjulia4d.opencl.devices import build, device_of
     from pyjulia4d.opencl.runner import TileRunner, launch
     from pyjulia4d.pipeline import kernel_config
@@ -80,7 +81,7 @@ def main(argv=None) -> int:
     q, tile = runner.queue, plan.tiles[0]
     cfg = plan.march_config
     src = kernel_config.source(cfg) + "\n" + (Path(__file__).resolve().parent / "refill_trial.cl").read_text()
-    prg = build(cl.Program(runner.ctx, src), [f"-D{d}" for d in cfg.defines])
+    prg = build(cl.Program(runner.ctx, src), options(cfg, runner.ctx.devices[0]))
     cone = runner.slots[0][0]["cone"]
     bx0, by0, bw, bh = tile.cone_blocks()
     launch(q, runner.cone_k, bw * bh, *runner.cone_args(blocks_w=bw, bx0=bx0, by0=by0, cone=cone), lanes=lanes).wait()

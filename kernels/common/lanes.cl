@@ -2,6 +2,9 @@
  * -D REAL_DOUBLE builds the double-precision variant (needs cl_khr_fp64);
  * the default is float, which is what GPUs run fast. */
 #ifdef REAL_DOUBLE
+#if !defined(DEV_FP64) && defined(DEV_CL_C)
+#error "double precision (REAL_DOUBLE) on a device without cl_khr_fp64"
+#endif
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double real;
 typedef double4 real4;
@@ -70,8 +73,13 @@ inline float3 UNIT3(float3 a, float3 fallback)
  * the gradient normals 0.3x).  Every work-item of a sub-group must reach sub_group_any,
  * those past the end too.  The vector's test stays apart from the lane's own: joined in one
  * condition, the compiler made it a lane branch again (the shade kernel 2.15 ms, not 1.05).
- * Without sub-groups, each work-item branches alone, as GPUs do anyway. */
-#if defined(cl_intel_subgroups)
+ * Without sub-groups, each work-item branches alone, as GPUs do anyway.  DEV_SUBGROUPS is
+ * the device's answer, not the compiler's macro (pyjulia4d/opencl/capabilities.py: a
+ * compiler may define cl_intel_subgroups and not link sub_group_any). */
+#if defined(DEV_SUBGROUPS)
+#ifdef DEV_KHR_SUBGROUPS
+#pragma OPENCL EXTENSION cl_khr_subgroups : enable
+#endif
 #define GROUP_ANY(x) sub_group_any(x)
 #else
 #define GROUP_ANY(x) (x)

@@ -157,19 +157,10 @@ def _cluster_options(p: argparse.ArgumentParser, units: str) -> None:
 
 
 def select_device(spec: str | None) -> Any:
-    """devices.select_device, imported late: pyopencl is slow to import.  The default device
-    (``spec`` None) is looked up with only its runtime loaded where it was remembered, and
-    remembered where it was not (opencl/default_device.py)."""
-    from pyjulia4d.opencl import default_device, runtimes
-    from pyjulia4d.opencl.devices import default_reason, indexed_devices
-    from pyjulia4d.opencl.devices import select_device as select
+    """default_device.select, imported late: pyopencl is slow to import."""
+    from pyjulia4d.opencl import default_device
 
-    if spec is None:
-        default_device.narrow()
-    dev = select(spec)
-    if spec is None and not runtimes.narrowed:
-        default_device.remember(dev, indexed_devices(), default_reason(dev))
-    return dev
+    return default_device.select(spec)
 
 
 def _size_overrides(args: argparse.Namespace) -> list[str]:
@@ -237,9 +228,20 @@ def _render(args: argparse.Namespace) -> int:
         device = select_device(args.device)
 
         from pyjulia4d.opencl.executor import render  # heavy (kernel build); only once the input is known good
+        from pyjulia4d.opencl.failures import DeviceFailure
 
         store = store_for(scene, outputs, out)
-        result = render(scene, device=device, progress=True, force=args.force, outputs=outputs, store=store)
+        from pyjulia4d.opencl import default_device
+
+        try:
+            result = render(scene, device=device, progress=True, force=args.force, outputs=outputs, store=store,
+                            fallback=args.device is None)
+        except DeviceFailure:
+            if args.device is None:   # the remembered default failed where it alone was loaded
+                default_device.again_with_every_runtime()
+            raise
+        if result.fell_back:   # the remembered default failed: the next command chooses again among all
+            default_device.forget()
     header, tail = render_header(scene, result)
     if store is not None:
         store.release()   # the report's arrays, read whole
@@ -453,7 +455,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with _signals_raise():
             if args.command == "devices":
-                from pyjulia4d.opencl.devices import describe_devices
+                from pyjulia4d.opencl.listing import describe_devices
 
                 print(describe_devices())
                 return 0
@@ -477,6 +479,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _render(args)
     except ValueError as e:  # SceneError, OutputError, DeviceError and render's own
         _say(f"pyjulia4d: error: {one_line(e)}")
+        return 2
+    except Exception as e:   # an OpenCL error no step named (opencl/failures.py names the render's)
+        if type(e).__module__.partition(".")[0] != "pyopencl":
+            raise
+        _say(f"pyjulia4d: error: OpenCL: {one_line(e)}")
         return 2
     except KeyboardInterrupt:
         _say("pyjulia4d: interrupted")

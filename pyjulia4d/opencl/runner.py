@@ -16,6 +16,7 @@ import pyopencl as cl
 import pyopencl.array as cla
 
 from pyjulia4d.opencl import build, pool
+from pyjulia4d.opencl.failures import DeviceFailure, kernel_name, launched
 from pyjulia4d.opencl.records import Packed, Precision, float4
 from pyjulia4d.pipeline import colormap, kernel_config, signatures as sig
 from pyjulia4d.pipeline.plan import Plan, Tile
@@ -112,7 +113,11 @@ def launch(queue: cl.CommandQueue, kernel: cl.Kernel, n: int, *args, lanes: int 
     type_arguments(kernel, (np.int32(n),) + args)
     loc = local_size(kernel, queue.device)
     items = -(-n // lanes) if items is None else items
-    return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
+    launched(kernel)
+    try:
+        return kernel(queue, (-(-items // loc) * loc,), (loc,), np.int32(n), *args)
+    except cl.Error as e:   # refused, or out of resources: one line naming the device and kernel
+        raise DeviceFailure(queue.device, f"running kernel '{kernel_name(kernel)}'", e) from None
 
 
 # Small read-only arrays the kernels take (colour map, lights), kept by context and content:

@@ -47,6 +47,7 @@ class RenderResult:
     march_method: str = ""       # the march that ran: "fixed", "de" or "proven" (the plan's)
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran
     film: Film | None = None     # a path-traced render's samples, variance and stated noise (pipeline/film.py)
+    fell_back: str = ""          # the devices that failed before this one took the render over (opencl/failures.py)
 
     def __repr__(self) -> str:
         h, w = next(a.shape[:2] for a in (self.color, self.depth, self.bracket, self.alpha) if a is not None)
@@ -150,6 +151,8 @@ class RenderResult:
             "pyjulia4d.space_proven": "yes" if self.proven else "no",
             "pyjulia4d.unresolved_pixels": f"hit={un['hit']} miss={un['miss']}",
         }
+        if self.fell_back:
+            header["pyjulia4d.device_failed"] = self.fell_back
         fired = [f"{k} {v}" for k, v in self.guards.items() if v]
         tail = f", {self.capped} capped" if self.capped else ""
         tail += f"; guards fired: {', '.join(fired)}" if fired else ""

@@ -161,6 +161,7 @@ class FakeResult:
         self.hit_fraction = 0.412
         self.capped = 0
         self.guards = {"ulp_step": 0, "normal_fallback": 0}
+        self.fell_back = ""
 
     def exr_channels(self) -> dict[str, np.ndarray]:
         return {"R": self.color[..., 0], "A": self.alpha}
@@ -176,7 +177,8 @@ class FakeRender:
         self.calls: list[tuple] = []
         self.exc: BaseException | None = None
 
-    def __call__(self, scene, device=None, progress=False, force=False, outputs=None, store=None) -> FakeResult:
+    def __call__(self, scene, device=None, progress=False, force=False, outputs=None, store=None,
+                 fallback=None) -> FakeResult:
         self.calls.append((scene, device, progress))
         if self.exc is not None:
             raise self.exc

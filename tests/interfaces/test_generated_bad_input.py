@@ -651,12 +651,12 @@ class Result:
         self.color = np.full((h, w, 3), 0.5, np.float32)
         self.alpha = np.ones((h, w), np.float32)
         self.device_name, self.seconds, self.hit_fraction, self.capped = "stand-in", 0.1, 0.5, 0
-        self.guards = {}
+        self.guards, self.fell_back = {}, ""
 
     def report(self, stated_p99=None):
         return {}, ""
 
-def render(scene, device=None, progress=False, force=False, outputs=None, store=None):
+def render(scene, device=None, progress=False, force=False, outputs=None, store=None, fallback=None):
     if phase == "render":
         print("rendering", file=sys.stderr, flush=True)
         time.sleep(60)

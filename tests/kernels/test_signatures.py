@@ -14,6 +14,7 @@ import pytest
 
 from harness import device
 from pyjulia4d import Scene
+from pyjulia4d.opencl import build
 from pyjulia4d.opencl.runner import queue_for
 from pyjulia4d.pipeline import kernel_config, signatures
 from pyjulia4d.pipeline.kernel_config import KernelConfig
@@ -73,7 +74,7 @@ def test_kernel_parameters_match_their_signature(name: str) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cl.CompilerWarning)
         prg = cl.Program(ctx, K.source(config)).build(
-            options=[f"-D{d}" for d in config.defines] + ["-cl-kernel-arg-info"], cache_dir=False)
+            options=build.options(config, device()) + ["-cl-kernel-arg-info"], cache_dir=False)
     kernels = prg.all_kernels()
     assert kernels
     for k in kernels:

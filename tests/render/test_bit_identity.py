@@ -67,14 +67,14 @@ import json, sys, warnings
 warnings.simplefilter("ignore")
 import numpy as np
 from pyjulia4d import Scene, render
-scenes, out = json.loads(sys.argv[1]), sys.argv[2]
+scenes, out, dev = json.loads(sys.argv[1]), sys.argv[2], sys.argv[3]
 arrays = {}
 for name, keys in scenes.items():
     # "custom", the default of BASE: the default since ("auto") renders sets without an estimate
     # with the proven march, which BASE does not have
     size = ["image.width=40", "image.height=30", "march.quality=custom"]
     scene = Scene.from_dict({}, size) if keys is None else Scene.default().with_overrides(size + keys)
-    r = render(scene)
+    r = render(scene, device=dev)
     for k in ("color", "alpha", "depth", "bracket", "normal", "position", "status", "samples"):
         a = getattr(r, k, None)
         if a is not None:
@@ -84,7 +84,7 @@ for name, keys in scenes.items():
     arrays[f"{name}.scene"] = np.array((r.scene or scene).to_toml())
 # a region of the default render: the unit of a cluster's tiles (distributed.render_tiled)
 r = render(Scene.default().with_overrides(["image.width=40", "image.height=30", "march.quality=custom"]),
-           region=(8, 4, 17, 13))
+           region=(8, 4, 17, 13), device=dev)
 for k in ("color", "depth", "bracket", "normal", "status"):
     arrays[f"region.{k}"] = getattr(r, k)
 np.savez(out, **arrays)
@@ -109,7 +109,11 @@ def _base_tree(tmp: Path) -> Path | None:
 def _render_with(code_root: Path, out: Path, scenes: dict) -> dict[str, np.ndarray]:
     env = dict(os.environ, PYTHONPATH=str(code_root))
     env.pop("OCL_ICD_VENDORS", None)   # each child registers the runtimes itself, as any process does
-    p = subprocess.run([sys.executable, "-c", CHILD, __import__("json").dumps(scenes), str(out)],
+    # the device by its index, the same in both: BASE took any GPU as its default, a simulator too
+    from harness import device
+    from pyjulia4d.opencl.lanes import device_spec
+
+    p = subprocess.run([sys.executable, "-c", CHILD, __import__("json").dumps(scenes), str(out), device_spec(device())],
                        cwd=code_root, env=env, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr[-2000:]
     with np.load(out, allow_pickle=False) as z:

@@ -190,7 +190,7 @@ def test_device_keys_are_made_once_per_device() -> None:
 
 
 def test_devices_says_the_default_and_the_registration() -> None:
-    from pyjulia4d.opencl.devices import describe_devices
+    from pyjulia4d.opencl.listing import describe_devices
 
     lines = describe_devices().splitlines()
     assert sum(line.endswith("(default)") for line in lines) == 1
