@@ -65,13 +65,17 @@ new MutationObserver((records) => {
 }).observe(document, {subtree: true, attributes: true, attributeFilter: ['data-count']});
 """
 
-CHANGE = """
-const [value, done] = [arguments[0], arguments[arguments.length - 1]];
+# a change of c[1]'s field, as a user types it: the start of CHANGE and REST (value: arguments[0])
+SET_C = """
+const done = arguments[arguments.length - 1];
 const n0 = window.__arrivals.length;
 const field = document.getElementsByName('fractal.c[1]')[0];
 const t0 = performance.now();
-field.value = value;
+field.value = arguments[0];
 field.dispatchEvent(new Event('change', {bubbles: true}));
+"""
+
+CHANGE = SET_C + """
 const poll = () => {
     const got = window.__arrivals.slice(n0);
     const fin = got.find(a => a[1] === 'final');
@@ -101,13 +105,8 @@ const tick = setInterval(() => {
 """
 
 
-REST = """
-const [value, batches, done] = [arguments[0], arguments[1], arguments[arguments.length - 1]];
-const n0 = window.__arrivals.length;
-const field = document.getElementsByName('fractal.c[1]')[0];
-const t0 = performance.now();
-field.value = value;
-field.dispatchEvent(new Event('change', {bubbles: true}));
+REST = SET_C + """
+const batches = arguments[1];
 const poll = () => {
     const got = window.__arrivals.slice(n0).filter(a => a[2] !== '');   // the path-traced batches
     if (got.length >= batches || got.some(a => a[1] === 'final'))

@@ -82,7 +82,7 @@ def worker_device(spec: str | None) -> Any:
     """The device a worker renders on: ``spec`` (the client's --device), else the worker's
     PYJULIA4D_DEVICE, else - on an embedded local cluster with several GPUs - GPU number
     <worker name> (one worker per GPU), else the default choice (devices.select_device)."""
-    from pyjulia4d.opencl.devices import device_type, list_devices, select_device
+    from pyjulia4d.opencl.devices import device_type, is_simulator, list_devices, select_device
 
     if spec is not None and not isinstance(spec, str):
         return select_device(spec)   # refuses it in one line
@@ -90,7 +90,7 @@ def worker_device(spec: str | None) -> Any:
     if spec is None:
         name = _worker_name()
         if isinstance(name, int):
-            gpus = [d for _, d in list_devices() if device_type(d) == "GPU"]
+            gpus = [d for _, d in list_devices() if device_type(d) == "GPU" and not is_simulator(d)]
             if len(gpus) > 1:
                 return gpus[name % len(gpus)]
     return select_device(spec)
@@ -166,13 +166,13 @@ def default_workers(device: str | None = None) -> int:
     """Workers of the embedded cluster when --workers is not given: one per OpenCL GPU when
     the device chosen is a GPU, else 1 (a CPU device already uses every core); 0 (in this
     process) without Dask distributed installed."""
-    from pyjulia4d.opencl.devices import device_type, list_devices, select_device
+    from pyjulia4d.opencl.devices import device_type, is_simulator, list_devices, select_device
 
     if not have_cluster():
         return 0
     dev = select_device(device)
     if device is None and device_type(dev) == "GPU":
-        return max(1, sum(1 for _, d in list_devices() if device_type(d) == "GPU"))
+        return max(1, sum(1 for _, d in list_devices() if device_type(d) == "GPU" and not is_simulator(d)))
     return 1
 
 

@@ -10,6 +10,9 @@ default CPU device (one ray per work-item there too, so the same kernel source r
 and only the compilers and their arithmetic differ).
 
     python tests/devices/simulated.py < scenes.json     # [[name, [key=value, ...]], ...]
+
+A scene whose name starts with "mesh" is meshed instead (``pyjulia4d mesh`` at a grid of
+MESH_GRID), and its record holds each device's inside points, faces and vertices.
 """
 from __future__ import annotations
 
@@ -26,6 +29,7 @@ ROOT = Path(__file__).resolve().parents[2]
 # of the march (Oclgrind 21.10), and then reports every value after it
 CHECKS = {"OCLGRIND_CHECK_API": "1", "OCLGRIND_DATA_RACES": "1"}
 MARK = "@@pyjulia4d scene "
+MESH_GRID = 24   # a scene named mesh* is meshed on a grid this many points a side, not rendered
 
 # Oclgrind's reports start with one of these lines
 REPORT = re.compile(r"^(Invalid (read|write)|.*data race|Uninitialized|Oclgrind - |Work-item divergence|"
@@ -79,6 +83,15 @@ def _child() -> None:
     scenes = [(name, Scene.default().with_overrides(list(o))) for name, o in json.loads(sys.stdin.read())]
     for name, scene in scenes:
         os.write(2, f"{MARK}{name}\n".encode())
+        if name.startswith("mesh"):   # the mesh's kernels (kernels/mesh/): a grid of MESH_GRID points a side
+            from pyjulia4d.app.mesh import build_mesh
+
+            got, want = (build_mesh(scene, MESH_GRID, device=d) for d in (sim, cpu))
+            print(json.dumps({"name": name, "mesh": True, **{
+                tag: {"inside": m.inside_points, "faces": len(m.mesh.faces), "bracket": m.widest_bracket,
+                      "vertices": np.asarray(m.mesh.vertices).tolist()}
+                for tag, m in (("sim", got), ("cpu", want))}}), flush=True)
+            continue
         got = render(scene, device=sim, calibrate=False)
         want = render(scene, device=cpu, lanes=1, calibrate=False)
         rec = {"name": name}

@@ -154,3 +154,15 @@ def test_the_command_line_says_it_in_one_line_and_leaves_nothing(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("pyjulia4d: error: device 'Oclgrind Simulator' (Oclgrind): making "
                                                   "kernel '") and "INVALID_KERNEL_NAME" in lines[0], p.stderr
     assert list(out.parent.iterdir()) == []
+
+
+def test_no_usable_opencl_at_all(tmp_path):
+    # the loader pointed at an ICD file that is not there: no platform at all
+    out = tmp_path / "x.png"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OCL_ICD_VENDORS=str(tmp_path / "none.icd"),
+               PYJULIA4D_CACHE=str(tmp_path / "cache"))
+    p = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6", "-o", str(out)],
+                       capture_output=True, text=True, env=env, timeout=120, cwd=tmp_path)
+    assert p.returncode == 2 and p.stderr.strip().splitlines() == [
+        "pyjulia4d: error: no OpenCL platform found (install pyopencl[pocl] for a CPU device)"], p.stderr
+    assert [x.name for x in tmp_path.iterdir() if x.name != "cache"] == []

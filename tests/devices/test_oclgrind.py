@@ -15,9 +15,12 @@ differ), and the test fails on:
   DEPTH_SLACK of the depth (the rounding of two float32 marches that take different steps);
 - a picture whose mean colour differs by more than MEAN_SLACK (relative).
 
-A sample runs by default; ``-m slow`` runs all of them: every algebra, each hypercomplex
+A mesh (``mesh*``: the mesh kernels on a grid of 24 points a side) must find the same grid points inside
+and the same faces, its vertices within the widest stated bracket of each other.
+
+A sample of six runs by default; ``-m slow`` runs all of them: every algebra, each hypercomplex
 function, every kind, every march, every normals method, the shading terms, reflection,
-antialiasing, the path tracer with a lens, and double precision.
+antialiasing, the path tracer with a lens, the mesh, and double precision.
 """
 from __future__ import annotations
 
@@ -43,6 +46,7 @@ SCENES = {
     "path_lens": ["shading.integrator=path", "image.samples=2", "camera.aperture=0.05"],
     "mandelbrot_zbuffer_aa": ["fractal.kind=mandelbrot", "fractal.c=[0,0,0,0]", "normals.method=zbuffer",
                               "image.samples=2"],
+    "mesh_default": [],
 }
 SAMPLE = tuple(SCENES)
 SCENES.update({
@@ -59,6 +63,7 @@ SCENES.update({
     "clip_fog_lights": ["clip.planes=[[0,0,1,0.1]]", "shading.fog=0.5",
                         "shading.lights=[{position=[2,2,-2,0],color=[0.5,0.5,1]}]", "shading.specular=0.8"],
     "path_double": ["shading.integrator=path", "image.samples=2", "render.float=double", "shading.metallic=0.5"],
+    "mesh_cquat_double": ["fractal.algebra=cquat", "render.float=double"],
 })
 SCENES.update({f"hypercomplex_{f}": ["fractal.algebra=hypercomplex", f"fractal.function={f}", "fractal.max_iter=8"]
                for f in ("sqr", "cube", "exp", "reciprocal", "asin", "sinh", "asinh", "cos", "acos", "cosh",
@@ -67,6 +72,12 @@ SCENES.update({f"hypercomplex_{f}": ["fractal.algebra=hypercomplex", f"fractal.f
 
 def check(name: str, rec: dict) -> None:
     assert not rec.get("reports"), f"{name}: Oclgrind reports:\n\n" + "\n\n".join(rec["reports"][:5])
+    if rec.get("mesh"):   # the same grid points inside, the same faces, vertices within the widest bracket
+        sim, cpu = rec["sim"], rec["cpu"]
+        assert (sim["inside"], sim["faces"]) == (cpu["inside"], cpu["faces"]), name
+        gap = np.max(np.abs(np.array(sim["vertices"]) - np.array(cpu["vertices"])))
+        assert gap <= max(sim["bracket"], cpu["bracket"]) + 1e-6, f"{name}: vertices {gap:.3g} apart"
+        return
     sim, cpu = rec["sim"], rec["cpu"]
     s, c = np.array(sim["status"]), np.array(cpu["status"])
     assert np.count_nonzero(s != c) <= MISS_PIXELS, f"{name}: {np.count_nonzero(s != c)} pixels hit on one device only"

@@ -3,6 +3,7 @@ bad keyframes, numbered frames with their scene in the header, resuming after SI
 and the video played back."""
 from __future__ import annotations
 
+import math
 import os
 import re
 import signal
@@ -97,33 +98,21 @@ def test_keys_not_keyframed_stay_and_integers_round():
     assert all(anim.scene(n).camera == anim.base.camera for n in range(5))
 
 
+def _turned(degrees: float) -> str:
+    """A keyframe of the camera turned through the xw plane by ``degrees`` (position and limbo)."""
+    c, s_ = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    r = lambda v: round(v, 6) + 0.0   # noqa: E731  (+ 0.0: no -0.0)
+    return (f"[[keyframe]]\nframe = {round(degrees / 5)}\ncamera.position = [{r(1.8 * c)}, 1.6, -2.2, {r(1.8 * s_)}]\n"
+            f"camera.limbo = [{r(-s_)}, 0.0, 0.0, {r(c)}]\n")
+
+
 KEYED_CAMERA = """
 [camera]
 position = [1.8, 1.6, -2.2, 0.0]
 target = [0.0, 0.0, 0.0, 0.0]
 [animation]
 frames = 25
-[[keyframe]]
-frame = 0
-camera.position = [1.8, 1.6, -2.2, 0.0]
-camera.limbo = [0.0, 0.0, 0.0, 1.0]
-[[keyframe]]
-frame = 6
-camera.position = [1.558846, 1.6, -2.2, 0.9]
-camera.limbo = [-0.5, 0.0, 0.0, 0.866025]
-[[keyframe]]
-frame = 12
-camera.position = [0.9, 1.6, -2.2, 1.558846]
-camera.limbo = [-0.866025, 0.0, 0.0, 0.5]
-[[keyframe]]
-frame = 18
-camera.position = [0.0, 1.6, -2.2, 1.8]
-camera.limbo = [-1.0, 0.0, 0.0, 0.0]
-[[keyframe]]
-frame = 24
-camera.position = [-0.9, 1.6, -2.2, 1.558846]
-camera.limbo = [-0.866025, 0.0, 0.0, -0.5]
-"""
+""" + "".join(_turned(d) for d in (0, 30, 60, 90, 120))
 
 
 def test_a_keyed_camera_is_reorthonormalised_every_frame(tmp_path):
