@@ -30,6 +30,7 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 
 from pyjulia4d.pipeline import film
+from pyjulia4d.pipeline.backdrop import check_backdrop
 from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
@@ -429,6 +430,7 @@ def render_on_cluster(scene: Scene, workers: int | None = None, scheduler: str |
     check_where(workers, scheduler)
     require_cluster(workers, scheduler)
     film.check_denoiser(scene)
+    check_backdrop(scene)
     check(scene, check_device(device, scheduler), force=force, outputs=outputs)
     with cluster(workers, scheduler, device) as client:
         result, _ = render_tiled(client, scene, device, outputs, force, tile, progress)

@@ -84,12 +84,14 @@ def exr_output(result: Any, scene: Any) -> tuple[dict[str, np.ndarray | Band], d
     header["pyjulia4d.depth"] = f"distance along the view axis; {MISS_DEPTH:g} on a miss"
     ch: dict[str, np.ndarray | Band] = {}
     if result.color is not None and result.alpha is not None:
+        back = getattr(result, "backdrop", None)
         bg = np.asarray(scene.shading.background, np.float32)
 
         def combined(k: int) -> Band:
-            # premultiplied whatever the background: rgb - (1 - a) background
+            # premultiplied whatever the background: rgb - (1 - a) background, per pixel for a backdrop
             return lambda rows: (np.asarray(result.color[rows, :, k], np.float32)
-                                 - (1.0 - np.asarray(result.alpha[rows], np.float32)) * bg[k])
+                                 - (1.0 - np.asarray(result.alpha[rows], np.float32))
+                                 * (bg[k] if back is None else back[rows, :, k]))
         for k, name in enumerate("RGB"):
             ch[f"ViewLayer.Combined.{name}"] = combined(k)
         ch["ViewLayer.Combined.A"] = result.alpha

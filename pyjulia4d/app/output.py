@@ -123,18 +123,36 @@ def to_levels(x: np.ndarray, bits: int) -> np.ndarray:
     return np.rint(np.clip(x, 0.0, 1.0) * 65535.0).astype(np.uint16)
 
 
+def wants_alpha(scene: Any) -> bool:
+    """image.alpha resolved: "auto" is alpha, but opaque where a gradient or image is behind the set."""
+    a = scene.image.alpha
+    if a == "auto":
+        from pyjulia4d.pipeline.backdrop import has_backdrop
+
+        return not has_backdrop(scene.shading)
+    return bool(a)
+
+
+def background_of(result: Any, scene: Any) -> np.ndarray:
+    """What a render's missed samples saw: its backdrop (H, W, 3), else shading.background (3,)."""
+    back = getattr(result, "backdrop", None)
+    return back if back is not None else np.asarray(scene.shading.background, np.float32)
+
+
 def straight_colour(color: np.ndarray, alpha: np.ndarray, background) -> np.ndarray:
     """The colour a PNG's or TIFF's straight alpha wants: a pixel the set covers in part was
     rendered as a c + (1 - a) background (its samples that missed saw the background), so its
     own colour is (colour - (1 - a) background) / a; pixels wholly covered or wholly missed
-    keep theirs.  ``color`` is copied only where some pixel is covered in part."""
+    keep theirs.  ``background``: a colour (3,), or per pixel (H, W, 3) (background_of).
+    ``color`` is copied only where some pixel is covered in part."""
     a = np.asarray(alpha)
     part = (a > 0) & (a < 1)
     if not part.any():
         return color
     out = np.array(color, np.float32)
     ap = a[part].astype(np.float32)[:, None]
-    bg = np.asarray(background, np.float32)[None, :3]
+    bg = np.asarray(background, np.float32)
+    bg = bg[part] if bg.ndim == 3 else bg[None, :3]   # a backdrop's own colour at each pixel
     out[part] = np.maximum((out[part] - (1 - ap) * bg) / ap, 0.0)
     return out
 
@@ -338,10 +356,10 @@ def write_image(path: str | Path, result: Any, header: Mapping[str, str] | None 
             from pyjulia4d.pipeline.tonemap import display
             color, alpha = result.color, result.alpha
             if scene is not None and color is not None:
-                if not scene.image.alpha:   # opaque: the picture on shading.background, as rendered
+                if not wants_alpha(scene):   # opaque: the picture on its background, as rendered
                     alpha = None
                 elif alpha is not None:     # straight alpha: the background out of the edges' colour
-                    color = straight_colour(color, alpha, scene.shading.background)
+                    color = straight_colour(color, alpha, background_of(result, scene))
                 # exposure and tone map: the picture's, not an EXR's
                 color = display(color, scene.image.exposure, scene.image.tonemap)
             (write_png if _suffix(p) == ".png" else write_tiff)(p, color, alpha, header, bits)

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pyjulia4d.pipeline.backdrop import put_behind
+
 LUMA = np.array([0.2126, 0.7152, 0.0722])   # linear Rec. 709 luminance (path/sample.cl path_lum)
 
 
@@ -93,12 +95,13 @@ def guide_normal(result) -> np.ndarray | None:
 
 
 def finish(result, scene) -> None:
-    """What a path-traced picture gets once it is whole (a render, or a cluster's joined tiles):
-    with image.denoise, the denoised colour, the picture before it kept in the film."""
-    if result.film is None or not scene.image.denoise or result.color is None:
-        return
-    result.film.noisy = result.color
-    result.color = denoise(result.color, result.film.albedo, guide_normal(result))
+    """What a picture gets once it is whole (a render, or a cluster's joined tiles): a
+    path-traced one with image.denoise the denoised colour, the picture before it kept in the
+    film; then any picture its backdrop (backdrop.put_behind)."""
+    if result.film is not None and scene.image.denoise and result.color is not None:
+        result.film.noisy = result.color
+        result.color = denoise(result.color, result.film.albedo, guide_normal(result))
+    put_behind(result, scene)
 
 
 def join(parts: dict, height: int, width: int) -> Film | None:

@@ -47,6 +47,7 @@ class RenderResult:
     march_method: str = ""       # the march that ran: "fixed", "de" or "proven" (the plan's)
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran
     film: Film | None = None     # a path-traced render's samples, variance and stated noise (pipeline/film.py)
+    backdrop: np.ndarray | None = None   # (H, W, 3) the gradient or image behind the set, where one is (pipeline/backdrop.py)
     fell_back: str = ""          # the devices that failed before this one took the render over (opencl/failures.py)
 
     def __repr__(self) -> str:

@@ -461,10 +461,16 @@ class OrWord:
         self.word = word
         self.inner = inner
         self.valid = f'"{word}" or {inner.valid}'
+        self.verbatim = inner.verbatim   # an override's text goes to the inner checker as it would alone
 
     def __call__(self, key: str, v: Any) -> Any:
         if isinstance(v, str):
             if v == self.word:
                 return v
+            if self.inner.verbatim:   # the inner's own words (true, false), read from the text
+                try:
+                    return self.inner(key, v)
+                except SceneError:
+                    pass
             raise SceneError(key, f"expected {self.valid}, got {show(v)}")
         return self.inner(key, v)

@@ -138,6 +138,8 @@ class Shading:
 
     color: Vec3 = (0.89, 0.477, 0.147)  # linear light (sRGB (0.95, 0.72, 0.42))
     background: Vec3 = (0.0, 0.0, 0.0)
+    background_gradient: tuple = ()    # stops (position, r, g, b), sRGB, top (0) to bottom (1) of the frame
+    background_image: str = "none"     # an image covering the frame (pipeline/backdrop.py)
     ambient: float = 0.15
     diffuse: float = 0.92
     specular: float = 0.35
@@ -185,7 +187,9 @@ class Image:
     samples: int = 1      # rays per pixel (stratified jitter); colour and alpha are their mean
     adaptive: bool = False   # samples only where neighbours differ (antialias.py)
     bits: int = 8         # per channel of a PNG or TIFF (app/output.py); EXR is float32 always
-    alpha: bool = True    # a PNG's or TIFF's alpha (straight: the background taken out of edge pixels); false: opaque
+    # a PNG's or TIFF's alpha (straight: the background taken out of edge pixels); false: opaque;
+    # "auto": alpha, but opaque on a gradient or an image behind the set
+    alpha: Union[bool, Literal["auto"]] = "auto"
     exr: str = "pyjulia4d"   # an EXR's channels: pyjulia4d's own, or the passes compositors read (app/exr_layout.py)
     noise: float = 0.0    # path: stop a pixel's samples once its stated noise is this low (0: take them all)
     exposure: float = 0.0   # stops of brightness applied before the tone map
@@ -274,6 +278,9 @@ class Scene:
             object.__setattr__(self, "march", dataclasses.replace(self.march, **auto_values(self.fractal)))
         rules.check_camera(self.camera)
         rules.check_fractal(self)
+        if self.shading.background_gradient and self.shading.background_image != "none":
+            raise SceneError("shading.background_image", "a gradient and an image behind the set: give one "
+                                                         "(shading.background_gradient = [] or background_image = \"none\")")
         if self.shading.reflection > 0 and self.normals.method == "zbuffer":
             raise SceneError("shading.reflection", "needs normals.method \"jacobian\" or \"gradient\": the "
                                                    "Z-buffer has no neighbours for reflected rays")

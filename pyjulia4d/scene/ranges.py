@@ -114,6 +114,9 @@ CHECKS: dict[str, dict[str, Checker]] = {
     "shading": {
         "color": Vector((3,), 0.0, 1e3),
         "background": Vector((3,), 0.0, 1e3),
+        "background_gradient": Stops(2, 16),
+        "background_image": ImageFile(("none",), (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".hdr"),
+                                      "an image, scaled to cover the frame"),
         "ambient": Real(0.0, 1e3),
         "diffuse": Real(0.0, 1e3),
         "specular": Real(0.0, 1e3),
@@ -150,7 +153,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "samples": Integer(1, 65536),
         "adaptive": Bool(),
         "bits": Whole(8, 16),
-        "alpha": Bool(),
+        "alpha": OrWord("auto", Bool()),
         "exr": Choice("pyjulia4d", "compositing"),
         "noise": Real(0.0, 1.0),
         "exposure": Real(-20.0, 20.0),

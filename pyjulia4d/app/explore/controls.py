@@ -23,12 +23,14 @@ from pyjulia4d.scene.quality import QUALITIES
 # At most this many values in one change, and this long each (a form has about 60).
 MAX_VALUES = 200
 MAX_VALUE_CHARS = 100
+MAX_TEXT_CHARS = 1000   # a text control's (16 colour stops, a long path)
 
 
 @dataclass(frozen=True)
 class Control:
     """One scene key on the page: ``size`` components (0: a scalar), a ``widget`` ("number",
-    "select", "checkbox"), and for numbers a slider's span and step."""
+    "select", "checkbox", or "text": the value as typed, such as a TOML array of colour stops
+    or a file's path), and for numbers a slider's span and step."""
 
     key: str
     label: str
@@ -94,9 +96,12 @@ GROUPS: tuple[tuple[str, tuple[Control, ...]], ...] = (
         Control("shading.color_offset", "colour offset", lo=-1.0, hi=1.0, step=0.01),
         Control("shading.color_scale", "colour scale", lo=-8.0, hi=8.0, step=0.05),
         Control("shading.color_repeat", "colour repeat", widget="select"),
+        Control("shading.gradient", "colour ramp [[pos, r, g, b], ...] (sRGB)", widget="text", slider=False),
         Control("shading.trap", "orbit trap", 4, lo=-2.0, hi=2.0, step=0.01),
         Control("shading.reflection", "reflection", lo=0.0, hi=1.0),
         Control("shading.background", "background (linear)", 3, lo=0.0, hi=1.0, step=0.01),
+        Control("shading.background_gradient", "background gradient, top to bottom", widget="text", slider=False),
+        Control("shading.background_image", "background image (a path)", widget="text", slider=False),
     )),
     ("Light", (
         Control("shading.light_color", "key light colour", 3, lo=0.0, hi=2.0, step=0.01),
@@ -132,6 +137,8 @@ def form_values(scene: Scene) -> dict[str, str]:
 
 
 def _text(v: Any) -> str:
+    if isinstance(v, (list, tuple)) and all(isinstance(x, (list, tuple)) for x in v):   # colour stops, as TOML
+        return "[" + ", ".join("[" + ", ".join(_text(float(y)) for y in x) + "]" for x in v) + "]"
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, float):
@@ -157,10 +164,11 @@ def apply_values(scene: Scene, values: Any) -> Scene:
             raise SceneError(show_key(str(name)), "no such control")
         if not isinstance(text, str):
             raise SceneError(name, f"expected the field's text, got {show(text)}")
-        if len(text) > MAX_VALUE_CHARS:
-            raise SceneError(name, f"longer than {MAX_VALUE_CHARS} characters")
+        most = MAX_TEXT_CHARS if control.widget == "text" else MAX_VALUE_CHARS
+        if len(text) > most:
+            raise SceneError(name, f"longer than {most} characters")
         section, key = control.key.split(".")
-        value = scalar(text)
+        value = text if control.widget == "text" else scalar(text)
         if control.widget == "checkbox":
             value = {"true": True, "false": False}.get(text.strip(), value)
         if m.group(2) is not None:
@@ -208,6 +216,10 @@ def form_html(scene: Scene) -> str:
                                    f'{" selected" if o == values[name] else ""}>{html.escape(o)}</option>'
                                    for o in choices)
                     fields.append(f'<select name="{esc}" id="{esc}" title="{tip}">{opts}</select>')
+                    continue
+                if c.widget == "text":
+                    fields.append(f'<input type="text" name="{esc}" id="{esc}" spellcheck="false" '
+                                  f'value="{html.escape(values[name], quote=True)}" title="{tip}">')
                     continue
                 fields.append(f'<input type="number" name="{esc}" id="{esc}" step="any" '
                               f'value="{html.escape(values[name], quote=True)}" title="{tip}">')

@@ -101,6 +101,8 @@ class Explorer:
         style = {"description_width": "120px"}
         if c.widget == "select":
             return w.Dropdown(options=controls.options(c, scene), value=value, description=label, style=style)
+        if c.widget == "text":   # sent when typed out (Enter or leaving the field), not at each key
+            return w.Text(value=value, description=label, style=style, continuous_update=False)
         x = float(value)
         integer = c.step == 1 and x.is_integer()
         number = int(x) if integer else x
