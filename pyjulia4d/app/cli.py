@@ -111,7 +111,7 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--walls", action="store_true",
                    help="also report the thinnest wall, for printing (grids up to 1024 a side)")
     m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene value, as for render")
+                   help="override a scene value, as for render ('clip.planes=[[0, -1, 0, 0.3]]' cuts a flat base)")
     m.add_argument("--device", metavar="SPEC", help="OpenCL device (as for render)")
     m.add_argument("--force", action="store_true", help="mesh grids whose sampling is estimated past 6 hours")
 

@@ -23,8 +23,9 @@ class MeshRunner:
         self.sample_k = build.kernel(prg, "mesh_sample")
         self.vertex_k = build.kernel(prg, "mesh_vertices")
         pr = self.pr = Precision(plan.double)
-        self.sample_args = Packed(sig.MESH_SAMPLE, {"mesh": plan}, pr, nx=plan.n, ny=plan.n)
-        self.vertex_args = Packed(sig.MESH_VERTICES, {"mesh": plan}, pr)
+        records, defines = {"mesh": plan, "clip": plan.clip}, plan.config.defines
+        self.sample_args = Packed(sig.MESH_SAMPLE, records, pr, defines, nx=plan.n, ny=plan.n)
+        self.vertex_args = Packed(sig.MESH_VERTICES, records, pr, defines)
 
     def sample(self, k0: int, nk: int) -> np.ndarray:
         """The inside mask of grid layers k0 .. k0 + nk - 1: uint8, shape (nk, n, n), [k, j, i]."""

@@ -225,10 +225,12 @@ def march_config(scene: Scene, lanes: int, ray_buffers: bool = False, pairs: boo
 
 def mesh_config(scene: Scene) -> KernelConfig:
     """The mesh's sampling and vertex kernels (kernels/mesh/mesh.cl): the iteration, the
-    scene's refinement (march/refine.cl) and the mesh piece."""
+    scene's refinement (march/refine.cl) and the mesh piece, cut by the clip planes (CLIP)."""
     defines = precision_defines(scene) + fractal_defines(scene)
     if scene.march.refine == "itp":
         defines += ("REFINE_ITP",)
+    if scene.clip.planes:
+        defines += ("CLIP",)
     return KernelConfig(iteration_pieces(scene) + ("march/refine", "mesh/mesh"), defines)
 
 

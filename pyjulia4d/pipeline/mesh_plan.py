@@ -6,7 +6,9 @@ The grid covers the ball's section by the slice: the bounding ball |p| <= R abou
 origin (geometry/camera.py set_radius) meets the slice's hyperplane, at distance d from the
 origin, in a 3D ball of radius r = sqrt(R^2 - d^2) about the slice's own origin.  The grid
 spans [-r - h, r + h] on each axis, N points a side, spacing h = 2 r / (N - 3): its outermost
-layer lies outside the ball, so the mesh is closed where the ball cuts the set."""
+layer lies outside the ball, so the mesh is closed where the ball cuts the set.  The clip
+planes cut it as they cut the render (kernels/mesh/mesh.cl, CLIP): a flat face where one
+crosses the set, a base to print on."""
 from __future__ import annotations
 
 import math
@@ -14,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pyjulia4d.geometry.camera import set_radius, slice_map
+from pyjulia4d.geometry.camera import clip_planes, set_radius, slice_map
 from pyjulia4d.pipeline.kernel_config import KernelConfig, mesh_config
+from pyjulia4d.pipeline.records import ClipArgs
 from pyjulia4d.scene.checks import SceneError, show
 from pyjulia4d.scene.model import Scene
 
@@ -42,6 +45,7 @@ class MeshPlan:
     steps: int
     config: KernelConfig
     block: int             # z-layers a launch samples
+    clip: ClipArgs = ClipArgs(())   # the clip planes in the world, as the render's (records.ClipArgs)
 
     @property
     def double(self) -> bool:
@@ -76,9 +80,6 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     n = check_resolution(resolution)
-    if scene.clip.planes:   # refused, not ignored: a mesh without the cut the render shows is not that set
-        raise SceneError("clip.planes", "the mesh does not cut the set by clip planes (the render does); "
-                                        "mesh it whole with --set clip.planes= and cut it in your slicer")
     f = scene.fractal
     radius = set_radius(scene)   # the set's ball (the estimate march's shell is no part of the set)
     d = float(scene.slice.distance)
@@ -91,4 +92,4 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
     return MeshPlan(scene=scene, n=n, origin=(-r - h,) * 3, spacing=h, axes=rot[:, :3].T.copy(),
                     offset=offset, radius=radius, c=tuple(f.c), max_iter=f.max_iter,
                     bailout=f.bailout, steps=REFINE_STEPS, config=mesh_config(scene),
-                    block=max(1, min(n, BLOCK_POINTS // (n * n))))
+                    block=max(1, min(n, BLOCK_POINTS // (n * n))), clip=ClipArgs(tuple(clip_planes(scene))))

@@ -192,13 +192,15 @@ PATH_FILM = Signature("path_film", "path/path", (
 MESH_ORBIT = (P("real radius2", "mesh.radius2"), P("real4 c", "mesh.c"), P("int max_iter", "mesh.max_iter"),
               P("real bailout", "mesh.bailout"))
 
+MESH_CLIP = group("CLIP", P("int n_clip", "clip.n_clip"), *CLIP_NORMALS, P("real4 clip_off", "clip.clip_off"))
+
 MESH_SAMPLE = Signature("mesh_sample", "mesh/mesh", (
     P("int nx"), P("int ny"), P("int k0"), P("real4 origin", "mesh.origin4"), P("real spacing", "mesh.spacing"),
     P("real4 rx", "mesh.rx"), P("real4 ry", "mesh.ry"), P("real4 rz", "mesh.rz"), P("real4 offset", "mesh.offset"),
-    *MESH_ORBIT, P("global uchar* inside")))
+    *MESH_ORBIT, *MESH_CLIP, P("global uchar* inside")))
 
 MESH_VERTICES = Signature("mesh_vertices", "mesh/mesh", (
-    P("global const real4* ends_a"), P("global const real4* ends_b"), *MESH_ORBIT, P("int steps", "mesh.steps"),
+    P("global const real4* ends_a"), P("global const real4* ends_b"), *MESH_ORBIT, *MESH_CLIP, P("int steps", "mesh.steps"),
     P("global real4* vertex"), P("global real* width"), P("global real4* inside_end")))
 
 # ---------------------------------------------------------------- the tests' kernels (each value given at launch)

@@ -1,6 +1,6 @@
 """Twin of kernels/mesh/mesh.cl in float64 numpy: a MeshPlan's grid sampled, and the vertices
-placed on the surface (the ball's sphere where it cuts the set, else the set's crossing refined
-by refine_bracket)."""
+placed on the surface (the ball's sphere or a clip plane where it cuts the set, else the set's
+crossing refined by refine_bracket)."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,14 +29,11 @@ def mesh_vertices(plan, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndar
     d = np.where(ia[:, None], pa, pb) - po
     length = np.linalg.norm(d, axis=1)
     d = d / length[:, None]
-    a = np.zeros(len(po))
-    out_ball = np.sum(po * po, axis=1) > plan.radius ** 2
-    b = np.sum(po * d, axis=1)
-    e = np.sum(po * po, axis=1) - plan.radius ** 2
-    a[out_ball] = np.clip(-b - np.sqrt(np.maximum(b * b - e, 0.0)), 0.0, length)[out_ball]
+    outside = ~_kept(plan, po)   # the outside end cut away: the edge enters the region at a
+    a = np.where(outside, _entry(plan, po, d, length), 0.0)
     pe = po + a[:, None] * d
-    cut = out_ball.copy()
-    cut[out_ball] = julia_inside(pe[out_ball], plan.c, plan.max_iter, plan.bailout, F)
+    cut = outside.copy()
+    cut[outside] = julia_inside(pe[outside], plan.c, plan.max_iter, plan.bailout, F)
     vertex, width, inner = pe.copy(), np.zeros(len(po)), pe.copy()
     k = ~cut & (ia != ib)
     if np.any(k):
@@ -51,8 +48,29 @@ def mesh_vertices(plan, ends_a: np.ndarray, ends_b: np.ndarray) -> tuple[np.ndar
     return vertex, width, inner
 
 
-def _inside(plan, p: np.ndarray, F) -> np.ndarray:
-    """In the ball and the set, as mesh_sample tests a grid point."""
+def _kept(plan, p: np.ndarray) -> np.ndarray:
+    """In the ball and in every clip half-space n . p <= offset (mesh.cl's mesh_kept)."""
     out = np.sum(p * p, axis=1) <= plan.radius ** 2
+    for n, off in plan.clip.planes:
+        out &= p @ np.asarray(n, float) <= off
+    return out
+
+
+def _entry(plan, po: np.ndarray, d: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """Where each ray po + a d enters the region of _kept (mesh.cl's mesh_entry): the largest
+    entry of the sphere and of each plane it starts outside, within [0, length]."""
+    b = np.sum(po * d, axis=1)
+    e = np.sum(po * po, axis=1) - plan.radius ** 2
+    a = np.where(e > 0, -b - np.sqrt(np.maximum(b * b - e, 0.0)), 0.0)
+    for n, off in plan.clip.planes:
+        so, sd = po @ np.asarray(n, float) - off, d @ np.asarray(n, float)
+        hit = (so > 0) & (sd < 0)
+        a = np.where(hit, np.maximum(a, so / np.where(hit, -sd, 1.0)), a)
+    return np.clip(a, 0.0, length)
+
+
+def _inside(plan, p: np.ndarray, F) -> np.ndarray:
+    """In the ball, the half-spaces and the set, as mesh_sample tests a grid point."""
+    out = _kept(plan, p)
     out[out] = julia_inside(p[out], plan.c, plan.max_iter, plan.bailout, F)
     return out

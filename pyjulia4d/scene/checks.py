@@ -314,20 +314,27 @@ class Bool:
 
 class Planes:
     """Up to 4 planes [nx, ny, nz, offset]: a list of 4-number lists (TOML) or, on the
-    command line, "nx,ny,nz,offset;..." ("" or "[]": none)."""
+    command line, "nx,ny,nz,offset;..." or the same TOML array of arrays ("" or "[]": none)."""
 
     verbatim = True
 
     def __init__(self, most: int) -> None:
         self.most = most
         self.valid = (f"up to {most} planes [nx, ny, nz, offset], numbers in [-1e6, 1e6], the normal not "
-                      f"all 0 (--set: nx,ny,nz,offset;...)")
+                      f"all 0 (--set: nx,ny,nz,offset;... or a TOML array of arrays)")
 
     def __call__(self, key: str, v: Any) -> tuple:
         if isinstance(v, str):
             text = v.strip()
             if text in ("", "[]"):
                 v = []
+            elif text.startswith("[["):   # the scene file's TOML array of arrays
+                import tomllib
+
+                try:
+                    v = tomllib.loads(f"v = {text}")["v"]
+                except tomllib.TOMLDecodeError as e:
+                    raise SceneError(key, f"not a TOML array of planes ({' '.join(str(e).split())[:100]})") from None
             else:
                 v = [[scalar(x) for x in part.split(",")] for part in text.strip("[]").split(";")]
         if not isinstance(v, (list, tuple)):

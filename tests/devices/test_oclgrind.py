@@ -64,6 +64,7 @@ SCENES.update({
                         "shading.lights=[{position=[2,2,-2,0],color=[0.5,0.5,1]}]", "shading.specular=0.8"],
     "path_double": ["shading.integrator=path", "image.samples=2", "render.float=double", "shading.metallic=0.5"],
     "mesh_cquat_double": ["fractal.algebra=cquat", "render.float=double"],
+    "mesh_clipped": ["clip.planes=[[0,-1,0,0.3],[1,0.2,0.5,0.4]]"],
 })
 SCENES.update({f"hypercomplex_{f}": ["fractal.algebra=hypercomplex", f"fractal.function={f}", "fractal.max_iter=8"]
                for f in ("sqr", "cube", "exp", "reciprocal", "asin", "sinh", "asinh", "cos", "acos", "cosh",

@@ -48,9 +48,10 @@ CONFIGS = {
     "path_gradient_double": lambda: path_config(_scene("shading.integrator=path", "normals.method=gradient",
                                                        "render.float=double")),
     "mesh": lambda: K.mesh_config(_scene()),
+    "mesh_clip": lambda: K.mesh_config(_scene("clip.planes=0,-1,0,0.3")),
     "probe": lambda: K.probe_config(_scene()),
 }
-SAMPLE = ("march_packets_pairs", "march_clip_light", "shade", "path", "mesh")
+SAMPLE = ("march_packets_pairs", "march_clip_light", "shade", "path", "mesh", "mesh_clip")
 
 
 def _declared(kernel: cl.Kernel) -> list[tuple[str, str]]:
