@@ -396,6 +396,9 @@ def render_header(scene: Any, result: Any) -> tuple[dict[str, str], str]:
     return {"pyjulia4d.scene": rendered.to_toml(), **report}, tail
 
 
+LOST_SET = 0.01   # a share of pixels hit below which the closing line suggests camera.fit
+
+
 def closing_line(out: Path, scene: Any, result: Any, tail: str, verbose: bool, why: str = "") -> str:
     """The render command's last line.  At a glance: the output, size, time and device, the
     error the render states in one figure (RenderResult.brief) and the camera camera.fit
@@ -416,7 +419,12 @@ def closing_line(out: Path, scene: Any, result: Any, tail: str, verbose: bool, w
         return f"{head}{why}, {100 * result.hit_fraction:.1f}% of pixels hit{tail}"
     # a preset's bound is named only where the user chose the preset
     chosen = stated_p99(scene.march.quality) if scene.march.quality != "auto" else None
-    return head + (result.brief(chosen) if hasattr(result, "brief") else "") + framed
+    hint = ""
+    if not scene.camera.fit and getattr(result, "hit_fraction", 1.0) < LOST_SET:
+        # a camera placed by hand turns camera.fit off: say so where the set is all but out of view
+        hint = (f"; the set covers {100 * result.hit_fraction:.2g}% of the picture: --set camera.fit=true "
+                f"frames it from this camera")
+    return head + (result.brief(chosen) if hasattr(result, "brief") else "") + framed + hint
 
 
 def read_header(path: str | Path) -> dict[str, str] | None:

@@ -97,3 +97,18 @@ def test_the_framed_set_is_centred_within_its_margin(extra, fill):
     assert abs(left - right) <= 2 and abs(top - bottom) <= 2, (left, right, top, bottom)
     share = max((xs.max() - xs.min() + 1) / w, (ys.max() - ys.min() + 1) / h)
     assert abs(share - fill) <= 0.04, share
+
+
+def test_a_hand_placed_camera_that_loses_the_set_is_told_of_fit():
+    # camera.position turns camera.fit off; where the set then covers under 1 % of the picture,
+    # the closing line says so and how to frame it, and says nothing where the set is in view
+    from pathlib import Path
+
+    from pyjulia4d.app.output import closing_line
+
+    far = Scene.from_dict({}, ["image.width=64", "image.height=48", "camera.position=20,20,-20,0"])
+    got = render(far)
+    line = closing_line(Path("x.png"), far, got, "", False)
+    assert got.hit_fraction < 0.01 and "of the picture: --set camera.fit=true frames it" in line
+    near = Scene.default().with_overrides(["image.width=64", "image.height=48"])
+    assert "camera.fit" not in closing_line(Path("x.png"), near, render(near), "", False)
