@@ -153,7 +153,7 @@ inline real light_weight(real4 lv, float4 lc, real size, real4 o, pvec n, real4 
 }
 
 /* The colour of a hit: the scene's, or the colour map's entry for its colour value *val
- * (shade/light.cl orbit_value, the inside end of its bracket for the escape count; 0 for
+ * (shade/light.cl orbit_value, the inside end of its bracket for the iteration value; 0 for
  * the flat colour) */
 inline pvec hit_base(real4 p, real4 d, real bracket, julia_params jp, real radius, real4 trap,
                      float4 color, __global const float4 *lut, int n_lut, real *val_out)

@@ -160,13 +160,15 @@ inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp
 #endif
 #endif
 
-/* The colour value of a hit.  Iteration: the smooth escape count nu = n + 1 -
- * log_D(ln|q_n|^2 / ln bailout^2) of the INSIDE end of the hit's bracket, iterated on past
- * max_iter up to 4 max_iter, as v = (nu - max_iter) / (3 max_iter), 1 where it never
- * escapes: how long the surface's orbits outlive the truncation, i.e. how close the
- * surface lies to the limit set (the outside end is no use: the truncated set's surface is
- * where orbits escape at max_iter, so its escape count is the same everywhere).  Trap:
- * 1 - exp(-3 min_n |q_n - trap|) over the outside end's orbit. */
+/* The colour value of a hit.  Iteration: how long the orbit of the INSIDE end of the hit's
+ * bracket stays in the unit ball, smoothly: n the first index with |q_n| > 1, and
+ * nu = n - 1 + ln|q_(n-1)| / (ln|q_(n-1)| - ln|q_n|) (the crossing of |q| = 1 interpolated in
+ * ln|q|, so nu runs on continuously where n steps), as v = nu / max_iter, 1 where it never
+ * leaves within max_iter.  (The escape count is no use on the surface: the truncated set's
+ * surface is where orbits escape right after max_iter, so it is the same everywhere - measured
+ * 1.00 past max_iter on 95 % of the default scene's hits - where the time spent in the unit
+ * ball ranges over 0 to 7 of its 12 iterations.)  Trap: 1 - exp(-3 min_n |q_n - trap|) over
+ * the outside end's orbit. */
 /* The orbit a colour follows: q_0 = p under q -> f(q) + c for a Julia set; for a
  * Mandelbrot set (kind/mandelbrot.cl) the orbit of the critical point 0 with c = p, from
  * q_1 = c (so its count starts at 1). */
@@ -179,19 +181,22 @@ inline void ambient_occlusion_pair(const quat *p, const quat *n, julia_params jp
 inline lreal orbit_value(quat p, julia_params jp)
 {
     KIND_ORBIT_START(p);
-    lreal m2 = ALG_NORM2(q);
-    lmask live = m2 <= jp.bailout2;
+    lreal m2 = ALG_NORM2(q), prev = m2;
+    lmask live = m2 <= (real)1;
     lmask n = KIND_ORBIT_N0;
-    for (int k = KIND_ORBIT_N0; k < 4 * jp.max_iter && L_ANY(live); ++k) {
+    for (int k = KIND_ORBIT_N0; k < jp.max_iter && L_ANY(live); ++k) {
+        prev = L_SEL(prev, m2, live);
         q = QSEL(q, KIND_ORBIT_F(q), live);
         m2 = L_SEL(m2, ALG_NORM2(q), live);
         n = L_SEL(n, n + 1, live);
-        live &= m2 <= jp.bailout2;
+        live &= m2 <= (real)1;
     }
-    lreal ratio = log(fmax(m2, jp.bailout2)) / log(fmax(jp.bailout2, (real)1.0000001));
-    lreal nu = convert_lreal(n) + (real)1 - log(fmax(ratio, (real)1)) / log((real)JULIA_GROWTH);
-    lreal v = clamp((nu - (real)jp.max_iter) / ((real)3 * jp.max_iter), (real)0, (real)1);
-    return L_SEL(v, (lreal)1, !(m2 > jp.bailout2));
+    /* squared norms: their logs are twice the norms', the ratio the same */
+    lreal lo = log(fmax(prev, (real)REAL_MIN)), hi = log(fmax(m2, (real)1));
+    lreal frac = clamp(-lo / fmax(hi - lo, (real)REAL_MIN), (real)0, (real)1);
+    lreal nu = L_SEL(convert_lreal(n) - (real)1 + frac, (lreal)KIND_ORBIT_N0, n == KIND_ORBIT_N0);
+    lreal v = clamp(nu / (real)jp.max_iter, (real)0, (real)1);
+    return L_SEL(v, (lreal)1, live);
 }
 #endif
 #ifdef COLOR_TRAP
@@ -278,8 +283,8 @@ inline void extra_light_shadows(const quat *o, const quat *p, const quat *nw, co
 }
 #endif
 
-/* val: the colour map's value (shading.coloring): the smooth escape count of the bracket's
- * inside end, the orbit trap, or w over [-R/2, R/2] (the visible range) */
+/* val: the colour map's value (shading.coloring): the bracket's inside end's smooth time in
+ * the unit ball, the orbit trap, or w over [-R/2, R/2] (the visible range) */
 inline void colour_values(const quat *p, const quat *pin, julia_params jp, real radius, real4 trap, lreal *val)
 {
     for (int b = 0; b < PACKETS; ++b) {

@@ -280,7 +280,7 @@ def _executor(plan: MeshPlan, device: Any, executor: str):
 
 def colouring_values(scene: Scene, world: np.ndarray, inner: np.ndarray) -> np.ndarray | None:
     """The colour map's value at each vertex, as the render takes it at a hit
-    (kernels/shade/light.cl): the smooth escape count or the orbit trap of the bracket's
+    (kernels/shade/light.cl): the smooth time in the unit ball or the orbit trap of the bracket's
     inside end ``inner``, or w over [-R/2, R/2] at the vertex ``world``; computed by the float64
     twins (reference/shade.py).  None for the "flat" colouring."""
     from pyjulia4d.geometry.camera import march_radius, to_world

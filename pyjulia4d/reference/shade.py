@@ -85,25 +85,29 @@ def _orbit_start(p, c, F: Formula):
 
 
 def orbit_iteration(p, c, max_iter, bailout, F: Formula = QUATERNION_SQR):
-    """Smooth escape count of p iterated up to 4 max_iter, as (nu - max_iter) / (3 max_iter);
-    1 where it never escapes (shade/light.cl orbit_value, COLOR_ITERATION)."""
+    """How long the orbit of p stays in the unit ball, smoothly, over max_iter: n the first
+    index with |q_n| > 1, nu = n - 1 + ln|q_(n-1)| / (ln|q_(n-1)| - ln|q_n|), v = nu / max_iter;
+    1 where it never leaves within max_iter (shade/light.cl orbit_value, COLOR_ITERATION).
+    ``bailout`` is not used: the unit ball is the measure, not the escape."""
     q, step, n0 = _orbit_start(p, c, F)
-    b2 = bailout * bailout
     m2 = F.ALG_NORM2(q)
-    n = np.full(len(q), float(n0))
-    live = m2 <= b2
+    prev = m2.copy()
+    n = np.full(len(q), n0)
+    live = m2 <= 1.0
     with np.errstate(all="ignore"):
-        for _ in range(n0, 4 * max_iter):
+        for _ in range(n0, max_iter):
             if not live.any():
                 break
+            prev[live] = m2[live]
             q[live] = step(q, live)
             m2[live] = F.ALG_NORM2(q[live])
             n[live] += 1
-            live &= m2 <= b2
-        ratio = np.log(np.maximum(m2, b2)) / np.log(max(b2, 1.0000001))
-        nu = n + 1 - np.log(np.maximum(ratio, 1.0)) / np.log(F.growth)
-    v = np.clip((nu - max_iter) / (3 * max_iter), 0.0, 1.0)
-    return np.where(m2 > b2, v, 1.0)
+            live &= m2 <= 1.0
+        lo = np.log(np.maximum(prev, np.finfo(np.float64).tiny))
+        hi = np.log(np.maximum(m2, 1.0))
+        frac = np.clip(-lo / np.maximum(hi - lo, np.finfo(np.float64).tiny), 0.0, 1.0)
+    nu = np.where(n == n0, float(n0), n - 1 + frac)
+    return np.where(live, 1.0, np.clip(nu / max_iter, 0.0, 1.0))
 
 
 def orbit_trap(p, c, max_iter, bailout, trap, F: Formula = QUATERNION_SQR):
