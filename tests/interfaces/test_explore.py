@@ -692,3 +692,22 @@ def test_a_path_traced_picture_refines_at_rest_to_the_render_of_the_scene(tmp_pa
     if not module_installed("pyoidn"):   # the page shows the pooled picture itself
         whole = render_scene(scene)
         assert np.abs(shown[-1] - whole.color).max() < 1e-5
+
+
+def test_text_controls_take_what_set_takes_and_give_it_back():
+    # the lighting and colour keys without a number of their own (a light at "eye" or a 4D point,
+    # more lights, colour ramps, a backdrop, the environment): typed as --set takes them, and
+    # each shown back as text that gives the same scene
+    from pyjulia4d.app.explore.controls import CONTROLS, apply_values, form_values
+
+    typed = {"shading.light": "eye", "shading.lights": "[{position = [3, 1, -2], color = [0.3, 0.5, 1]}]",
+             "shading.gradient": "[[0, 0, 0, 0], [1, 1, 0.5, 0]]",
+             "shading.background_gradient": "[[0, 0.1, 0.2, 0.4], [1, 0.9, 0.8, 0.7]]", "shading.environment": "uniform"}
+    s = apply_values(Scene.default(), typed)
+    assert s.shading.light == "eye" and s.shading.lights[0].color == (0.3, 0.5, 1.0)
+    assert s.shading.environment == "uniform" and len(s.shading.background_gradient) == 2
+    shown = form_values(s)
+    texts = {k: shown[k] for k in shown if CONTROLS[k.split("[")[0]].widget == "text"}
+    assert set(typed) <= set(texts) and apply_values(Scene.default(), texts) == s
+    with pytest.raises(SceneError, match="shading.lights"):
+        apply_values(Scene.default(), {"shading.lights": "[{position = [3, 1"})

@@ -18,6 +18,7 @@ from pyjulia4d.fractal.registry import ALGEBRAS, FUNCTIONS_OF, KINDS
 from pyjulia4d.scene.checks import Choice, SceneError, scalar, show, show_key
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.ranges import CHECKS, valid_range
+from pyjulia4d.scene.text import parse_override, toml_value
 from pyjulia4d.scene.quality import QUALITIES
 
 # At most this many values in one change, and this long each (a form has about 60).
@@ -89,7 +90,9 @@ GROUPS: tuple[tuple[str, tuple[Control, ...]], ...] = (
         Control("shading.specular", "specular", lo=0.0, hi=1.5),
         Control("shading.shininess", "shininess", lo=1.0, hi=200.0, step=1.0),
         Control("shading.shadow", "shadow", widget="select"),
+        Control("shading.shadow_softness", "shadow softness", lo=1.0, hi=64.0, step=0.5),
         Control("shading.ao", "occlusion", lo=0.0, hi=1.0),
+        Control("shading.ao_distance", "occlusion distance", lo=0.01, hi=0.5, step=0.005),
         Control("shading.fog", "fog", lo=0.0, hi=5.0),
         Control("shading.coloring", "colouring", widget="select"),
         Control("shading.colormap", "colour map", widget="select"),
@@ -104,10 +107,14 @@ GROUPS: tuple[tuple[str, tuple[Control, ...]], ...] = (
         Control("shading.background_image", "background image (a path)", widget="text", slider=False),
     )),
     ("Light", (
+        Control("shading.light", "key light (x, y, z, w or eye)", widget="text", slider=False),
         Control("shading.light_color", "key light colour", 3, lo=0.0, hi=2.0, step=0.01),
+        Control("shading.light_radius", "key light radius (path)", lo=0.0, hi=1.0, step=0.01),
+        Control("shading.lights", "more lights (TOML)", widget="text", slider=False),
         Control("shading.light_space", "lights move with", widget="select"),
         Control("shading.sky", "sky (linear)", 3, lo=0.0, hi=2.0, step=0.01),
         Control("shading.integrator", "integrator", widget="select"),
+        Control("shading.environment", "environment (sky, uniform or a path)", widget="text", slider=False),
         Control("shading.bounces", "bounces (path)", lo=1, hi=8, step=1),
         Control("shading.roughness", "roughness (path)", lo=0.0, hi=1.0),
         Control("shading.metallic", "metallic (path)", lo=0.0, hi=1.0),
@@ -137,8 +144,8 @@ def form_values(scene: Scene) -> dict[str, str]:
 
 
 def _text(v: Any) -> str:
-    if isinstance(v, (list, tuple)) and all(isinstance(x, (list, tuple)) for x in v):   # colour stops, as TOML
-        return "[" + ", ".join("[" + ", ".join(_text(float(y)) for y in x) + "]" for x in v) + "]"
+    if isinstance(v, (list, tuple)):   # a text control's vector, colour stops or lights: TOML, as --set takes them
+        return toml_value([float(x) if isinstance(x, int) and not isinstance(x, bool) else x for x in v])
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, float):
@@ -168,7 +175,8 @@ def apply_values(scene: Scene, values: Any) -> Scene:
         if len(text) > most:
             raise SceneError(name, f"longer than {most} characters")
         section, key = control.key.split(".")
-        value = text if control.widget == "text" else scalar(text)
+        # a text control's value is read as --set reads it (a vector, a word, TOML stops, a path)
+        value = parse_override(f"{control.key}={text}", CHECKS)[2] if control.widget == "text" else scalar(text)
         if control.widget == "checkbox":
             value = {"true": True, "false": False}.get(text.strip(), value)
         if m.group(2) is not None:
