@@ -137,6 +137,8 @@ def _check_scenes(anim: Animation, frames: range, device: Any, force: bool, outp
     seen: dict[str, list[int]] = {}
     for n in frames:
         s = anim.scene(n)
+        for t in anim.moments(n):   # a blurred frame's moments: each a valid scene too
+            anim.scene_at(t, f"frame[{n}]")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
@@ -210,7 +212,7 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
     for p in {p.parent: p for p in paths.values()}.values():  # the longest number per directory
         check_output_path(p)
     summary.stale_removed = len(remove_stale_temps(paths.values()))
-    tag = outputs_tag(outputs)
+    tag = outputs_tag(outputs) + (f"; motion blur {anim.shutter:g} x {anim.motion_samples}" if anim.shutter > 0 else "")
     bar = None
 
     def write(n: int, result: Any, info: Any) -> None:
@@ -238,7 +240,9 @@ def _frames(anim, frames, paths, summary, video, workers, scheduler, device, for
             else:
                 s = a.scene(n)
                 header = {HEADER_SCENE: s.to_toml(), HEADER_FRAME: str(n), HEADER_OUTPUTS: tag}
-                out.append((n, s, {"outputs": outputs, "encode": (paths[n].suffix.lower(), header)}))
+                blur = {"moments": tuple(a.scene_at(t, f"frame[{n}]") for t in a.moments(n)),
+                        "shutter": a.shutter} if a.shutter > 0 else {}
+                out.append((n, s, {"outputs": outputs, "encode": (paths[n].suffix.lower(), header), **blur}))
         return out
 
     # without camera.fit the frames on disk are known before any cluster starts

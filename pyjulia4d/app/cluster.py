@@ -98,11 +98,13 @@ def worker_device(spec: str | None) -> Any:
 
 
 def render_unit(scene: Scene, device: str | None = None, outputs=None, region=None,
-                force: bool = False, encode: tuple[str, dict] | None = None) -> tuple[Any, UnitInfo]:
+                force: bool = False, encode: tuple[str, dict] | None = None,
+                moments: tuple[Scene, ...] = (), shutter: float = 0.0) -> tuple[Any, UnitInfo]:
     """One work unit: executor.render of ``scene`` (its ``region`` alone for a tile) on the
-    worker's device.  Returns the RenderResult - or, with ``encode`` = (".png" or ".exr",
-    header), an EncodedImage of it, the header followed by the render's report - and a
-    UnitInfo."""
+    worker's device; with ``moments`` (a motion-blurred frame's scenes over a shutter of
+    ``shutter`` frames), each of them rendered and their mean kept (pipeline/motion.py).
+    Returns the RenderResult - or, with ``encode`` = (".png" or ".exr", header), an
+    EncodedImage of it, the header followed by the render's report - and a UnitInfo."""
     from pyjulia4d.opencl import build
     from pyjulia4d.opencl.executor import render
 
@@ -111,7 +113,13 @@ def render_unit(scene: Scene, device: str | None = None, outputs=None, region=No
     before = build.programs_built()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the client checked the scene and said its warnings
-        result = render(scene, device=dev, force=force, outputs=outputs, region=region)
+        if moments:
+            from pyjulia4d.pipeline.motion import blend
+
+            result = blend([render(m, device=dev, force=force, outputs=outputs, region=region) for m in moments],
+                           shutter)
+        else:
+            result = render(scene, device=dev, force=force, outputs=outputs, region=region)
     built = build.programs_built() - before
     if encode is not None:
         result = _encode(result, *encode)

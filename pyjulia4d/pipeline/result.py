@@ -48,6 +48,7 @@ class RenderResult:
     prediction: Prediction | None = None   # calibrate.py's, where a probe ran
     film: Film | None = None     # a path-traced render's samples, variance and stated noise (pipeline/film.py)
     backdrop: np.ndarray | None = None   # (H, W, 3) the gradient or image behind the set, where one is (pipeline/backdrop.py)
+    motion_blur: str = ""        # a frame blurred over its shutter: how (pipeline/motion.py); "" for none
     fell_back: str = ""          # the devices that failed before this one took the render over (opencl/failures.py)
 
     def __repr__(self) -> str:
@@ -154,6 +155,8 @@ class RenderResult:
         }
         if self.fell_back:
             header["pyjulia4d.device_failed"] = self.fell_back
+        if self.motion_blur:
+            header["pyjulia4d.motion_blur"] = self.motion_blur + "; depth, normals and errors: the middle moment's"
         fired = [f"{k} {v}" for k, v in self.guards.items() if v]
         tail = f", {self.capped} capped" if self.capped else ""
         tail += f"; guards fired: {', '.join(fired)}" if fired else ""

@@ -45,6 +45,7 @@ from pyjulia4d.scene.text import override_key, override_list, read_scene_table
 INTERPOLATIONS = ("linear", "smooth", "catmull-rom")
 MAX_FRAMES = 1_000_000
 MAX_FPS = 1000.0
+MAX_MOTION_SAMPLES = 64
 # Keys that cannot change between the frames of one sequence: a video's frames share a size.
 FIXED_KEYS = ("image.width", "image.height")
 CAMERA_VECTORS = ("camera.position", "camera.target", "camera.up", "camera.limbo")
@@ -135,6 +136,8 @@ class Animation:
     frames: int = 1
     fps: float = 24.0
     interpolation: str = "catmull-rom"
+    shutter: float = 0.0       # motion blur: the share of a frame's interval the shutter is open (0: none)
+    motion_samples: int = 8    # moments of the shutter each blurred frame is rendered at
     _cache: dict = field(default_factory=dict, compare=False, repr=False)
 
     def scene(self, n: int) -> Scene:
@@ -145,9 +148,26 @@ class Animation:
             return self._cache[n]
         if not 0 <= n < self.frames:
             raise SceneError("--frames", f"frame {n} is outside 0..{self.frames - 1}")
+        s = self.scene_at(float(n), f"frame[{n}]")
+        self._cache[n] = s
+        return s
+
+    def moments(self, n: int) -> tuple[float, ...]:
+        """The times frame ``n``'s motion blur samples: ``motion_samples`` moments spread
+        evenly over a shutter of ``shutter`` frames centred on n (the middle of each of as
+        many equal parts: t_k = n + shutter ((k + 1/2) / K - 1/2)); () without blur.  A track
+        holds its first and last keyed values beyond its keyframes, as at whole frames."""
+        if self.shutter <= 0:
+            return ()
+        k = self.motion_samples
+        return tuple(n + self.shutter * ((i + 0.5) / k - 0.5) for i in range(k))
+
+    def scene_at(self, t: float, name: str | None = None) -> Scene:
+        """The scene at frame time ``t`` (fractional between frames: a motion blur's moment),
+        validated; errors name ``name`` (default ``time[t]``)."""
         data = self.base.to_dict()
         for tr in self.tracks:
-            v = interpolate(tr.frames, tr.values, float(n), self.interpolation)
+            v = interpolate(tr.frames, tr.values, float(t), self.interpolation)
             if tr.integer:
                 value: Any = int(math.floor(float(v) + 0.5))
             elif v.ndim == 0:
@@ -162,11 +182,9 @@ class Animation:
             if got is not None:
                 cam["up"], cam["limbo"] = got
         try:
-            s = Scene.from_dict(data)
+            return Scene.from_dict(data)
         except SceneError as e:
-            raise SceneError(f"frame[{n}].{e.key}", e.reason) from None
-        self._cache[n] = s
-        return s
+            raise SceneError(f"{name or f'time[{t:g}]'}.{e.key}", e.reason) from None
 
     def with_camera(self, position, target) -> "Animation":
         """The animation with camera.fit resolved: every frame keeps this position and target
@@ -175,11 +193,14 @@ class Animation:
         vectors = {key: v.tolist() if isinstance(v, np.ndarray) else v
                    for key, v in (("camera.position", position), ("camera.target", target))}
         base = self.base.replace(**vectors, **{"camera.fit": False})
-        return Animation(base, self.tracks, self.frames, self.fps, self.interpolation)
+        return Animation(base, self.tracks, self.frames, self.fps, self.interpolation, self.shutter,
+                         self.motion_samples)
 
 
 def _animation_settings(table: Any, overrides: list[tuple[str, str]]) -> dict[str, Any]:
-    """[animation]: frames (integer >= 1), fps (> 0), interpolation; overrides (key, text) last."""
+    """[animation]: frames (integer >= 1), fps (> 0), interpolation, shutter ([0, 1]: the share
+    of a frame's interval the shutter is open, 0 no motion blur) and motion_samples (2 to
+    MAX_MOTION_SAMPLES moments rendered per blurred frame); overrides (key, text) last."""
     if table is None:
         table = {}
     if not isinstance(table, Mapping):
@@ -194,13 +215,18 @@ def _animation_settings(table: Any, overrides: list[tuple[str, str]]) -> dict[st
             out[key] = Integer(1, MAX_FRAMES)(dotted, value)
         elif key == "fps":
             out[key] = Real(0.0, MAX_FPS, lo_open=True)(dotted, value)
+        elif key == "shutter":
+            out[key] = Real(0.0, 1.0)(dotted, value)
+        elif key == "motion_samples":
+            out[key] = Integer(2, MAX_MOTION_SAMPLES)(dotted, value)
         elif key == "interpolation":
             if value not in INTERPOLATIONS:
                 raise SceneError(dotted, f"expected one of {', '.join(map(repr, INTERPOLATIONS))}, "
                                          f"got {show(value)}")
             out[key] = value
         else:
-            raise SceneError(show_key(dotted), "unknown key (animation takes frames, fps, interpolation)")
+            raise SceneError(show_key(dotted), "unknown key (animation takes frames, fps, interpolation, shutter, "
+                                               "motion_samples)")
     return out
 
 
@@ -309,7 +335,8 @@ def from_table(table: Mapping[str, Any], overrides: Iterable[str] = ()) -> Anima
     # keyframes past the last frame shape the curve (a loop's closing keyframe: frame N = frame 0)
     frames = settings.get("frames", max(last + 1, 1))
     anim = Animation(base, tuple(tracks), frames, settings.get("fps", 24.0),
-                     settings.get("interpolation", "catmull-rom"))
+                     settings.get("interpolation", "catmull-rom"), settings.get("shutter", 0.0),
+                     settings.get("motion_samples", 8))
     return anim
 
 

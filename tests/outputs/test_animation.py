@@ -406,3 +406,86 @@ def test_the_closing_line_says_where_the_frames_were_rendered():
     two = Summary(range(2), rendered=[0, 1], seconds=1.0, workers={("tcp://a:1", 7), ("tcp://b:1", 8)},
                   devices={"CPU X"})
     assert "on CPU X (on 2 workers)" in closing_line(two, "f_#.png", None, 24.0)
+
+
+# ---------------------------------------------------------------- motion blur
+
+SPIN = """
+[image]
+width = 48
+height = 36
+[camera]
+position = [1.8, 1.6, -2.2, 0.0]
+target = [0.0, 0.0, 0.0, 0.0]
+[animation]
+frames = 3
+interpolation = "linear"
+shutter = 0.5
+motion_samples = 4
+[[keyframe]]
+frame = 0
+slice.turn = [0, 0, 0, 0, 0, 0]
+[[keyframe]]
+frame = 2
+slice.turn = [40, 0, 0, 0, 0, 0]
+"""
+
+
+def test_motion_blur_moments_spread_over_the_shutter():
+    import tomllib
+
+    anim = from_table(tomllib.loads(SPIN))
+    assert anim.moments(1) == (0.8125, 0.9375, 1.0625, 1.1875)   # 1 + 0.5 ((k + 1/2) / 4 - 1/2)
+    assert anim.scene_at(0.9375).slice.turn[0] == pytest.approx(40 * 0.9375 / 2)
+    assert from_table(tomllib.loads(SPIN.replace("shutter = 0.5", "shutter = 0"))).moments(1) == ()
+
+
+def test_a_blurred_frame_is_the_mean_of_its_moments(tmp_path):
+    # the file animate writes holds exactly the mean colour and alpha of the frame's renders
+    # at its moments (pipeline/motion.py), and says so in its header; without a shutter the
+    # frame is the plain render of its scene
+    import tomllib
+
+    from pyjulia4d.app.output import write_image
+    from pyjulia4d.opencl.executor import render
+    from pyjulia4d.pipeline.motion import blend
+
+    anim = from_table(tomllib.loads(SPIN))
+    animate(anim, str(tmp_path / "f_####.png"), frames=[1], progress=False)
+    parts = [render(anim.scene_at(t)) for t in anim.moments(1)]
+    mean = blend(parts, anim.shutter)
+    assert np.allclose(mean.color, np.mean([p.color for p in parts], axis=0), atol=1e-6)
+    mean.scene = anim.scene(1)
+    write_image(tmp_path / "want.png", mean)
+    got, want = (np.asarray(Image.open(tmp_path / n)) for n in ("f_0001.png", "want.png"))
+    assert np.array_equal(got, want)
+    assert read_header(tmp_path / "f_0001.png")["pyjulia4d.motion_blur"].startswith("4 moments over 0.5 of a frame")
+    still = np.asarray(Image.open(tmp_path / "want.png"))
+    plain = render(anim.scene(1))
+    assert not np.array_equal(mean.alpha, plain.alpha)   # the turn through the shutter shows
+    assert still.shape == got.shape
+
+
+def test_motion_blur_noise_is_that_of_the_mean():
+    # K independent path-traced estimates: the mean's variance is sum var_k / K^2
+    from pyjulia4d.opencl.executor import render
+    from pyjulia4d.pipeline.motion import blend
+
+    s = Scene.default().with_overrides(["image.width=24", "image.height=18", "shading.integrator=path",
+                                        "image.samples=4"])
+    a, b = render(s), render(s, first_sample=4)
+    m = blend([a, b], 0.5)
+    cov = a.film.noise > 0
+    assert np.allclose(m.film.noise[cov], np.sqrt(a.film.noise[cov] ** 2 + b.film.noise[cov] ** 2) / 2, rtol=1e-5)
+    assert np.array_equal(m.film.paths, a.film.paths + b.film.paths)
+
+
+@pytest.mark.parametrize("setting, says", [("shutter = 1.5", "animation.shutter: "),
+                                           ("motion_samples = 1", "animation.motion_samples: ")])
+def test_bad_motion_blur_settings_are_one_line(tmp_path, setting, says):
+    text = SPIN.replace("shutter = 0.5", setting) if "shutter" in setting else SPIN.replace("motion_samples = 4", setting)
+    (tmp_path / "a.toml").write_text(text)
+    p = subprocess.run([sys.executable, "-m", "pyjulia4d", "animate", "a.toml", "-o", "f_####.png"], cwd=tmp_path,
+                       capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=120)
+    assert p.returncode == 2 and p.stderr.strip().startswith(f"pyjulia4d: error: {says}"), p.stderr
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["a.toml"]
