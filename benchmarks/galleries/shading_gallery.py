@@ -38,7 +38,8 @@ SCENES = {
                                     "direction 0,-1,0.3 color 1,0.45,0.2 intensity 0.35"],
     "mirror reflection 0.35 (dark blue background)": ["shading.reflection=0.35",
                                                        "shading.background=0.05,0.07,0.12"],
-    "antialiased, 9 samples": ["image.samples=9"],
+    "antialiased (9 samples), on a gradient": [
+        "image.samples=9", "shading.background_gradient=[[0, 0.1, 0.13, 0.25], [0.7, 0.45, 0.42, 0.5], [1, 0.75, 0.62, 0.5]]"],
     "cut open (z >= 0 kept)": ["clip.planes=0,0,-1,0"],
     "cut open, orbit trap, 4 samples": ["clip.planes=0,0,-1,0", "shading.coloring=trap",
                                         "shading.colormap=inferno", "image.samples=4"],
