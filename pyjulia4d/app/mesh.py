@@ -221,8 +221,9 @@ def build_mesh(scene: Scene, resolution: int = 128, device: Any = None, smooth: 
             bar.update(nk)
     t = time.perf_counter()
     if not parts_v:
+        cut = ", or clip.planes that keep more of it" if scene.clip.planes else ""
         raise SceneError("scene", f"the slice of the set holds no grid point of a {plan.n}^3 grid: nothing to "
-                                  f"mesh (a finer --resolution, or another slice)")
+                                  f"mesh (a finer --resolution, or another slice{cut})")
     # (k, j, i) -> (i, j, k); vertices on shared layers merge (exact halves: no tolerance needed)
     grid = trimesh.Trimesh(np.concatenate(parts_v)[:, ::-1], np.concatenate(parts_f), process=True)
     gv = np.asarray(grid.vertices)
