@@ -52,7 +52,9 @@
 #define SKY_SAMPLE(n, u1, u2) path_cosine((n), (u1), (u2))
 #endif
 #define PATH_FAR(radius) ((real4)(4 * (radius), 0, 0, 0))   /* a ray the march finds outside the ball */
-#define DIM(bounce, k) (4u + 8u * (uint)(bounce) + (uint)(k))   /* the random dimensions of a hit */
+/* the random dimensions of a hit, in Sobol' pairs (path/sample.cl): (0, 1) the light's or the
+ * sky's direction, 2 which light, 3 which lobe, (4, 5) the next direction, 6 the roulette */
+#define DIM(bounce, k) (4u + 8u * (uint)(bounce) + (uint)(k))
 
 inline pvec to_cam(real4 a, real4 right, real4 up, real4 forward)
 {
@@ -261,7 +263,7 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
     for (int e = 0; e < EXTRA_LIGHT_COUNT; e++)
         w_all += light_weight(lights_geo[e], lights_rgb[e], (real)lights_size[e], o, n, right, up, forward);
     /* the light j whose share of w_all holds the random number; none where no light can reach */
-    real u_pick = path_rand(key, s, DIM(bounce, 0)) * w_all;
+    real u_pick = path_rand(key, s, DIM(bounce, 2)) * w_all;
     int j = u_pick < w_key ? 0 : -1;
     real w_j = w_key, w_cum = w_key;
     for (int e = 0; e < EXTRA_LIGHT_COUNT; e++) {
@@ -303,15 +305,15 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
              * Humphreys 2023, §12.2.2, the cone of a sphere) */
             real cmax = lc.w != 0.0f ? cos(fmin(size, (real)90) * (real)(PATH_PI / 180))
                                      : sqrt(fmax((real)1 - (size / fmax(dist, size)) * (size / fmax(dist, size)), (real)0));
-            real ct = (real)1 - path_rand(key, s, DIM(bounce, 1)) * ((real)1 - cmax);
-            real st = sqrt(fmax((real)1 - ct * ct, (real)0)), phi = (real)(2 * PATH_PI) * path_rand(key, s, DIM(bounce, 2));
+            real ct = (real)1 - path_rand(key, s, DIM(bounce, 0)) * ((real)1 - cmax);
+            real st = sqrt(fmax((real)1 - ct * ct, (real)0)), phi = (real)(2 * PATH_PI) * path_rand(key, s, DIM(bounce, 1));
             l = path_unit(path_local(l, st * cos(phi), st * sin(phi), ct));
             dist = fmax(dist - size, (real)0);   /* the sphere's near side: a hit beyond it is behind the light */
         }
         le = (float)PATH_PI * (float4)(lc.xyz, 0.0f);   /* a white matte surface facing it: its colour */
         wl = (real)1;                   /* a light no bounce can hit: its sample takes it all */
     } else {
-        l = SKY_SAMPLE(n, path_rand(key, s, DIM(bounce, 1)), path_rand(key, s, DIM(bounce, 2)));
+        l = SKY_SAMPLE(n, path_rand(key, s, DIM(bounce, 0)), path_rand(key, s, DIM(bounce, 1)));
         dist = (real)INFINITY;
         real pl = SKY_PDF(n, l);
         float4 sl = SKY_RADIANCE(to_world(l, right, up, forward));

@@ -1,11 +1,19 @@
 /* path/sample.cl: the path tracer's random numbers and the densities it samples, written
  * once for path/path.cl and mirrored operation for operation by reference/path_sample.py.
  *
- * Random numbers are counter-based: dimension k of sample s of pixel p (p = y width + x in
- * the whole image) is a hash of the three, so a pixel's paths are the same whatever the
- * tiles, the workers or the order they run in.  The hash is Wellons' "lowbias32" integer
- * mix, chained over the three counters; its top 24 bits over 2^24 give a number in [0, 1)
- * that float and double hold exactly.
+ * Random numbers are counter-based and low-discrepancy: dimension k of sample s of pixel p
+ * (p = y width + x in the whole image) depends on those three alone, so a pixel's paths are
+ * the same whatever the tiles, the workers or the order they run in.  Dimensions come in
+ * pairs (2j, 2j + 1), and a pair's points over a pixel's samples s = 0, 1, 2, ... are the
+ * first two dimensions of Sobol's sequence, Owen-scrambled - the index shuffled and each
+ * coordinate scrambled by hash-based nested uniform scrambles seeded by the pixel and the
+ * pair (Burley, "Practical Hash-based Owen Scrambling", 2020, §3-4: the Laine-Karras
+ * permutation between bit reversals; each pair padded with its own seeds, as pbrt-v4's
+ * PaddedSobolSampler).  So every 2^m samples of a pair are stratified in every 2^a x 2^b
+ * grid with a + b = m (a (0, 2)-net), and the pairs of one path are independent of each
+ * other.  The seeds are Wellons' "lowbias32" integer mix of the pixel and the pair; a
+ * coordinate's top 24 bits over 2^24 give a number in [0, 1) that float and double hold
+ * exactly.
  *
  * The material (Walter, Marschner, Li & Torrance, "Microfacet Models for Refraction
  * through Rough Surfaces", 2007, §5.2 eqs. 33-34: GGX; Burley, "Physically Based Shading at
@@ -43,11 +51,50 @@ inline uint path_mix(uint x)
     return x;
 }
 
-/* dimension ``dim`` of sample ``s`` of pixel ``pixel``: a number in [0, 1) */
+/* x with its 32 bits in reverse order */
+inline uint path_reverse(uint x)
+{
+    uint r = 0u;
+    for (int k = 0; k < 32; ++k) {
+        r = (r << 1) | (x & 1u);
+        x >>= 1;
+    }
+    return r;
+}
+
+/* Burley's nested uniform scramble of x: the Laine-Karras permutation of its reversed bits */
+inline uint path_owen(uint x, uint seed)
+{
+    x = path_reverse(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return path_reverse(x);
+}
+
+/* the second dimension of Sobol's sequence at index i: direction numbers v_0 = 2^31,
+ * v_(k+1) = v_k ^ (v_k >> 1) (the first dimension is the bit reversal of i) */
+inline uint path_sobol1(uint i)
+{
+    uint r = 0u, v = 0x80000000u;
+    for (int k = 0; k < 32; ++k) {
+        r ^= v & (0u - ((i >> k) & 1u));
+        v ^= v >> 1;
+    }
+    return r;
+}
+
+/* dimension ``dim`` of sample ``s`` of pixel ``pixel``: a number in [0, 1) (see above) */
 inline real path_rand(uint pixel, uint s, uint dim)
 {
-    uint h = path_mix(pixel ^ path_mix(s ^ path_mix(dim + 0x9e3779b9u)));
-    return (real)(h >> 8) * (real)(1.0 / 16777216.0);
+    uint seed = path_mix(pixel ^ path_mix((dim >> 1) + 0x9e3779b9u));
+    uint i = path_owen(s, seed);
+    uint odd = dim & 1u;
+    uint x = odd ? path_sobol1(i) : path_reverse(i);
+    x = path_owen(x, path_mix(seed ^ (odd ? 0x68bc21ebu : 0x02e5be93u)));
+    return (real)(x >> 8) * (real)(1.0 / 16777216.0);
 }
 
 /* a / |a|, (0, 0, 1) where a is 0 */

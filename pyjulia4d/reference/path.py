@@ -180,7 +180,7 @@ class PathTwin:
             wts = np.stack([light_weight(geo[i], rgb[i], sizes[i], ob, nn, self.to_cam) for i in range(len(geo))]
                            + [np.full(k.size, pa.sky_weight if sky_on else 0.0)], axis=1)
             w_all = wts.sum(axis=1)
-            u_pick = path_rand(ks, s, dim(b, 0)) * w_all
+            u_pick = path_rand(ks, s, dim(b, 2)) * w_all
             cum = np.cumsum(wts, axis=1)
             # the first light whose running sum passes u (path.cl's walk: key, extra lights, sky);
             # -1 where none can reach the point
@@ -206,15 +206,15 @@ class PathTwin:
                     else:
                         q = size / np.maximum(dist[m], size)
                         cmax = np.sqrt(np.maximum(1 - q * q, 0))
-                    ct = 1 - path_rand(ks[m], s, dim(b, 1)) * (1 - cmax)
+                    ct = 1 - path_rand(ks[m], s, dim(b, 0)) * (1 - cmax)
                     st = np.sqrt(np.maximum(1 - ct * ct, 0))
-                    phi = 2 * PI * path_rand(ks[m], s, dim(b, 2))
+                    phi = 2 * PI * path_rand(ks[m], s, dim(b, 1))
                     l[m] = unit(local(l[m], st * np.cos(phi), st * np.sin(phi), ct))
                     dist[m] = np.maximum(dist[m] - size, 0)
                 le[m] = PI * c[:3]
             m = j == len(geo)
             if m.any():
-                l[m] = self.sky_sample(nn[m], path_rand(ks[m], s, dim(b, 1)), path_rand(ks[m], s, dim(b, 2)))
+                l[m] = self.sky_sample(nn[m], path_rand(ks[m], s, dim(b, 0)), path_rand(ks[m], s, dim(b, 1)))
                 pl = self.sky_pdf(nn[m], l[m])
                 sl = self.sky_radiance(self.to_world(l[m]), sky)
                 with np.errstate(divide="ignore", invalid="ignore"):

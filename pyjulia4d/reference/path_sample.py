@@ -22,12 +22,46 @@ def path_mix(x) -> np.ndarray:
     return x
 
 
+def _reverse(x) -> np.ndarray:
+    """The 32 bits of each uint32 in reverse order (path/sample.cl path_reverse)."""
+    x = np.asarray(x, np.uint32).copy()
+    for shift, mask in ((1, 0x55555555), (2, 0x33333333), (4, 0x0F0F0F0F), (8, 0x00FF00FF)):
+        s, m = np.uint32(shift), np.uint32(mask)
+        x = ((x >> s) & m) | ((x & m) << s)
+    return (x >> np.uint32(16)) | (x << np.uint32(16))
+
+
+def _owen(x, seed) -> np.ndarray:
+    """Burley's nested uniform scramble (path/sample.cl path_owen)."""
+    x = _reverse(x)
+    x = x + np.asarray(seed, np.uint32)
+    for k in (0x6C50B47C, 0xB82F1E52, 0xC7AFE638, 0x8D22F6E6):
+        x ^= x * np.uint32(k)
+    return _reverse(x)
+
+
+def _sobol1(i) -> np.ndarray:
+    """The second dimension of Sobol's sequence (path/sample.cl path_sobol1)."""
+    i = np.asarray(i, np.uint32)
+    r, v = np.zeros_like(i), 0x80000000
+    for k in range(32):
+        r ^= np.where((i >> np.uint32(k)) & np.uint32(1), np.uint32(v), np.uint32(0))
+        v ^= v >> 1
+    return r
+
+
 def path_rand(pixel, s, dim) -> np.ndarray:
-    """Dimension ``dim`` of sample ``s`` of pixel ``pixel``: [0, 1), 24 bits."""
+    """Dimension ``dim`` of sample ``s`` of pixel ``pixel``: [0, 1), 24 bits; a pair of
+    dimensions (2j, 2j + 1) is Owen-scrambled Sobol' over the samples (path/sample.cl)."""
     pixel = np.asarray(pixel, np.uint32)
-    inner = path_mix(np.asarray(dim, np.uint64).astype(np.uint32) + np.uint32(0x9E3779B9))
-    h = path_mix(pixel ^ path_mix(np.uint32(s) ^ inner))
-    return (h >> np.uint32(8)).astype(np.float64) / 16777216.0
+    dim = int(dim)
+    with np.errstate(over="ignore"):
+        seed = path_mix(pixel ^ path_mix(np.uint32(((dim >> 1) + 0x9E3779B9) & 0xFFFFFFFF)))
+        i = _owen(np.broadcast_to(np.asarray(s, np.uint64).astype(np.uint32), seed.shape), seed)
+        odd = dim & 1
+        x = _sobol1(i) if odd else _reverse(i)
+        x = _owen(x, path_mix(seed ^ np.uint32(0x68BC21EB if odd else 0x02E5BE93)))
+    return (x >> np.uint32(8)).astype(np.float64) / 16777216.0
 
 
 def dot(a, b) -> np.ndarray:

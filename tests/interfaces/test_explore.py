@@ -679,9 +679,10 @@ def test_a_path_traced_picture_refines_at_rest_to_the_render_of_the_scene(tmp_pa
         paths = [int(m["facts"]["paths"]) for m in frames if "paths" in m["facts"]]
         assert paths == [2, 4, 8, 16]
         noise = [float(m["facts"]["noise"].split()[1].rstrip(",")) for m in frames if "noise" in m["facts"]]
-        # from the second batch on: the standard error a 2-path batch states is itself rough
-        # (one degree of freedom a channel), its p50 often below the truth
-        assert noise[-1] < noise[1]
+        # from the third batch on: the standard error a batch of 2 or 4 paths states is itself
+        # rough (one to three degrees of freedom a channel, over stratified samples: a pixel's
+        # first few paths of a Sobol' pair often agree), its p50 often below the truth
+        assert noise[-1] < noise[2]
         s.handle({"op": "focus", "x": 0.5, "y": 0.5})
         assert s.scene.camera.focus != "auto" and 0 < s.scene.camera.focus < 10
         assert not got.of("error"), got.of("error")

@@ -126,9 +126,23 @@ def test_camera_rays_are_the_twins() -> None:
     assert np.abs(o - o2[:1]).max() > 1e-3   # the lens moved the origins: its dimensions were drawn
 
 
+def test_a_pixels_samples_of_a_pair_are_a_0_2_net() -> None:
+    """path_rand's pairs (2j, 2j + 1): a pixel's 2^m samples from any multiple of 2^m on put
+    exactly one point in each cell of every 2^a x 2^b grid with a + b = m (Owen-scrambled
+    Sobol' is a (0, 2)-sequence); counter-based random numbers would leave cells empty."""
+    m = 8
+    for pixel, first, pair in ((0, 0, 2), (7, 256, 3), (123456, 2 ** 30, 9)):
+        s = np.arange(first, first + 2 ** m)
+        px = np.full(2 ** m, pixel, np.uint32)
+        x, y = path_rand(px, s, 2 * pair), path_rand(px, s, 2 * pair + 1)
+        for a in range(m + 1):
+            cell = np.floor(x * 2 ** a).astype(int) * 2 ** (m - a) + np.floor(y * 2 ** (m - a)).astype(int)
+            assert np.all(np.bincount(cell, minlength=2 ** m) == 1), (pixel, first, pair, a)
+
+
 def test_path_rand_is_uniform_and_independent() -> None:
-    """The counters' hash: uniform per dimension (chi-square over 64 bins), uncorrelated
-    between neighbouring pixels, samples and dimensions."""
+    """Over pixels (each scrambled by its own seeds): uniform per dimension (chi-square over 64
+    bins), uncorrelated between neighbouring pixels, samples and dimensions."""
     n = 200_000
     pixel = np.arange(n, dtype=np.uint32)
     a, b, c = path_rand(pixel, 3, 9), path_rand(pixel + 1, 3, 9), path_rand(pixel, 4, 9)
