@@ -28,7 +28,7 @@ from pyjulia4d.pipeline.colormap import srgb_to_linear
 from pyjulia4d.scene.checks import SceneError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".hdr")
-MAX_PIXELS = 1 << 28   # a backdrop image read whole: 256 Mpixel at most (3 GiB of float32 RGB)
+MAX_PIXELS = 1 << 27   # a backdrop image is read whole: 134 Mpixel at most (1.5 GiB as float32 RGB)
 
 
 def has_backdrop(shading) -> bool:
