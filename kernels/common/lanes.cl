@@ -51,6 +51,20 @@ typedef struct {
 #define COUNTER_NONE
 #endif
 
+/* -D CLIP: the scene's up to 4 half-spaces clip_n[k] . p <= clip_off[k] (scene.Clip), the
+ * arguments of the kernels that cut the set (march/march.cl, mesh/mesh.cl), handed on to their
+ * helpers by CLIP_PASS; CLIP_NORMAL(k) and CLIP_OFFSET(k) are plane k's (march/clip.cl too). */
+#ifdef CLIP
+#define CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
+                  const real4 clip_n3, const real4 clip_off
+#define CLIP_PASS , n_clip, clip_n0, clip_n1, clip_n2, clip_n3, clip_off
+#else
+#define CLIP_ARGS
+#define CLIP_PASS
+#endif
+#define CLIP_NORMAL(k) ((k) == 0 ? clip_n0 : (k) == 1 ? clip_n1 : (k) == 2 ? clip_n2 : clip_n3)
+#define CLIP_OFFSET(k) ((k) == 0 ? clip_off.x : (k) == 1 ? clip_off.y : (k) == 2 ? clip_off.z : clip_off.w)
+
 /* Dot products and unit vectors of one work-item's vectors, written out.  Intel's CPU
  * compiler runs a kernel of one ray per work-item 16 work-items at a time (AVX-512), but not
  * where it calls the builtin dot, length, normalize or cross: then its build log says "was

@@ -14,7 +14,7 @@ __kernel void clip_normals(const int n_items, __global const int *flags, __globa
     if (status[i] != STATUS_HIT || !(f & FLAG_CUT_FACE))
         return;
     int k = (f >> 5) & 3;
-    real4 n = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
+    real4 n = CLIP_NORMAL(k);
     real3 c = (real3)(DOT4(n, right), DOT4(n, up), -DOT4(n, forward));   /* common/lanes.cl DOT3 */
     c *= rsqrt(DOT3(c, c));   /* n is a unit 4-vector (plan.py), its 3D image not 0 */
     normal[i] = (real4)(c.x, c.y, c.z, 0);

@@ -37,13 +37,7 @@
 /* -D CLIP: up to 4 half-spaces clip_n[k] . p <= clip_off[k] cut the set open (scene.Clip):
  * each clips [near, far]; a hit at the first point of an interval that a plane started
  * lies on that plane's cut face, flagged FLAG_CUT_FACE | k << 5 for march/clip.cl. */
-#ifdef CLIP
-/* FLAG_CUT_FACE: common/codes.cl */
-#define CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
-                  const real4 clip_n3, const real4 clip_off
-#else
-#define CLIP_ARGS
-#endif
+/* (FLAG_CUT_FACE: common/codes.cl; CLIP_ARGS: common/lanes.cl) */
 
 /* -D CONE_START (the estimate's march of camera rays, march/cone.cl): each ray of a block
  * whose entry the block's cone covers starts at the cone's t_last; cone holds the tile's
@@ -65,8 +59,8 @@ inline lmask clip_span(quat o, quat d, int n_clip, real4 clip_n0, real4 clip_n1,
 {
     lmask cut = 0;
     for (int k = 0; k < n_clip; ++k) {
-        real4 nk = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
-        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
+        real4 nk = CLIP_NORMAL(k);
+        real off = CLIP_OFFSET(k);
         lreal dn = QDOT_UNIFORM(d, nk), on = QDOT_UNIFORM(o, nk) - off;
         lreal tp = -on / dn;
         *far = L_SEL(*far, fmin(*far, tp), dn > (real)0);

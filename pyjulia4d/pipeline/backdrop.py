@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from pyjulia4d.pipeline.colormap import srgb_to_linear
+from pyjulia4d.pipeline.environment import three_channels
 from pyjulia4d.scene.checks import SceneError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".hdr")
@@ -77,11 +78,7 @@ def _covered(path: str, size: int, mtime: int, value: str, height: int, width: i
     out = oiio.ImageBufAlgo.resize(crop, roi=oiio.ROI(0, width, 0, height, 0, 1, 0, crop.nchannels))
     if out.has_error:
         raise SceneError(key, f"{value}: cannot be resized ({' '.join(out.geterror().split())[:160]})")
-    rgb = np.asarray(out.get_pixels(oiio.FLOAT), np.float32).reshape(height, width, -1)
-    if rgb.shape[2] == 1:
-        rgb = np.repeat(rgb, 3, axis=2)
-    elif rgb.shape[2] == 2:
-        rgb = np.concatenate([rgb, rgb[..., :1]], axis=2)
+    rgb = three_channels(np.asarray(out.get_pixels(oiio.FLOAT), np.float32).reshape(height, width, -1))
     if not np.all(np.isfinite(rgb)):
         raise SceneError(key, f"{value}: holds non-finite values, which are not light")
     rgb = np.maximum(rgb, 0.0)   # a Lanczos filter rings a little below 0 at hard edges

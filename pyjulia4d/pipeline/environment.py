@@ -94,14 +94,19 @@ def _load(path: str, size: int, mtime: int, value: str) -> Environment:
         inp.close()
     if pixels is None or err:
         raise SceneError(key, f"{value}: cannot read its pixels ({' '.join(str(err).split())[:160] or 'truncated?'})")
-    rgb = np.asarray(pixels, np.float32).reshape(h, w, -1)
-    if rgb.shape[2] == 1:
-        rgb = np.repeat(rgb, 3, axis=2)
-    elif rgb.shape[2] == 2:
-        rgb = np.concatenate([rgb, rgb[..., :1]], axis=2)
+    rgb = three_channels(np.asarray(pixels, np.float32).reshape(h, w, -1))
     if not np.all(np.isfinite(rgb)) or np.any(rgb < 0):
         raise SceneError(key, f"{value}: holds negative or non-finite values, which are not light")
     return build(rgb, value)
+
+
+def three_channels(a: np.ndarray) -> np.ndarray:
+    """(H, W, 1-3) pixels as (H, W, 3): grey repeated, a second channel's third taken from the first."""
+    if a.shape[2] == 1:
+        return np.repeat(a, 3, axis=2)
+    if a.shape[2] == 2:
+        return np.concatenate([a, a[..., :1]], axis=2)
+    return a
 
 
 def build(rgb: np.ndarray, name: str = "") -> Environment:

@@ -17,7 +17,7 @@ from pyjulia4d.pipeline.plan import Plan
 from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.reference.march import march
 from pyjulia4d.reference.normals import clip_normals, normals_gradient, normals_jacobian
-from pyjulia4d.reference.path_sample import (PI, bsdf_eval, cosine, disc, dot, ggx_half, local, path_rand,
+from pyjulia4d.reference.path_sample import (PI, bsdf_eval, cosine, disc, dot, ggx_half, local, path_rand, path_rand2,
                                              power_weight, spec_share, unit)
 from pyjulia4d.reference.path_environment import EnvTwin
 from pyjulia4d.reference.shade import orbit_iteration, orbit_trap
@@ -87,14 +87,14 @@ class PathTwin:
         p, fr = self.plan, self.plan.frame
         W, H = p.image.width, p.image.height
         key = (py.astype(np.uint64) * W + px).astype(np.uint32)
-        ox, oy = path_rand(key, s, 0), path_rand(key, s, 1)
+        ox, oy = path_rand2(key, s, 0)
         u = (2 * (px + ox) / W - 1) * fr.tan_half_fov * (W / H)
         v = (1 - 2 * (py + oy) / H) * fr.tan_half_fov
         d = fr.forward + u[:, None] * fr.right + v[:, None] * fr.up
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         o = np.tile(np.asarray(fr.position, np.float64), (len(px), 1))
         if p.path.aperture > 0:
-            l = p.path.aperture * disc(path_rand(key, s, 2), path_rand(key, s, 3))
+            l = p.path.aperture * disc(*path_rand2(key, s, 2))
             f = o + d * (p.path.focus / (d @ fr.forward))[:, None]
             o = o + l[:, :1] * fr.right + l[:, 1:2] * fr.up
             d = (f - o) / np.linalg.norm(f - o, axis=1, keepdims=True)
@@ -206,15 +206,16 @@ class PathTwin:
                     else:
                         q = size / np.maximum(dist[m], size)
                         cmax = np.sqrt(np.maximum(1 - q * q, 0))
-                    ct = 1 - path_rand(ks[m], s, dim(b, 0)) * (1 - cmax)
+                    uc, uphi = path_rand2(ks[m], s, dim(b, 0))
+                    ct = 1 - uc * (1 - cmax)
                     st = np.sqrt(np.maximum(1 - ct * ct, 0))
-                    phi = 2 * PI * path_rand(ks[m], s, dim(b, 1))
+                    phi = 2 * PI * uphi
                     l[m] = unit(local(l[m], st * np.cos(phi), st * np.sin(phi), ct))
                     dist[m] = np.maximum(dist[m] - size, 0)
                 le[m] = PI * c[:3]
             m = j == len(geo)
             if m.any():
-                l[m] = self.sky_sample(nn[m], path_rand(ks[m], s, dim(b, 0)), path_rand(ks[m], s, dim(b, 1)))
+                l[m] = self.sky_sample(nn[m], *path_rand2(ks[m], s, dim(b, 0)))
                 pl = self.sky_pdf(nn[m], l[m])
                 sl = self.sky_radiance(self.to_world(l[m]), sky)
                 with np.errstate(divide="ignore", invalid="ignore"):
@@ -231,7 +232,7 @@ class PathTwin:
                 R[k[ls[reach]]] += add[ls[reach]]
             if b + 1 >= pa.bounces:
                 break
-            u1, u2 = path_rand(ks, s, dim(b, 4)), path_rand(ks, s, dim(b, 5))
+            u1, u2 = path_rand2(ks, s, dim(b, 4))
             spec = path_rand(ks, s, dim(b, 3)) < ps
             h = ggx_half(nn, pa.alpha2, u1, u2)
             nd = np.where(spec[:, None], 2 * dot(v, h)[:, None] * h - v, cosine(nn, u1, u2))

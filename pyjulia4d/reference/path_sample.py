@@ -50,18 +50,39 @@ def _sobol1(i) -> np.ndarray:
     return r
 
 
+def _seed(pixel, pair: int) -> np.ndarray:
+    """The seed of a pair of a pixel's dimensions (path/sample.cl path_seed)."""
+    return path_mix(np.asarray(pixel, np.uint32) ^ path_mix(np.uint32((pair + 0x9E3779B9) & 0xFFFFFFFF)))
+
+
+def _coord(i, seed, odd: int) -> np.ndarray:
+    """Coordinate ``odd`` of a pair's point at the shuffled index i (path/sample.cl path_coord)."""
+    x = _sobol1(i) if odd else _reverse(i)
+    x = _owen(x, path_mix(seed ^ np.uint32(0x68BC21EB if odd else 0x02E5BE93)))
+    return (x >> np.uint32(8)).astype(np.float64) / 16777216.0
+
+
+def _index(s, seed) -> np.ndarray:
+    """The sample index shuffled (path/sample.cl: path_owen(s, seed))."""
+    return _owen(np.broadcast_to(np.asarray(s, np.uint64).astype(np.uint32), seed.shape), seed)
+
+
 def path_rand(pixel, s, dim) -> np.ndarray:
     """Dimension ``dim`` of sample ``s`` of pixel ``pixel``: [0, 1), 24 bits; a pair of
     dimensions (2j, 2j + 1) is Owen-scrambled Sobol' over the samples (path/sample.cl)."""
-    pixel = np.asarray(pixel, np.uint32)
     dim = int(dim)
     with np.errstate(over="ignore"):
-        seed = path_mix(pixel ^ path_mix(np.uint32(((dim >> 1) + 0x9E3779B9) & 0xFFFFFFFF)))
-        i = _owen(np.broadcast_to(np.asarray(s, np.uint64).astype(np.uint32), seed.shape), seed)
-        odd = dim & 1
-        x = _sobol1(i) if odd else _reverse(i)
-        x = _owen(x, path_mix(seed ^ np.uint32(0x68BC21EB if odd else 0x02E5BE93)))
-    return (x >> np.uint32(8)).astype(np.float64) / 16777216.0
+        seed = _seed(pixel, dim >> 1)
+        return _coord(_index(s, seed), seed, dim & 1)
+
+
+def path_rand2(pixel, s, dim) -> tuple[np.ndarray, np.ndarray]:
+    """Dimensions ``dim`` and dim + 1 (dim even) at once: path_rand's two (path/sample.cl path_rand2)."""
+    dim = int(dim)
+    with np.errstate(over="ignore"):
+        seed = _seed(pixel, dim >> 1)
+        i = _index(s, seed)
+        return _coord(i, seed, 0), _coord(i, seed, 1)
 
 
 def dot(a, b) -> np.ndarray:
