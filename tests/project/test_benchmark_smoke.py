@@ -456,3 +456,54 @@ def test_gpu_check_stops_without_a_gpu(tmp_path):
     assert p.returncode == 3, p.stdout + p.stderr
     assert "gpu_check: no OpenCL GPU found" in p.stdout
     assert "(default)" in (tmp_path / "devices.txt").read_text()
+
+
+def test_proof_budget_ball_is_proven_and_the_largest():
+    """benchmarks/studies/proof_budget.py's certified ball: every point drawn in the ball about
+    p escapes (|q_k| > bailout for some k <= max_iter, checked in float64 by iterating), for
+    the square and the cube; the recursion it inverts, run forward, proves the ball of 0.999 r
+    and not that of 1.001 r (r is the largest it proves); and a point inside the set gets 0."""
+    pb = load("proof_budget")
+    rng = np.random.default_rng(5)
+    c = np.array([-0.2, 0.8, 0.0, 0.0])
+    for degree in (2, 3):
+        p = rng.normal(size=(40, 4)) * 0.7
+        r = pb.best_ball(p, c, 12, 4.0, degree)
+        assert (r >= 0).all() and (r > 0).sum() > 20
+        for i in np.nonzero(r > 0)[0][:12]:
+            u = rng.normal(size=(400, 4))
+            u *= (rng.random(400) ** 0.25 * r[i] / np.linalg.norm(u, axis=1))[:, None]
+            q = p[i] + u
+            escaped = np.linalg.norm(q, axis=1) > 4.0
+            for _ in range(12):
+                q = np.where(escaped[:, None], q, (pb._qmul(q, q) if degree == 2 else pb._qmul(pb._qmul(q, q), q)) + c)
+                escaped |= np.linalg.norm(q, axis=1) > 4.0
+            assert escaped.all()
+            # forward: r_{k+1} = (|q_k| + r_k)^D - |q_k|^D proves the ball from 0.999 r, and from 1.001 r at no k
+            for factor, want in ((0.999, True), (1.001, False)):
+                q, rk, proves = p[i:i + 1].copy(), r[i] * factor, False
+                with np.errstate(all="ignore"):   # escaped orbits overflow to inf: no proof there
+                    for _ in range(13):
+                        a = np.linalg.norm(q)
+                        proves |= np.isfinite(a) & (a - rk > 4.0)
+                        # (a + r)^D - a^D without its cancellation where a is far larger than r
+                        rk = rk * (2 * a + rk) if degree == 2 else rk * (3 * a * a + 3 * a * rk + rk * rk)
+                        q = (pb._qmul(q, q) if degree == 2 else pb._qmul(pb._qmul(q, q), q)) + c
+                assert bool(proves) == want
+    assert pb.best_ball(np.zeros((1, 4)), np.zeros(4), 12, 4.0, 2)[0] == 0.0   # 0 is inside for c = 0
+
+
+def test_proof_budget_report_runs(tmp_path):
+    """benchmarks/studies/proof_budget.py, tiny (the float64 twin, no OpenCL): every row."""
+    assert load("proof_budget").main(["--size", "16x12", "--beam-size", "32x24", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "proof_budget.md").read_text()
+    assert "commit" in md and "| proven march, normal preset |" in md and "Beam start at 32x24" in md
+
+
+def test_path_noise_sources_report_runs(tmp_path):
+    """benchmarks/studies/path_noise_sources.py, tiny: a row per variant, finite deviations."""
+    bench = load("path_noise_sources")
+    assert bench.main(["--size", "16x12", "--samples", "4", "--out", str(tmp_path)]) == 0
+    rows = [ln for ln in (tmp_path / "path_noise_sources.md").read_text().splitlines() if ln.startswith("| ") and "---" not in ln][1:]
+    assert len(rows) == len(bench.VARIANTS)
+    assert all(np.isfinite(float(ln.split("|")[3])) for ln in rows)
