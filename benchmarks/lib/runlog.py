@@ -36,6 +36,13 @@ def append_run(path: Path, title: str, section: str) -> None:
     os.replace(tmp, path)
 
 
+def append_study(out: Path, script: str, heading: str, section: str) -> None:
+    """Append ``section`` to ``out``/<the script's name>.md, a file that begins with ``heading``
+    and names the script (benchmarks/<family>/<name>.py) that writes it."""
+    name = Path(script).stem
+    append_run(out / f"{name}.md", f"# {heading}\n\nWritten by {script}; a section per run.\n", section)
+
+
 def short_commit(rev: str) -> str | None:
     """``rev``'s short commit in this repository, None where it names none."""
     got = subprocess.run(["git", "rev-parse", "--short", "--verify", "--quiet", f"{rev}^{{commit}}"], cwd=ROOT,

@@ -24,7 +24,7 @@ if str(ROOT) not in sys.path:   # the checkout: its pyjulia4d, and benchmarks/ a
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.lib.args import Parser, size_of  # noqa: E402
-from benchmarks.lib.runlog import append_run, git_commit, utc_now  # noqa: E402
+from benchmarks.lib.runlog import append_study, git_commit, utc_now  # noqa: E402
 from benchmarks.speed.path_clean import KEYS  # noqa: E402
 
 from pyjulia4d import Scene, render  # noqa: E402
@@ -68,9 +68,7 @@ def main(argv=None) -> int:
             "| light | mean colour | one path's relative deviation | paths for 2 % | paths per CPU-second |\n",
             "| --- | ---: | ---: | ---: | ---: |\n"]
     text += [f"| {nm} | {mu:.3f} | {dv:.2f} | {(dv / 0.02) ** 2:.0f} | {pps:.3g} |\n" for nm, mu, dv, pps in rows]
-    append_run(a.out / "path_noise_sources.md",
-               "# Where a path-traced picture's noise comes from\n\nWritten by "
-               "benchmarks/studies/path_noise_sources.py; a section per run.\n", "".join(text))
+    append_study(a.out, "benchmarks/studies/path_noise_sources.py", "Where a path-traced picture's noise comes from", "".join(text))
     return 0
 
 

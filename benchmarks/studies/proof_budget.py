@@ -39,7 +39,7 @@ if str(ROOT) not in sys.path:   # the checkout: its pyjulia4d, and benchmarks/ a
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.lib.args import Parser, size_of  # noqa: E402
-from benchmarks.lib.runlog import append_run, git_commit, utc_now  # noqa: E402
+from benchmarks.lib.runlog import append_study, git_commit, utc_now  # noqa: E402
 
 from pyjulia4d import Scene  # noqa: E402
 from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks, make_plan  # noqa: E402
@@ -231,9 +231,7 @@ def main(argv=None) -> int:
             f"the beam plus {beam_count / (bw * bh):.2f} for the beams ({beam_count / len(cone[0]):.1f} per block); "
             f"{np.mean(start[blive] > bnear[blive]) * 100:.0f} % of the rays started behind a beam.\n"]
     print("".join(text))
-    append_run(a.out / "proof_budget.md",
-               "# Where a proof of the space in front spends its work\n\nWritten by "
-               "benchmarks/studies/proof_budget.py; a section per run.\n", "".join(text))
+    append_study(a.out, "benchmarks/studies/proof_budget.py", "Where a proof of the space in front spends its work", "".join(text))
     return 0
 
 
