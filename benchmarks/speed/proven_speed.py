@@ -60,10 +60,10 @@ def proof_share(scene: Scene) -> float:
     original = M.enc_prove
 
     def counted(*a, **k):
-        proven, margin = original(*a, **k)
+        proven, margin, prefix = original(*a, **k)
         counts[0] += int(proven.sum())
         counts[1] += proven.size
-        return proven, margin
+        return proven, margin, prefix
 
     M.enc_prove = counted
     try:

@@ -99,6 +99,13 @@ def best_ball(p, c, max_iter, bailout, degree):
             norms.append(np.linalg.norm(q, axis=1))
     a = np.minimum(np.nan_to_num(np.array(norms), nan=1e100, posinf=1e100), 1e100)
     best = np.zeros(len(p))
+    with np.errstate(all="ignore"):   # orbits far past the bailout: capped, as above
+        return _invert(a, bailout, degree, best)
+
+
+def _invert(a, bailout, degree, best):
+    """best_ball's inversion from every escaped k back to k = 0 (norms ``a``, (max_iter + 1, n))."""
+    max_iter = a.shape[0] - 1
     for k in range(max_iter + 1):
         m = np.where(a[k] > bailout, a[k] - bailout, 0.0)
         for j in range(k - 1, -1, -1):

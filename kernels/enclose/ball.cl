@@ -92,6 +92,15 @@ inline lmask enc_outside(enclosure e, real bailout2)
     return (l > (real)0) & (l * l > bailout2);
 }
 
+/* the part [-1, s] of the segment the form keeps outside the bailout (-1: none; ``live``: the
+ * lanes that ask), march/proven.cl's partial proofs (enclose/disc.cl enc_prefix_of): every
+ * point's |q| >= |m + s v| (1 - ENC_ROUND) - r > bailout there */
+#define ENC_HAS_PREFIX
+inline lreal enc_prefix(enclosure e, real bailout, lmask live)
+{
+    return enc_prefix_of(e.m, e.v, e.ml * e.ml, bailout + e.r, live);
+}
+
 /* how many times its extent the centre lies beyond the bailout (<= 0: inside): the march
  * sizes its next segment by it */
 inline lreal enc_margin(enclosure e, real bailout) { return (e.ml - bailout) / (e.vl + e.r); }

@@ -100,6 +100,34 @@ inline lreal enc_least_norm(quat m, quat v)
     return QLEN(QADD(m, QSCALE(s, v)));
 }
 
+/* A partial proof (march/proven.cl): where a form does not keep all of its segment outside
+ * the bailout, it may keep a part [-1, s] in front.  Given |m|^2 (mm), returns the largest s
+ * in [-1, 1] with |m + s' v| (1 - ENC_ROUND) > reach for every s' in [-1, s], -1 where none
+ * is found.  Only where the segment's start is outside (|m - v| past reach: the iterations
+ * about its own escape; the rest return -1 at once) is the smaller root of |v|^2 s^2 +
+ * 2 (m . v) s + |m|^2 - rho^2 taken (1 where there is none), drawn in towards -1 by
+ * PREFIX_DRAW of its distance, and checked: |m + s v| falls on [-1, s] (s before the
+ * least's s = -(m . v) / |v|^2), so its value at s is its least there, tested as the
+ * enclosure piece tests the whole.  Rounding in the root costs a shorter part, never a
+ * wrong one. */
+#define PREFIX_DRAW ((real)2.44140625e-4)   /* 2^-12 */
+
+inline lreal enc_prefix_of(quat m, quat v, lreal mm, lreal reach, lmask live)
+{
+    lreal vv = QNORM2(v), mv = QDOT(m, v);
+    lreal rho = reach / ((real)1 - ENC_ROUND);
+    lreal rho2 = rho * rho;
+    lmask go = live & (mm - (real)2 * mv + vv > rho2);
+    if (!L_ANY(go))
+        return (lreal)-1;
+    lreal disc = mv * mv - vv * (mm - rho2);
+    lreal root = (-mv - sqrt(fmax(disc, (lreal)0))) / fmax(vv, (lreal)REAL_MIN);
+    lreal s = L_SEL(fmin(fmax(root, (lreal)-1), (lreal)1), (lreal)1, (disc < (real)0) | (vv == (real)0));
+    s = (real)-1 + (s + (real)1) * ((real)1 - PREFIX_DRAW);
+    lreal l = QLEN(QADD(m, QSCALE(s, v))) * ((real)1 - ENC_ROUND);
+    return L_SEL((lreal)-1, s, go & (s * vv <= -mv) & (l > reach) & (s > (real)-1));
+}
+
 /* The disc of a function piece that states FUNC_M2 (its bound on |f''|): d_taylor with its
  * own cfun, cfun_d and that bound, expanded where the piece uses it */
 #define D_TAYLOR_OF(z) d_taylor(cfun((z).m), c_abs(cfun_d((z).m)), (z).r, FUNC_M2((z).m, (z).r))

@@ -87,6 +87,17 @@ inline lmask enc_outside(enclosure e, real bailout2)
     return (l > (real)0) & ((real)0.5 * l * l > bailout2);
 }
 
+/* the part [-1, s] of the segment the forms keep outside the bailout (-1: none; ``live``: the
+ * lanes that ask), march/proven.cl's partial proofs (enclose/disc.cl enc_prefix_of): every
+ * point's |h|^2 = |(a, b)|^2 / 2 with |(a, b)| >= |m + s v| (1 - ENC_ROUND) - |(ra, rb)| >
+ * sqrt(2) bailout there */
+#define ENC_HAS_PREFIX
+inline lreal enc_prefix(enclosure e, real bailout, lmask live)
+{
+    quat m = QUAT(e.a.m.re, e.a.m.im, e.b.m.re, e.b.m.im), v = QUAT(e.a.v.re, e.a.v.im, e.b.v.re, e.b.v.im);
+    return enc_prefix_of(m, v, QNORM2(m), (real)1.4142135623730951 * bailout + lane_hypot(e.a.r, e.b.r), live);
+}
+
 /* how many times its extent the centre lies beyond the bailout (<= 0: inside) */
 inline lreal enc_centre_norm(enclosure e)
 {

@@ -32,10 +32,16 @@
 
 /* Whether [t0, t1] is proven empty, for the lanes in ``todo``; *margin gets the largest
  * enc_margin over the iterations: about how many times longer the segment could have been
- * (> 1, proven) or must be shorter (< 1) to be proven, to first order in its length. */
+ * (> 1, proven) or must be shorter (< 1) to be proven, to first order in its length.
+ * *prefix gets the largest s in [-1, 1] whose part [-1, s] of the segment (s = -1 at t0, 1 at
+ * t1) some iteration's form keeps outside the bailout (enc_prefix: 1 where proven, -1 where
+ * none).  Different points may leave at different iterations, so each iteration's part is
+ * proven on its own, and the longest is kept. */
 /* enc_start, enc_next, ENC_STEPS and enc_param: the kind's orbits (enclose/julia.cl,
- * enclose/mandelbrot.cl) */
-inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, lreal *margin)
+ * enclose/mandelbrot.cl); enc_prefix: the algebra's enclosure piece (enclose/ball.cl,
+ * enclose/split.cl), where it has one (ENC_HAS_PREFIX) */
+inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, lreal *margin,
+                       lreal *prefix)
 {
     enc_param p;
     enclosure e = enc_start(o, d, t0, t1, jp, &p);
@@ -43,17 +49,39 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
     lmask proven = todo & enc_outside(e, jp.bailout2);
     lmask live = todo & !proven;
     lreal best = enc_margin(e, bailout);
+#ifdef ENC_HAS_PREFIX
+    lreal pre = enc_prefix(e, bailout, todo & !proven);
+#else
+    lreal pre = (lreal)-1;
+#endif
     int n = 0;
     for (; n < ENC_STEPS(jp) && L_ANY(live); ++n) {
         e = enc_next(e, p, live);
         lmask out = live & enc_outside(e, jp.bailout2);
         best = L_SEL(best, fmax(best, enc_margin(e, bailout)), live);
+#ifdef ENC_HAS_PREFIX
+        pre = L_SEL(pre, fmax(pre, enc_prefix(e, bailout, live)), live);
+#endif
         proven |= out;
         live &= (!out) & enc_hopeful(e, bailout);
     }
     COUNT_ITER(jp, n);
     *margin = best;
+    *prefix = L_SEL(pre, (lreal)1, proven);
     return proven;
+}
+
+/* After a partial proof the next segment is PREFIX_NEXT times its part: on the default scene
+ * (float64 twin, 80x60) 1 took 23.7 enclosures a ray, 1.5 26.5, 2 29.3, against 32.5 with no
+ * partial proofs.  Its end is pulled in by PREFIX_PULL of itself, two float32 spacings, so
+ * that rounding t0 + (t1 - t0) (s + 1) / 2 never passes the part proven. */
+#define PREFIX_NEXT ((real)1)
+#define PREFIX_PULL ((real)0.99999952316284180)   /* 1 - 2^-21 */
+
+/* the end of the part of [t0, t1] a partial proof keeps */
+inline lreal prefix_end(lreal t0, lreal t1, lreal pre)
+{
+    return (t0 + (t1 - t0) * ((pre + (real)1) * (real)0.5)) * PREFIX_PULL;
 }
 
 /* the first segment: an eighth of the ray, or the floor if that is longer */
@@ -112,11 +140,14 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal fine_end = (lreal)-INFINITY, outer_floor = floor_w;
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lreal t1 = fmin(t + h, far);
-        lreal margin;
-        lmask empty = enc_prove(o, d, t, t1, active, jp, &margin);
+        lreal margin, pre;
+        lmask empty = enc_prove(o, d, t, t1, active, jp, &margin, &pre);
         n = L_SEL(n, n + 1, active);
         lmask fine = fine_end > t;
         lmask at_floor = active & !empty & (h <= floor_here);
+        /* a partial proof above the floor (outside the fine look): its part passed, proven */
+        lreal t_pre = prefix_end(t, t1, pre);
+        lmask part = active & !empty & !fine & (h > floor_here) & (t_pre > t);
         lmask got = 0;
         if (L_ANY(at_floor)) {   /* FLOOR_POINTS points across it, in order: a thin part may hold the first */
             lmask look = at_floor;
@@ -140,9 +171,10 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         lreal t_end = L_SEL(t1, fmax(t1, fine_end), give_up);
         open_w = L_SEL(open_w, open_w + (t_end - t), open);
         t_open = L_SEL(t_open, fmin(t_open, t), open);
-        run = L_SEL(L_SEL(run, (lreal)0, empty), run + 1, open);
+        lmask proof = empty | part;
+        run = L_SEL(L_SEL(run, (lreal)0, proof), run + 1, open);
         lmask wider = open & (run >= (real)FLOOR_RUN);
-        floor_here = L_SEL(L_SEL(floor_here, floor_w, empty), fmin(floor_here * 2, widest), wider);
+        floor_here = L_SEL(L_SEL(floor_here, floor_w, proof), fmin(floor_here * 2, widest), wider);
         run = L_SEL(run, (lreal)0, wider);
         hit |= got;
         lmask pass = empty | open;
@@ -155,7 +187,8 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
         h = L_SEL(h, fmin(h * grow, span), empty);
         h = L_SEL(h, fmax(h * shrink, floor_here), active & !empty & !at_floor);
         h = L_SEL(h, floor_here, open);
-        t = L_SEL(t, t_end, pass & !done);
+        h = L_SEL(h, fmax(PREFIX_NEXT * (t_pre - t), floor_here), part);
+        t = L_SEL(L_SEL(t, t_pre, part), t_end, pass & !done);
         /* the fine look: begun, kept while t is short of its end, and ended (the floor back) */
         outer_floor = L_SEL(outer_floor, floor_here, again);
         fine_end = L_SEL(fine_end, t1, again);
@@ -175,11 +208,13 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_in, a, bracketed), hit);
     /* refinement finds a crossing in [t, t_in], not the first: the floor segment's part in
      * front of the refined bracket, [t, a], is unproven unless a proof says otherwise */
-    lreal tail_margin;
+    lreal tail_margin, tail_pre = (lreal)-1;
     lmask tail = bracketed & (a > t);
-    lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &tail_margin) : (lmask)0;
-    open_w = L_SEL(open_w, open_w + (a - t), tail & !tail_empty);
-    t_open = L_SEL(t_open, fmin(t_open, t), tail & !tail_empty);
+    lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &tail_margin, &tail_pre) : (lmask)0;
+    /* its part a partial proof keeps is proven too */
+    lreal t_from = clamp(prefix_end(t, a, tail_pre), t, fmax(a, t));
+    open_w = L_SEL(open_w, open_w + (a - t_from), tail & !tail_empty);
+    t_open = L_SEL(t_open, fmin(t_open, t_from), tail & !tail_empty);
     /* on a hit, the reach of what is unproven: the first crossing lies in [depth - unresolved,
      * depth + width], every point in front of t_open being proven empty; on a miss the width
      * left unproven; a capped ray adds all it did not reach */
@@ -194,16 +229,17 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
 __kernel void prove_segments(const int n_items, __global const real4 *origins, __global const real4 *dirs,
                              __global const real *t0s, __global const real *t1s, const real4 c,
                              const int max_iter, const real bailout, __global int *proven,
-                             __global real *margins)
+                             __global real *margins, __global real *prefixes)
 {
 #if LANES == 1
     size_t i = get_global_id(0);
     if (i >= (size_t)n_items)
         return;
     julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_NONE };
-    lreal m;
-    proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &m) ? 1 : 0;
+    lreal m, pre;
+    proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &m, &pre) ? 1 : 0;
     margins[i] = m;
+    prefixes[i] = pre;
 #endif
 }
 #endif

@@ -225,7 +225,7 @@ PROBE_CFUN = Signature("probe_cfun", "probe", (
 PROVE_SEGMENTS = Signature("prove_segments", "march/proven", (
     P("global const real4* origins"), P("global const real4* dirs"), P("global const real* t0s"),
     P("global const real* t1s"), P("real4 c"), P("int max_iter"), P("real bailout"), P("global int* proven"),
-    P("global real* margins")))
+    P("global real* margins"), P("global real* prefixes")))
 
 CAFF_OPS = Signature("caff_ops", "enclose/caff", (
     P("global const real4* a_mv"), P("global const real* a_r"), P("global const real4* b_mv"),

@@ -179,10 +179,13 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
 
 def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
-    (reference/enclose/) outside the bailout ball at some n <= max_iter - and the largest
-    enc_margin over the iterations (march/proven.cl)."""
+    (reference/enclose/) outside the bailout ball at some n <= max_iter -, the largest
+    enc_margin over the iterations, and the largest s in [-1, 1] whose part [-1, s] of the
+    segment some iteration's enclosure keeps outside (1 where proven, -1 where none, or where
+    the enclosure piece has no enc_prefix) (march/proven.cl)."""
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
+    prefix_of = getattr(E, "enc_prefix", None)
     b2 = bailout * bailout
     # every ray's form is stepped, the decided ones too: their growth past the float64 range
     # is an infinite radius, no proof (as in the kernel), not a warning
@@ -191,15 +194,24 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
         proven = E.enc_outside(e, b2)
         live = ~proven
         best = E.enc_margin(e, bailout)
+        pre = prefix_of(e, bailout) if prefix_of else np.full(len(o), -1.0)
         for _ in range(K.enc_steps(max_iter)):
             if not live.any():
                 break
             e = K.enc_next(e, p, formula)
             out = live & E.enc_outside(e, b2)
             best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
+            if prefix_of:
+                pre = np.where(live, np.fmax(pre, prefix_of(e, bailout)), pre)
             proven |= out
             live &= ~out & E.enc_hopeful(e, bailout)
-    return proven, best
+    return proven, best, np.where(proven, 1.0, pre)
+
+
+def prefix_end(t0, t1, pre):
+    """The end of the part of [t0, t1] a partial proof keeps (enc_prove's prefix), pulled in by
+    PREFIX_PULL of itself (march/proven.cl)."""
+    return (t0 + (t1 - t0) * ((pre + 1) * 0.5)) * PREFIX_PULL
 
 
 PROVEN_FIRST = 0.125
@@ -209,6 +221,8 @@ FLOOR_RUN = 32     # unproven floor segments in a row that double the floor (mar
 FLOOR_WIDEST = 0.001   # of the ray: the widest the floor grows to
 FINE_DIV = 16.0        # a lone open floor segment is gone over again at a floor this much finer (march/proven.cl)
 FINE_LEAST = 2.0 ** -20   # of the ray: the finest floor that look goes to (march/proven.cl)
+PREFIX_NEXT = 1.0          # after a partial proof, the next segment is this many times its part (march/proven.cl)
+PREFIX_PULL = 1 - 2.0 ** -21   # a partial proof's end, pulled in by 2 float32 spacings (march/proven.cl)
 
 
 def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_steps, max_steps,
@@ -238,10 +252,13 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         if k.size == 0:
             break
         t1 = np.minimum(t[k] + h[k], far[k])
-        empty, margin = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
+        empty, margin, pre = enc_prove(o[k], d[k], t[k], t1, c, max_iter, bailout, formula)
         count[k] += 1
         fine = fine_end[k] > t[k]
         at_floor = ~empty & (h[k] <= floor_here[k])
+        # a partial proof above the floor: its part passed, proven (march/proven.cl)
+        t_pre = prefix_end(t[k], t1, pre)
+        part = ~empty & ~fine & (h[k] > floor_here[k]) & (t_pre > t[k])
         got = np.zeros(k.size, bool)
         look = at_floor.copy()
         before = t[k].copy()
@@ -264,10 +281,11 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         t_end = np.where(give_up, np.maximum(t1, fine_end[k]), t1)
         open_w[k] = np.where(opened, open_w[k] + (t_end - t[k]), open_w[k])
         t_open[k] = np.where(opened, np.minimum(t_open[k], t[k]), t_open[k])
-        run[k] = np.where(opened, run[k] + 1, np.where(empty, 0.0, run[k]))
+        proof = empty | part
+        run[k] = np.where(opened, run[k] + 1, np.where(proof, 0.0, run[k]))
         wider = opened & (run[k] >= FLOOR_RUN)
         floor_here[k] = np.where(wider, np.minimum(floor_here[k] * 2, widest[k]),
-                                 np.where(empty, floor_w[k], floor_here[k]))
+                                 np.where(proof, floor_w[k], floor_here[k]))
         run[k] = np.where(wider, 0.0, run[k])
         hit[k] |= got
         passed = empty | opened
@@ -279,7 +297,8 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
         h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_here[k]), h[k])
         h[k] = np.where(opened, floor_here[k], h[k])
-        t[k] = np.where(passed & ~done, t_end, t[k])
+        h[k] = np.where(part, np.maximum(PREFIX_NEXT * (t_pre - t[k]), floor_here[k]), h[k])
+        t[k] = np.where(passed & ~done, t_end, np.where(part, t_pre, t[k]))
         # the fine look: begun, kept while t is short of its end, and ended (the floor back)
         outer_floor[k] = np.where(again, floor_here[k], outer_floor[k])
         fine_end[k] = np.where(again, t1, fine_end[k])
@@ -300,9 +319,11 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         # the hit segment's part in front of the refined bracket: proven, or unproven
         j = k[depth[k] > t[k]]
         if j.size:
-            tail_empty, _ = enc_prove(o[j], d[j], t[j], depth[j], c, max_iter, bailout, formula)
-            open_w[j] += np.where(tail_empty, 0.0, depth[j] - t[j])
-            t_open[j] = np.where(tail_empty, t_open[j], np.minimum(t_open[j], t[j]))
+            tail_empty, _, tail_pre = enc_prove(o[j], d[j], t[j], depth[j], c, max_iter, bailout, formula)
+            # its part a partial proof keeps is proven too
+            t_from = np.clip(prefix_end(t[j], depth[j], tail_pre), t[j], depth[j])
+            open_w[j] += np.where(tail_empty, 0.0, depth[j] - t_from)
+            t_open[j] = np.where(tail_empty, t_open[j], np.minimum(t_open[j], t_from))
     # on a hit the reach of what is unproven (depth - t_open), on a miss the unproven width;
     # a capped ray adds all it did not reach (march/proven.cl)
     with np.errstate(invalid="ignore"):   # inf - inf off the hits

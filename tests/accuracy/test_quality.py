@@ -53,14 +53,18 @@ def test_preset_meets_its_stated_error(truths, quality, oracle):
 
 
 def test_presets_differ_where_they_say(truths):
-    """draft -> normal -> final: a finer floor, more post-steps and a smaller stated p99 error
-    on the real-c oracle."""
+    """draft -> normal -> final: a finer floor, more post-steps and a stated p99 error that
+    falls (draft's several times normal's) and stays within each preset's bound, on the
+    real-c oracle.  With partial proofs normal already reaches about 3e-5, where the
+    enclosures widened for float32's rounding stop proving (scene/quality.py), so final
+    states little less there."""
     scene, tr = truths["real"]
     got = {}
     for q in ("draft", "normal", "final"):
         res = render(apply_quality(scene, q))
         got[q] = res.error_stats()["p99"]
-    assert got["draft"] > 3 * got["normal"] and got["normal"] > 3 * got["final"]
+        assert got[q] <= PRESETS[q]["p99_bound"]
+    assert got["draft"] > 3 * got["normal"] and got["normal"] >= got["final"]
     zs = [PRESETS[q]["z_resolution"] for q in ("draft", "normal", "final")]
     posts = [PRESETS[q]["post_steps"] for q in ("draft", "normal", "final")]
     assert zs == sorted(zs) and posts == sorted(posts)

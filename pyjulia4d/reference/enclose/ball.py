@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius, least_norm
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius, least_norm, prefix_of
 
 
 def _norm(q):
@@ -60,6 +60,13 @@ def enc_outside(e, bailout2):
     with np.errstate(all="ignore"):
         lo = least_norm(m, v) * (1 - ENC_ROUND) - r
         return (lo > 0) & (lo * lo > bailout2)
+
+
+def enc_prefix(e, bailout):
+    """The part [-1, s] of the segment the form keeps outside the bailout (-1: none;
+    kernels/enclose/ball.cl)."""
+    m, v, r = e
+    return prefix_of(m, v, np.sum(m * m, axis=-1), bailout + r)
 
 
 def enc_margin(e, bailout):

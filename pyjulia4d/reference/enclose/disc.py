@@ -92,6 +92,26 @@ def least_norm(m, v):
     return np.sqrt(np.sum((m + s[..., None] * v) ** 2, axis=-1))
 
 
+PREFIX_DRAW = 2.0 ** -12   # the root drawn in towards -1 by this share of its distance (enclose/disc.cl)
+
+
+def prefix_of(m, v, mm, reach):
+    """The largest s in [-1, 1] with |m + s' v| (1 - ENC_ROUND) > reach for every s' in
+    [-1, s] (a partial proof), -1 where none is found (kernels/enclose/disc.cl enc_prefix_of):
+    the smaller root of |m + s v| = reach / (1 - ENC_ROUND), drawn in by PREFIX_DRAW, where
+    the segment's start is outside, checked at s before the least's s."""
+    vv, mv = np.sum(v * v, axis=-1), np.sum(m * v, axis=-1)
+    with np.errstate(all="ignore"):
+        rho2 = (reach / (1 - ENC_ROUND)) ** 2
+        go = mm - 2 * mv + vv > rho2
+        disc = mv * mv - vv * (mm - rho2)
+        root = (-mv - np.sqrt(np.maximum(disc, 0.0))) / np.maximum(vv, np.finfo(np.float64).tiny)
+        s = np.where((disc < 0) | (vv == 0), 1.0, np.fmin(np.fmax(root, -1.0), 1.0))
+        s = -1 + (s + 1) * (1 - PREFIX_DRAW)
+        lo = np.sqrt(np.sum((m + s[..., None] * v) ** 2, axis=-1)) * (1 - ENC_ROUND)
+        return np.where(go & (s * vv <= -mv) & (lo > reach) & (s > -1), s, -1.0)
+
+
 def taylor_disc(cfun, cfun_d, m2):
     """The disc enclosure of a function with a bound ``m2(m, rho)`` on |f''| over a disc:
     d_taylor with its own f and f' (kernels/enclose/disc.cl D_TAYLOR_OF)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from pyjulia4d.reference.enclose.caff import caff_add
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius, least_norm
+from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius, least_norm, prefix_of
 
 
 def caff_f(z, fn):
@@ -76,6 +76,13 @@ def enc_outside(e, bailout2):
     with np.errstate(all="ignore"):
         lo = least_norm(m, v) * (1 - ENC_ROUND) - np.hypot(ar, br)
         return (lo > 0) & (0.5 * lo * lo > bailout2)
+
+
+def enc_prefix(e, bailout):
+    """The part [-1, s] of the segment the forms keep outside the bailout (-1: none;
+    kernels/enclose/split.cl)."""
+    m, v, ar, br = _joined(e)
+    return prefix_of(m, v, np.sum(m * m, axis=-1), np.sqrt(2.0) * bailout + np.hypot(ar, br))
 
 
 def _centre_norm_extent(e):
