@@ -297,7 +297,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
         h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_here[k]), h[k])
         h[k] = np.where(opened, floor_here[k], h[k])
-        h[k] = np.where(part, np.maximum(PREFIX_NEXT * (t_pre - t[k]), floor_here[k]), h[k])
+        h[k] = np.where(part, np.maximum(PREFIX_NEXT * (t_pre - t[k]), h[k]), h[k])   # h: already the shrunk try
         t[k] = np.where(passed & ~done, t_end, np.where(part, t_pre, t[k]))
         # the fine look: begun, kept while t is short of its end, and ended (the floor back)
         outer_floor[k] = np.where(again, floor_here[k], outer_floor[k])
