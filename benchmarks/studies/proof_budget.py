@@ -226,7 +226,10 @@ def main(argv=None) -> int:
     t_lo, t_last = cone_of_pixels(cone, (0, 0, bw, bh))
     start = np.where(blive & (t_last > bnear) & (bnear >= t_lo) & (t_last < bfar), t_last, bnear)
     base = proven_counted(bplan, F, bo[blive], bd[blive], bnear[blive], bfar[blive])[1].size / (bw * bh)
-    beamed = proven_counted(bplan, F, bo[blive], bd[blive], start[blive], bfar[blive])[1].size / (bw * bh)
+    bdepth, bids, _ = proven_counted(bplan, F, bo[blive], bd[blive], start[blive], bfar[blive])
+    beamed = bids.size / (bw * bh)
+    behind = (start[blive] > bnear[blive]) & np.isfinite(bdepth)
+    gap_left = float(np.median((bdepth - start[blive])[behind])) if behind.any() else float("nan")
     text = [f"\n## {utc_now()}, commit {git_commit()}\n\n",
             f"`python benchmarks/studies/proof_budget.py --size {w}x{h} --beam-size {bw}x{bh}`: the default scene's "
             f"{len(o)} rays that meet the bounding ball, float64 twin.\n\n",
@@ -236,7 +239,8 @@ def main(argv=None) -> int:
             f"p50 {q[1]:.2f}, p95 {q[2]:.2f} (the estimate march steps 1.2 estimates).\n",
             f"- Beam start at {bw}x{bh}: {base:.1f} enclosures per pixel from the ball's entry, {beamed:.1f} after "
             f"the beam plus {beam_count / (bw * bh):.2f} for the beams ({beam_count / len(cone[0]):.1f} per block); "
-            f"{np.mean(start[blive] > bnear[blive]) * 100:.0f} % of the rays started behind a beam.\n"]
+            f"{np.mean(start[blive] > bnear[blive]) * 100:.0f} % of the rays started behind a beam, "
+            f"the hits among them a median {gap_left:.2f} in front of their depth.\n"]
     print("".join(text))
     append_study(a.out, "benchmarks/studies/proof_budget.py", "Where a proof of the space in front spends its work", "".join(text))
     return 0
