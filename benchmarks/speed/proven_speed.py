@@ -3,8 +3,9 @@ fixed scan at z_resolution 1000 and the distance estimate, side by side in one r
 ratios (this machine is shared and noisy), on the scenes the proof was asked to be fast on:
 hypercomplex sin, cosh and pwr, and the quaternion default.
 
-The proven march runs in packets of at most 8 rays (opencl/lanes.py PROVEN_LANES); a row
-at 16 lanes, where the device takes them, keeps that choice measured.
+The proven march runs in packets of 8 rays (opencl/lanes.py PROVEN_LANES) or of the device's
+widest, whichever its timed probe found faster; rows at 8 and at 16 lanes, where the device
+takes them, keep that choice measured.
 For each scene and march: the whole render's kernel seconds (median of --repeats after a
 warm-up), the march kernel alone (packets, rays from buffers), the tests per ray
 (set tests for the scan, estimates for de, enclosures for proven), and what each render
@@ -45,7 +46,8 @@ SCENES = {"hypercomplex sin": {"algebra": "hypercomplex", "function": "sin"},
           "hypercomplex pwr": {"algebra": "hypercomplex", "function": "pwr"},
           "quaternion sqr (default)": {}}
 MARCHES = {"proven, quality normal": ["march.quality=normal"],
-           "proven, quality normal, 16 lanes": ["march.quality=normal"],   # opencl/lanes.py PROVEN_LANES
+           "proven, quality normal, 8 lanes": ["march.quality=normal"],    # opencl/lanes.py PROVEN_LANES
+           "proven, quality normal, 16 lanes": ["march.quality=normal"],
            "fixed, z_resolution 1000": ["march.method=fixed", "march.z_resolution=1000"],
            "custom (the estimate, else the scan at 250)": ["march.quality=custom"]}
 
@@ -110,8 +112,9 @@ def main(argv=None) -> int:
         got = {}
         for mname, over in MARCHES.items():
             s = Scene.from_dict({"fractal": fractal} if fractal else {}, [f"image.width={w}", f"image.height={h}"] + over)
-            wide = "16 lanes" in mname and lanes_for(dev, s.render.variant, False) >= 16
-            got[mname] = run(s, dev, a.repeats, 16 if wide else None)
+            width = lanes_for(dev, s.render.variant, False)
+            forced = next((k for k in (8, 16) if f", {k} lanes" in mname and width >= k), None)
+            got[mname] = run(s, dev, a.repeats, forced)
         base = got["fixed, z_resolution 1000"]["kernel_s"]
         for mname, g in got.items():
             share = f"{100 * proof_share(g['scene']):.0f} %" if g["proven"] else ""

@@ -114,7 +114,7 @@ def plan_render(scene: Scene, dev: cl.Device, args: RenderArgs, lanes: int | Non
     if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     if lanes is None:
-        lanes = march_lanes(lanes_for(dev, scene.render.variant, double), march_method(scene))
+        lanes = march_lanes(lanes_for(dev, scene.render.variant, double), march_method(scene), dev)
     pairs = packet_pairs(dev, lanes, double)
     estimate = None
     if scene.camera.fit:   # framing.py: a quick first pass places the camera

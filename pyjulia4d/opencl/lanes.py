@@ -12,7 +12,8 @@ CPU runtimes here (default scene, 320x240: 1.4x slower on Intel's, 1.0x on PoCL)
 PoCL 3.0 killed the process with SIGSEGV on float16 kernels, which is why the probe runs
 apart.  The answer is cached per device and
 driver version in ``~/.cache/pyjulia4d/lanes.json`` and ``lanes_double.json``
-(``PYJULIA4D_CACHE`` moves them).
+(``PYJULIA4D_CACHE`` moves them); the proven march's own width in ``lanes_proven.json``
+(PROVEN_LANES below).
 """
 from __future__ import annotations
 
@@ -81,16 +82,59 @@ def probe(device: cl.Device, timeout: float = 120.0, double: bool = False) -> in
 
 # The proven march's lanes part ways more than the scan's or the estimate's (each proves
 # segments of its own lengths, each enclosure runs to its own iteration), so narrower packets
-# idle less: at 8 lanes it took 0.74-0.88x its time at 16 on the hypercomplex sin, cosh and
-# pwr, the CQuat cube and the quaternion default (320x240, normal, interleaved renders on the
-# development machine), where the fixed scan and the estimate were within 0.84-1.19x.
+# may idle less; which width is faster depends on the CPU.  On an AMD EPYC at 8 lanes it took
+# 0.74-0.88x its time at 16 on the hypercomplex sin, cosh and pwr, the CQuat cube and the
+# quaternion default (320x240, normal, interleaved renders); on an Intel Xeon, with partial
+# proofs, 16 lanes took 0.55-1.0x the time of 8 on the same scenes at 640x480
+# (benchmarks/speed/proven_speed.py).  So where the device takes wider packets, a timed probe
+# (a child process: the default scene at normal, 160x120, both widths built, then the least
+# march time of three interleaved renders each) picks between PROVEN_LANES and the width,
+# once per device and driver (``lanes_proven.json``).
 PROVEN_LANES = 8
 
+_PROVEN_PROBE = r"""
+import sys, warnings
+warnings.simplefilter("ignore")
+from pyjulia4d import Scene
+from pyjulia4d.opencl.devices import select_device
+from pyjulia4d.opencl.executor import render
+dev = select_device(sys.argv[1])
+widths = [int(w) for w in sys.argv[2:]]
+s = Scene.default().with_overrides(["image.width=160", "image.height=120", "march.quality=normal"])
+for w in widths:
+    render(s, device=dev, lanes=w, calibrate=False)   # built and warm
+best = {w: float("inf") for w in widths}
+for _ in range(3):
+    for w in widths:
+        best[w] = min(best[w], render(s, device=dev, lanes=w, calibrate=False).kernel_seconds)
+print(min(widths, key=lambda w: best[w]))
+"""
 
-def march_lanes(width: int, method: str) -> int:
-    """The packet width of a march: the probed ``width``, at most PROVEN_LANES for the
-    proven march (march.method resolved)."""
-    return min(width, PROVEN_LANES) if method == "proven" else width
+
+def probe_proven(device: cl.Device, widths: tuple[int, ...], timeout: float = 120.0) -> int | None:
+    """The fastest of ``widths`` for the proven march on ``device`` (the timed probe above, in a
+    child process); None where it failed or ran out of ``timeout`` (undecided: not cached)."""
+    try:
+        p = subprocess.run([sys.executable, "-c", _PROVEN_PROBE, device_spec(device), *map(str, widths)],
+                           capture_output=True, text=True, timeout=timeout)
+    except (subprocess.TimeoutExpired, ValueError):
+        return None
+    words = p.stdout.split()
+    if p.returncode != 0 or not words or not words[-1].isdigit() or int(words[-1]) not in widths:
+        return None
+    return int(words[-1])
+
+
+def march_lanes(width: int, method: str, device: cl.Device | None = None) -> int:
+    """The packet width of a march: the probed ``width``; for the proven march (march.method
+    resolved), where ``width`` is wider than PROVEN_LANES, the faster of the two on ``device``
+    (probe_proven, remembered), else PROVEN_LANES."""
+    if method != "proven" or width <= PROVEN_LANES:
+        return width
+    if device is None:
+        return PROVEN_LANES
+    got = remembered("lanes_proven", device, int, lambda d: probe_proven(d, (PROVEN_LANES, width)))
+    return got if got in (PROVEN_LANES, width) else PROVEN_LANES
 
 
 def lanes_for(device: cl.Device, variant: str, double: bool) -> int:

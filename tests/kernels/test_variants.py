@@ -173,3 +173,42 @@ def test_a_probe_that_ran_out_of_time_is_not_cached(tmp_path, monkeypatch):
 def test_scene_variant_key():
     s = Scene.default().with_overrides(["render.variant=scalar", "image.width=9", "image.height=7"])
     assert render(s).lanes == 1
+
+
+def test_the_proven_march_takes_the_width_its_probe_picked(tmp_path, monkeypatch):
+    """march_lanes: the estimate and the scan keep the device's width; the proven march takes
+    it, or PROVEN_LANES, as the timed probe found faster on the device (remembered in
+    lanes_proven.json: probed once); a probe that fails or answers neither width leaves
+    PROVEN_LANES, uncached; a width no wider than PROVEN_LANES needs no probe."""
+    from harness import device
+    from pyjulia4d.opencl import devices
+    dev = device()
+    monkeypatch.setenv("PYJULIA4D_CACHE", str(tmp_path))
+    devices.forget_remembered()
+    calls = []
+
+    def fake(d, widths, answer):
+        calls.append(widths)
+        return answer
+
+    monkeypatch.setattr(lanes_mod, "probe_proven", lambda d, w: fake(d, w, 16))
+    assert lanes_mod.march_lanes(16, "de", dev) == 16 and lanes_mod.march_lanes(16, "fixed", dev) == 16
+    assert calls == []
+    assert lanes_mod.march_lanes(16, "proven", dev) == 16
+    assert lanes_mod.march_lanes(16, "proven", dev) == 16 and calls == [(8, 16)]   # remembered
+    assert json.loads((tmp_path / "lanes_proven.json").read_text())[devices.device_key(dev)] == 16
+    assert lanes_mod.march_lanes(8, "proven", dev) == 8 and lanes_mod.march_lanes(4, "proven", dev) == 4
+    assert lanes_mod.march_lanes(16, "proven", None) == lanes_mod.PROVEN_LANES
+    for answer in (None, 4):
+        devices.forget_remembered()
+        (tmp_path / "lanes_proven.json").unlink(missing_ok=True)
+        monkeypatch.setattr(lanes_mod, "probe_proven", lambda d, w, a=answer: fake(d, w, a))
+        assert lanes_mod.march_lanes(16, "proven", dev) == lanes_mod.PROVEN_LANES
+    devices.forget_remembered()
+
+
+@pytest.mark.slow   # two builds of the proven march and six timed renders in a child process
+def test_the_proven_width_probe_answers_one_of_its_widths():
+    from harness import device
+    dev = device()
+    assert lanes_mod.probe_proven(dev, (4, 8)) in (4, 8)

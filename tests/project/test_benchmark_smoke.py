@@ -279,7 +279,7 @@ def test_proven_speed_benchmark_runs(tmp_path, capsys):
     assert bench.main(["--only", "quaternion sqr (default)", "--size", "24x18", "--repeats", "1",
                        "--out", str(tmp_path)]) == 0
     rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| quaternion sqr")]
-    assert len(rows) == 4
+    assert len(rows) == 5   # the device's width, 8 and 16 lanes, the scan, the estimate
     cells = {r.split("|")[2].strip(): [c.strip() for c in r.strip("|").split("|")] for r in rows}
     assert cells["fixed, z_resolution 1000"][3] == "1.00"
     assert cells["proven, quality normal"][7].endswith("%") and cells["fixed, z_resolution 1000"][7] == ""
