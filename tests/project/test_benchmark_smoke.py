@@ -266,7 +266,7 @@ def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
                        "--set", "fractal.max_iter=3", "--out", str(tmp_path)]) == 0
     row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("| quaternion sqr |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
-    assert cells[1] == "de" and cells[4] == "0.00 %" and cells[5] == "0.00 %" and cells[6] == "yes"
+    assert cells[1] == "de" and cells[4] == "0.00 %" and cells[5] == "0.00 %" and cells[6] == "0.00 %" and cells[7] == "yes"
     assert "commit" in (tmp_path / "pair_accuracy.md").read_text()
 
 
