@@ -130,6 +130,10 @@ def test_presets_are_valid_overrides_and_ordered():
     (["fractal.kind=mandelbrot"], True),
     (["fractal.theta=30"], False),
     (["fractal.algebra=hypercomplex", "fractal.function=sin"], False),       # no estimate at all
+    (["fractal.max_iter=12"], True),                                         # the most the estimate is trusted at
+    (["fractal.max_iter=13"], False),                                        # thin parts it steps over from here
+    (["fractal.algebra=hypercomplex", "fractal.max_iter=30"], False),
+    (["fractal.kind=mandelbrot", "fractal.max_iter=30"], True),              # measured on the Julia sets only
 ])
 def test_auto_takes_the_estimate_only_on_connected_sets(over, expect):
     from pyjulia4d.fractal.registry import march_method
