@@ -42,8 +42,9 @@ from benchmarks.lib.args import Parser, size_of  # noqa: E402
 from benchmarks.lib.runlog import append_study, git_commit, utc_now  # noqa: E402
 
 from pyjulia4d import Scene  # noqa: E402
-from pyjulia4d.pipeline.plan import CONE_BLOCK, cone_blocks, make_plan  # noqa: E402
-from pyjulia4d.reference.cone import CONE_SPREAD, cone_of_pixels  # noqa: E402
+from pyjulia4d.pipeline.plan import make_plan  # noqa: E402
+from pyjulia4d.reference.algebra.quaternion import alg_cube, alg_sqr  # noqa: E402
+from pyjulia4d.reference.cone import centre_rays, cone_of_pixels  # noqa: E402
 from pyjulia4d.reference.formula import formula_of  # noqa: E402
 from pyjulia4d.reference.iterate import julia_distance_formula  # noqa: E402
 from pyjulia4d.reference.rays import generate_rays  # noqa: E402
@@ -92,7 +93,7 @@ def best_ball(p, c, max_iter, bailout, degree):
     set by the norm recursion (module docstring); 0 where the orbit never escapes."""
     q = p.copy()
     norms = [np.linalg.norm(q, axis=1)]
-    mul = {2: lambda x: _qmul(x, x), 3: lambda x: _qmul(_qmul(x, x), x)}[degree]
+    mul = alg_sqr if degree == 2 else alg_cube
     with np.errstate(all="ignore"):
         for _ in range(max_iter):
             q = mul(q) + c
@@ -117,13 +118,6 @@ def _invert(a, bailout, degree, best):
     return best
 
 
-def _qmul(a, b):
-    w1, x1, y1, z1 = a.T
-    w2, x2, y2, z2 = b.T
-    return np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=1)
-
-
 def ball_march(o, d, near, far, c, max_iter, bailout, degree, floor):
     """Steps of the best certified ball until a point is inside or the ray leaves; where the
     ball is under ``floor``, a floor step (unproven).  Evaluations per ray."""
@@ -143,16 +137,9 @@ def ball_march(o, d, near, far, c, max_iter, bailout, degree, floor):
 def beam_starts(plan, F, w, h, lead):
     """(t_lo, t_last) per 4x4 block: the block's centre ray proven with widened enclosures from
     ``lead`` in front of its entry of the bounding ball; the number of enclosures."""
-    fr, ma = plan.frame, plan.march
+    ma = plan.march
     c = np.asarray(ma.c, float)
-    bx0, by0, bw, bh = cone_blocks(0, 0, w, h)
-    by, bx = (a.ravel() for a in np.mgrid[by0:by0 + bh, bx0:bx0 + bw])
-    u = (2 * (CONE_BLOCK * bx + CONE_BLOCK / 2) / w - 1) * fr.tan_half_fov * (w / h)
-    v = (1 - 2 * (CONE_BLOCK * by + CONE_BLOCK / 2) / h) * fr.tan_half_fov
-    d = fr.forward + u[:, None] * fr.right + v[:, None] * fr.up
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = np.tile(np.asarray(fr.position, float), (len(d), 1))
-    k = CONE_SPREAD * 2 * fr.tan_half_fov / h
+    o, d, k = centre_rays(plan.frame, w, h)
     t, far, meets = rm.ball_span(o, d, ma.radius, ma.near, ma.far)
     t = np.maximum(t - lead, 0.0)
     active = meets & (far >= t)

@@ -69,15 +69,23 @@ def probe(device: cl.Device, timeout: float = 120.0, double: bool = False) -> in
     spec = device_spec(device)
     undecided = False
     for lanes in DOUBLE_WIDTHS if double else WIDTHS:
-        try:
-            p = subprocess.run([sys.executable, "-c", _PROBE, spec, str(lanes), "double" if double else "single"],
-                               capture_output=True, text=True, timeout=timeout)
-        except subprocess.TimeoutExpired:
+        said = _child(_PROBE, [spec, str(lanes), "double" if double else "single"], timeout)
+        if said is None:
             undecided = True
-            continue
-        if p.returncode == 0 and p.stdout.strip().endswith("ok"):
+        elif said == "ok":
             return lanes
     return None if undecided else 1
+
+
+def _child(source: str, args: list[str], timeout: float) -> str | None:
+    """The last word a probe (Python ``source`` run apart, with ``args``) printed where it
+    exited cleanly, "" where it failed, None where it ran out of ``timeout``."""
+    try:
+        p = subprocess.run([sys.executable, "-c", source, *args], capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None
+    words = p.stdout.split()
+    return words[-1] if p.returncode == 0 and words else ""
 
 
 # The proven march's lanes part ways more than the scan's or the estimate's (each proves
@@ -115,14 +123,10 @@ def probe_proven(device: cl.Device, widths: tuple[int, ...], timeout: float = 12
     """The fastest of ``widths`` for the proven march on ``device`` (the timed probe above, in a
     child process); None where it failed or ran out of ``timeout`` (undecided: not cached)."""
     try:
-        p = subprocess.run([sys.executable, "-c", _PROVEN_PROBE, device_spec(device), *map(str, widths)],
-                           capture_output=True, text=True, timeout=timeout)
-    except (subprocess.TimeoutExpired, ValueError):
+        said = _child(_PROVEN_PROBE, [device_spec(device), *map(str, widths)], timeout)
+    except ValueError:   # the device is on no platform
         return None
-    words = p.stdout.split()
-    if p.returncode != 0 or not words or not words[-1].isdigit() or int(words[-1]) not in widths:
-        return None
-    return int(words[-1])
+    return int(said) if said and said.isdigit() and int(said) in widths else None
 
 
 def march_lanes(width: int, method: str, device: cl.Device | None = None) -> int:

@@ -15,6 +15,22 @@ from pyjulia4d.reference.march import ball_span
 CONE_SPREAD = 2.8285   # 2 sqrt(2), rounded up (march/cone.cl)
 
 
+def centre_rays(frame: Frame, width: int, height: int, region: tuple[int, int, int, int] | None = None
+                ) -> tuple[np.ndarray, np.ndarray, float]:
+    """The centre rays (origins, unit directions) of the CONE_BLOCK x CONE_BLOCK blocks that the
+    pixels of ``region`` (default: the image) meet, row-major, and k: every ray of a block
+    passes within k t of its centre ray's point at t (march/cone.cl cone_dirs, CONE_SPREAD)."""
+    x0, y0, w, h = region or (0, 0, width, height)
+    bx0, by0, bw, bh = cone_blocks(x0, y0, w, h)
+    by, bx = (a.ravel() for a in np.mgrid[by0:by0 + bh, bx0:bx0 + bw])
+    u = (2 * (CONE_BLOCK * bx + CONE_BLOCK / 2) / width - 1) * frame.tan_half_fov * (width / height)
+    v = (1 - 2 * (CONE_BLOCK * by + CONE_BLOCK / 2) / height) * frame.tan_half_fov
+    d = frame.forward + u[:, None] * frame.right + v[:, None] * frame.up
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = np.tile(np.asarray(frame.position, np.float64), (len(d), 1))
+    return o, d, CONE_SPREAD * 2 * frame.tan_half_fov / height
+
+
 def cone_starts(frame: Frame, width: int, height: int, args: MarchArgs, formula: Formula = QUATERNION_SQR,
                 region: tuple[int, int, int, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """march/cone.cl with the march's record (``args``: pipeline/plan.MarchArgs): (t_lo,
@@ -22,16 +38,7 @@ def cone_starts(frame: Frame, width: int, height: int, args: MarchArgs, formula:
     meet, row-major: the cone is covered from t_lo, and t_last is the last centre point whose
     ball held it (-1: none did)."""
     c, max_iter, bailout, max_steps = args.c, args.max_iter, args.bailout, args.max_steps
-    x0, y0, w, h = region or (0, 0, width, height)
-    bx0, by0, bw, bh = cone_blocks(x0, y0, w, h)
-    by, bx = (a.ravel() for a in np.mgrid[by0:by0 + bh, bx0:bx0 + bw])
-    aspect = width / height
-    u = (2 * (CONE_BLOCK * bx + CONE_BLOCK / 2) / width - 1) * frame.tan_half_fov * aspect
-    v = (1 - 2 * (CONE_BLOCK * by + CONE_BLOCK / 2) / height) * frame.tan_half_fov
-    d = frame.forward + u[:, None] * frame.right + v[:, None] * frame.up
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = np.tile(np.asarray(frame.position, np.float64), (len(d), 1))
-    k = CONE_SPREAD * 2 * frame.tan_half_fov / height
+    o, d, k = centre_rays(frame, width, height, region)
     t, far, meets = ball_span(o, d, args.radius, args.near, args.far)
     active = meets & (far >= t)
     t_lo, t_last = np.full(len(d), np.inf), np.full(len(d), -1.0)

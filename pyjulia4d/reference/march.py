@@ -185,7 +185,7 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     the enclosure piece has no enc_prefix) (march/proven.cl)."""
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
-    prefix_of = getattr(E, "enc_prefix", None)
+    enc_prefix = getattr(E, "enc_prefix", None)
     b2 = bailout * bailout
     # every ray's form is stepped, the decided ones too: their growth past the float64 range
     # is an infinite radius, no proof (as in the kernel), not a warning
@@ -194,15 +194,15 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
         proven = E.enc_outside(e, b2)
         live = ~proven
         best = E.enc_margin(e, bailout)
-        pre = prefix_of(e, bailout) if prefix_of else np.full(len(o), -1.0)
+        pre = enc_prefix(e, bailout) if enc_prefix else np.full(len(o), -1.0)
         for _ in range(K.enc_steps(max_iter)):
             if not live.any():
                 break
             e = K.enc_next(e, p, formula)
             out = live & E.enc_outside(e, b2)
             best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
-            if prefix_of:
-                pre = np.where(live, np.fmax(pre, prefix_of(e, bailout)), pre)
+            if enc_prefix:
+                pre = np.where(live, np.fmax(pre, enc_prefix(e, bailout)), pre)
             proven |= out
             live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best, np.where(proven, 1.0, pre)
@@ -221,7 +221,6 @@ FLOOR_RUN = 32     # unproven floor segments in a row that double the floor (mar
 FLOOR_WIDEST = 0.001   # of the ray: the widest the floor grows to
 FINE_DIV = 16.0        # a lone open floor segment is gone over again at a floor this much finer (march/proven.cl)
 FINE_LEAST = 2.0 ** -20   # of the ray: the finest floor that look goes to (march/proven.cl)
-PREFIX_NEXT = 1.0          # after a partial proof, the next segment is this many times its part (march/proven.cl)
 PREFIX_PULL = 1 - 2.0 ** -21   # a partial proof's end, pulled in by 2 float32 spacings (march/proven.cl)
 
 
@@ -297,7 +296,7 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
         h[k] = np.where(empty, np.minimum(h[k] * grow, span[k]), h[k])
         h[k] = np.where(~empty & ~at_floor, np.maximum(h[k] * shrink, floor_here[k]), h[k])
         h[k] = np.where(opened, floor_here[k], h[k])
-        h[k] = np.where(part, np.maximum(PREFIX_NEXT * (t_pre - t[k]), h[k]), h[k])   # h: already the shrunk try
+        h[k] = np.where(part, np.maximum(t_pre - t[k], h[k]), h[k])   # as long as the part; h: already the shrunk try
         t[k] = np.where(passed & ~done, t_end, np.where(part, t_pre, t[k]))
         # the fine look: begun, kept while t is short of its end, and ended (the floor back)
         outer_floor[k] = np.where(again, floor_here[k], outer_floor[k])

@@ -117,7 +117,9 @@ def estimate_bounds_distance(fractal: Any) -> bool:
         return False
     if fractal.kind != "julia":
         return True
-    if fractal.theta or fractal.algebra not in ("quaternion", "hypercomplex") or fractal.max_iter > ESTIMATE_MAX_ITER:
+    if fractal.theta or fractal.algebra not in ("quaternion", "hypercomplex"):
+        return False
+    if fractal.max_iter > ESTIMATE_MAX_ITER:
         return False
     return critical_orbit_bounded(fractal.algebra, FUNCTIONS_TABLE[fractal.function].degree,
                                   tuple(float(x) for x in fractal.c))
@@ -127,8 +129,7 @@ def auto_quality(fractal: Any) -> str:
     """What "auto" (the default) is for a [fractal]: "custom" - the distance estimate - where
     it bounds the distance to the set (estimate_bounds_distance: a connected quaternion or
     hypercomplex square or cube at max_iter up to ESTIMATE_MAX_ITER, the Mandelbrot set); its
-    error statement is the whole ray in
-    front, which it does not prove.  Everywhere else "normal", the proven march: where the set
+    error statement is the whole ray in front, which it does not prove.  Everywhere else "normal", the proven march: where the set
     has no estimate the fixed scan stepped over thin parts on up to 12 % of the pixels
     (benchmarks/results/pair_accuracy.md), and on dust the estimate does."""
     return "custom" if estimate_bounds_distance(fractal) else "normal"

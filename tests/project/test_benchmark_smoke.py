@@ -463,10 +463,11 @@ def test_proof_budget_ball_is_proven_and_the_largest():
     p escapes (|q_k| > bailout for some k <= max_iter, checked in float64 by iterating), for
     the square and the cube; the recursion it inverts, run forward, proves the ball of 0.999 r
     and not that of 1.001 r (r is the largest it proves); and a point inside the set gets 0."""
+    from pyjulia4d.reference.algebra.quaternion import alg_cube, alg_sqr
     pb = load("proof_budget")
     rng = np.random.default_rng(5)
     c = np.array([-0.2, 0.8, 0.0, 0.0])
-    for degree in (2, 3):
+    for degree, power in ((2, alg_sqr), (3, alg_cube)):
         p = rng.normal(size=(40, 4)) * 0.7
         r = pb.best_ball(p, c, 12, 4.0, degree)
         assert (r >= 0).all() and (r > 0).sum() > 20
@@ -476,7 +477,7 @@ def test_proof_budget_ball_is_proven_and_the_largest():
             q = p[i] + u
             escaped = np.linalg.norm(q, axis=1) > 4.0
             for _ in range(12):
-                q = np.where(escaped[:, None], q, (pb._qmul(q, q) if degree == 2 else pb._qmul(pb._qmul(q, q), q)) + c)
+                q = np.where(escaped[:, None], q, power(q) + c)
                 escaped |= np.linalg.norm(q, axis=1) > 4.0
             assert escaped.all()
             # forward: r_{k+1} = (|q_k| + r_k)^D - |q_k|^D proves the ball from 0.999 r, and from 1.001 r at no k
@@ -488,7 +489,7 @@ def test_proof_budget_ball_is_proven_and_the_largest():
                         proves |= np.isfinite(a) & (a - rk > 4.0)
                         # (a + r)^D - a^D without its cancellation where a is far larger than r
                         rk = rk * (2 * a + rk) if degree == 2 else rk * (3 * a * a + 3 * a * rk + rk * rk)
-                        q = (pb._qmul(q, q) if degree == 2 else pb._qmul(pb._qmul(q, q), q)) + c
+                        q = power(q) + c
                 assert bool(proves) == want
     assert pb.best_ball(np.zeros((1, 4)), np.zeros(4), 12, 4.0, 2)[0] == 0.0   # 0 is inside for c = 0
 
