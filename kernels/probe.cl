@@ -48,3 +48,17 @@ __kernel void probe_cfun(const int n_items, __global const real *re, __global co
     d_re[i] = d.re; d_im[i] = d.im;
 #endif
 }
+
+/* The enclosures' bound on the norm of h -> q h (enclose/ball.cl ALG_LBOUND) at points q =
+ * ALG_IN(p), NAN where the algebra has none (the tests hold it above the product's norm). */
+__kernel void probe_lbound(const int n_items, __global const real4 *points, __global real *lbound)
+{
+    size_t i = get_global_id(0);
+    if (i >= (size_t)n_items)
+        return;
+#if defined(ALG_LBOUND) && LANES == 1
+    lbound[i] = ALG_LBOUND(ALG_IN(points[i]));
+#else
+    lbound[i] = NAN;
+#endif
+}

@@ -16,3 +16,12 @@ inline quat alg_mul(quat a, quat b)
                 a.x * b.z + a.z * b.x - a.y * b.w - a.w * b.y,
                 a.x * b.w + a.w * b.x - a.y * b.z - a.z * b.y);
 }
+
+/* |L_m^T L_m - |m|^2 I|_F^2 for algebra/power.cl's bound on h -> m h: its off-diagonal
+ * entries are -2 m_z m_w, 2 m_x m_z, 2 m_x m_w and 2 (m_z m_w - m_x m_y), each twice */
+inline lreal alg_off_gram2(quat m)
+{
+    lreal a = m.z * m.w, b = m.x * m.z, c = m.x * m.w, d = m.z * m.w - m.x * m.y;
+    return (real)8 * (a * a + b * b + c * c + d * d);
+}
+#define ALG_OFF_GRAM2(m) alg_off_gram2(m)

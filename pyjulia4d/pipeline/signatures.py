@@ -218,6 +218,8 @@ PROBE_STEP = Signature("probe_step", "probe", (
     P("global const real4* points"), P("global const real4* dirs"), P("real4 c"), P("global real4* value"),
     P("global real4* jvp")))
 
+PROBE_LBOUND = Signature("probe_lbound", "probe", (P("global const real4* points"), P("global real* lbound")))
+
 PROBE_CFUN = Signature("probe_cfun", "probe", (
     P("global const real* re"), P("global const real* im"), P("global real* f_re"), P("global real* f_im"),
     P("global real* d_re"), P("global real* d_im")))
@@ -235,7 +237,8 @@ CAFF_OPS = Signature("caff_ops", "enclose/caff", (
 
 SIGNATURES = {s.kernel: s for s in (
     CONE_STARTS, MARCH, NORMALS_JACOBIAN, NORMALS_GRADIENT, NORMALS_ZBUFFER, CLIP, LIGHT_TERMS, SHADE, REFLECT_RAYS,
-    REFLECT_COLOR, PATH_CAMERA, PATH_BOUNCE, PATH_SHADOW, PATH_FILM, MESH_SAMPLE, MESH_VERTICES, GENERATE_RAYS, PROBE_ITERATE, PROBE_STEP, PROBE_CFUN,
+    REFLECT_COLOR, PATH_CAMERA, PATH_BOUNCE, PATH_SHADOW, PATH_FILM, MESH_SAMPLE, MESH_VERTICES, GENERATE_RAYS, PROBE_ITERATE, PROBE_STEP, PROBE_LBOUND,
+    PROBE_CFUN,
     PROVE_SEGMENTS, CAFF_OPS)}
 
 NORMALS = {"jacobian": NORMALS_JACOBIAN, "gradient": NORMALS_GRADIENT, "zbuffer": NORMALS_ZBUFFER}

@@ -22,10 +22,26 @@ def maps(alg_mul):
             lambda q, h, fn: julia_f_jvp(alg_mul, q, h, fn.FUNC_POWER))
 
 
+LBOUND_UP = 1 + 2.0 ** -19   # kernels/algebra/power.cl ALG_LBOUND_UP
+
+
 def enclose_bounds(alg_mul):
     """(K, L, L2) of kernels/algebra/power.cl for reference/enclose/ball.py: |a b| <= K |a| |b|
-    with K = 2, and the norm of h -> m h at most |m|_1 (L(m)) and of h -> (m m) h at most
-    |m m|_1 (L2(m)): each coordinate of a b is a^T P b with P a signed permutation."""
+    with K = 2 (each coordinate of a b is a^T P b with P a signed permutation), the norm of
+    h -> m h at most L(m) = min(sqrt(|m|^2 + sqrt(3/4 |S|_F^2)), |m|_1), S = L_m^T L_m - |m|^2 I,
+    and of h -> (m m) h at most L(m m).  S comes from the product itself here (the matrix
+    L_m column by column), where the kernel writes each algebra's |S|_F^2 out."""
+    basis = np.eye(4)
+
     def norm1(m):
         return np.sum(np.abs(m), axis=-1)
-    return 2.0, norm1, lambda m: norm1(alg_mul(m, m))
+
+    def lbound(m):
+        m = np.asarray(m, np.float64)
+        L = np.stack([alg_mul(m, np.broadcast_to(basis[j], m.shape)) for j in range(4)], axis=-1)
+        n2 = np.sum(m * m, axis=-1)
+        S = np.einsum("...ij,...ik->...jk", L, L) - n2[..., None, None] * basis
+        with np.errstate(all="ignore"):
+            return np.fmin(np.sqrt(n2 + np.sqrt(0.75 * np.sum(S * S, axis=(-2, -1)))) * LBOUND_UP, norm1(m))
+
+    return 2.0, lbound, lambda m: lbound(alg_mul(m, m))

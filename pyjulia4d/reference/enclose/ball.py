@@ -2,9 +2,10 @@
 s in [-1, 1], as affine forms q_n(s) in m_n + s v_n + B(r_n), for the algebras iterated in
 the point's own coordinates (quaternions, CQuats, the commutative rules).  With rho = |v| + r,
 K, L(m), L(m m) the algebra's product bounds (ALG_ENCLOSE_K, ALG_LBOUND, ALG_LBOUND_SQR):
-    D = 2:  r' = 2 L(m) r + K rho^2,
-    D = 3:  r' = (L(m m) + 2 L(m)^2) r + 3 K L(m) rho^2 + K^2 rho^3,
-centre julia_f(m, c), tangent julia_f_jvp(m, v)."""
+    D = 2:  r' = 2 L(m) r + |v v| / 2 + 2 L(v) r + K r^2,  centre julia_f(m, c) + v v / 2
+            (half of s^2 v v in the centre: Stolfi & de Figueiredo 1997 §3.3),
+    D = 3:  r' = (L(m m) + 2 L(m)^2) r + 3 K L(m) rho^2 + K^2 rho^3,  centre julia_f(m, c),
+tangent julia_f_jvp(m, v)."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,17 +30,21 @@ def enc_step(e, c, F):
     K = alg.ALG_ENCLOSE_K
     with np.errstate(all="ignore"):
         s, lm = _norm(m), alg.ALG_LBOUND(m)
-        rho = _norm(v) + r
         sv = _norm(v)
         if F.fn.FUNC_POWER == 2:
-            rn, size = 2 * lm * r + K * rho * rho, K * s * s + 2 * lm * sv
+            vv = F.julia_f(v, np.zeros(4))   # v v (the rotated map's u (u^-1 v)^2)
+            rn = 2 * lm * r + 0.5 * _norm(vv) + (2 * alg.ALG_LBOUND(v) + K * r) * r
+            size = K * s * s + 2 * lm * sv + K * sv * sv
+            mn = F.julia_f(m, c) + 0.5 * vv
         else:
+            rho = sv + r
             jn = alg.ALG_LBOUND_SQR(m) + 2 * lm * lm
             rn = jn * r + (3 * K * lm + K * K * rho) * rho * rho
             size = K * K * s ** 3 + jn * sv
+            mn = F.julia_f(m, c)
         vn = F.julia_f_jvp(m, v)
         gain = 8 if F.theta != 0 else 4   # the rotated map's two more rotations (enclose/ball.cl ENC_STEP_GAIN)
-        return F.julia_f(m, c), vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
+        return mn, vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
 
 
 def enc_add(a, b):
