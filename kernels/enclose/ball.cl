@@ -18,18 +18,22 @@
  * m h (|m|; the tables' algebra/power.cl alg_lbound):
  *     f(q) = f(m) + J[s v] + J[e] + R,  J = julia_f_jvp at m,
  *     D = 2:  |J[e]| <= 2 L(m) r,   R = d d = s^2 v v + s (v e + e v) + e e,
- *     D = 3:  |J[e]| <= (L(m m) + 2 L(m)^2) r,       |R| <= 3 K L(m) rho^2 + K^2 rho^3
- * ((m + d)^3 with the cube's bracketing, algebra/power.cl; the quaternions' the same by
- * associativity).  The square's s^2 v v is split as affine arithmetic splits the square of
- * a noise symbol (Stolfi & de Figueiredo, "Self-Validated Numerical Methods and
- * Applications", 1997, §3.3: s^2 = 1/2 + (s^2 - 1/2), |s^2 - 1/2| <= 1/2, the best
- * constant approximation of s^2 on [-1, 1]): half of v v joins the centre and half of
- * |v v| the ball, so
- *     m' = f(m) + v v / 2,   r' = 2 L(m) r + |v v| / 2 + 2 L(v) r + K r^2,
- * against K rho^2 = K (|v| + r)^2 for the whole of R: half the quaternions' second-order
- * growth, and the tables' |v v| is often well under 2 |v|^2 (on the default scene,
- * float64 twin at 80x60, 22.4 enclosures a ray fell to 19.0).  Every radius is raised for
- * the rounding of the centre and tangent (enclose/disc.cl enc_radius). */
+ *     D = 3:  |J[e]| <= (L(m m) + 2 L(m)^2) r,   R = s^2 Q(v) + s^3 v^3 + the terms in e,
+ * Q(x) the second-order term of (m + x)^3 (m x x + x m x + x x m; the tables' cube, with
+ * its bracketing (algebra/power.cl), 2 (m x) x + (x x) m), which is the derivative of x^3
+ * at v along m (julia_f_jvp(v, m)), |Q(x)| <= 3 K L(m) |x|^2; the terms in e are at most
+ * 3 K L(m) (2 |v| + r) r + K^2 ((|v| + r)^3 - |v|^3).  The powers of s are split as affine
+ * arithmetic splits a noise symbol's (Stolfi & de Figueiredo, "Self-Validated Numerical
+ * Methods and Applications", 1997, §3.3; the best approximations of s^2 and s^3 on [-1, 1]
+ * of degree below theirs, Chebyshev's): s^2 = 1/2 + (s^2 - 1/2), |s^2 - 1/2| <= 1/2, and
+ * s^3 = 3 s / 4 + (s^3 - 3 s / 4), |s^3 - 3 s / 4| <= 1/4.  So
+ *     D = 2:  m' = f(m) + v v / 2,   r' = 2 L(m) r + |v v| / 2 + 2 L(v) r + K r^2,
+ *     D = 3:  m' = f(m) + Q(v) / 2,  v' = J[v] + 3 v^3 / 4,
+ *             r' = (L(m m) + 2 L(m)^2) r + |Q(v)| / 2 + |v^3| / 4 + the terms in e,
+ * against K (|v| + r)^2 and 3 K L(m) rho^2 + K^2 rho^3, rho = |v| + r, for the whole of R:
+ * half the second-order growth, a quarter of the third (on the default scene, float64 twin
+ * at 80x60, 22.4 enclosures a ray fell to 19.0).  Every radius is raised for the rounding
+ * of the centre and tangent (enclose/disc.cl enc_radius). */
 
 /* ml = |m| and vl = |v| are carried with the form: the proof's test, margin and hope and the
  * next step each took them, a square root each, on the march's critical path */
@@ -79,14 +83,22 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     lreal r = (real)2 * lm * e.r + (real)0.5 * vvl + ((real)2 * lv + K * e.r) * e.r;
     lreal size = K * s * s + (real)2 * lm * sv + K * sv * sv;
     quat m = QADD(julia_f(e.m, c), QSCALE((lreal)0.5, vv));
-#else
-    lreal rho = sv + e.r;
-    lreal jn = ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm;
-    lreal r = jn * e.r + ((real)3 * K * lm + K * K * rho) * rho * rho;
-    lreal size = K * K * s * s * s + jn * sv;
-    quat m = julia_f(e.m, c);
-#endif
     quat v = julia_f_jvp(e.m, e.v);
+#else
+    quat qv = julia_f_jvp(e.v, e.m);      /* Q(v), the second-order term at m along v */
+    quat cv = julia_f(e.v, (real4)(0));   /* v^3 */
+#ifdef ALG_LBOUND_IS_LEN
+    lreal cvl = sv * sv * sv;             /* |v^3| = |v|^3 */
+#else
+    lreal cvl = QLEN(cv);
+#endif
+    lreal jn = ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm;
+    lreal r = jn * e.r + (real)0.5 * QLEN(qv) + (real)0.25 * cvl +
+              ((real)3 * K * lm * ((real)2 * sv + e.r) + K * K * ((real)3 * sv * sv + ((real)3 * sv + e.r) * e.r)) * e.r;
+    lreal size = K * K * s * s * s + jn * sv + ((real)3 * K * lm + K * K * sv) * sv * sv;
+    quat m = QADD(julia_f(e.m, c), QSCALE((lreal)0.5, qv));
+    quat v = QADD(julia_f_jvp(e.m, e.v), QSCALE((lreal)0.75, cv));
+#endif
     return enc_form(m, v, enc_radius(r, ENC_STEP_GAIN * size + (real)2 * length(c), ENC_ROUND));
 }
 

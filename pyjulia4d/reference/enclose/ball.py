@@ -4,8 +4,10 @@ the point's own coordinates (quaternions, CQuats, the commutative rules).  With 
 K, L(m), L(m m) the algebra's product bounds (ALG_ENCLOSE_K, ALG_LBOUND, ALG_LBOUND_SQR):
     D = 2:  r' = 2 L(m) r + |v v| / 2 + 2 L(v) r + K r^2,  centre julia_f(m, c) + v v / 2
             (half of s^2 v v in the centre: Stolfi & de Figueiredo 1997 §3.3),
-    D = 3:  r' = (L(m m) + 2 L(m)^2) r + 3 K L(m) rho^2 + K^2 rho^3,  centre julia_f(m, c),
-tangent julia_f_jvp(m, v)."""
+    D = 3:  r' = (L(m m) + 2 L(m)^2) r + |Q(v)| / 2 + |v^3| / 4 + 3 K L(m) (2 |v| + r) r
+                 + K^2 ((|v| + r)^3 - |v|^3),  centre julia_f(m, c) + Q(v) / 2, Q(v) = julia_f_jvp(v, m)
+            (s^2 and s^3 split alike: s^3 = 3 s / 4 + at most 1/4),
+tangent julia_f_jvp(m, v) (+ 3 v^3 / 4 for D = 3)."""
 from __future__ import annotations
 
 import numpy as np
@@ -36,13 +38,15 @@ def enc_step(e, c, F):
             rn = 2 * lm * r + 0.5 * _norm(vv) + (2 * alg.ALG_LBOUND(v) + K * r) * r
             size = K * s * s + 2 * lm * sv + K * sv * sv
             mn = F.julia_f(m, c) + 0.5 * vv
+            vn = F.julia_f_jvp(m, v)
         else:
-            rho = sv + r
+            qv, cv = F.julia_f_jvp(v, m), F.julia_f(v, np.zeros(4))   # Q(v) and v^3
             jn = alg.ALG_LBOUND_SQR(m) + 2 * lm * lm
-            rn = jn * r + (3 * K * lm + K * K * rho) * rho * rho
-            size = K * K * s ** 3 + jn * sv
-            mn = F.julia_f(m, c)
-        vn = F.julia_f_jvp(m, v)
+            rn = jn * r + 0.5 * _norm(qv) + 0.25 * _norm(cv) + (
+                3 * K * lm * (2 * sv + r) + K * K * (3 * sv * sv + (3 * sv + r) * r)) * r
+            size = K * K * s ** 3 + jn * sv + (3 * K * lm + K * K * sv) * sv * sv
+            mn = F.julia_f(m, c) + 0.5 * qv
+            vn = F.julia_f_jvp(m, v) + 0.75 * cv
         gain = 8 if F.theta != 0 else 4   # the rotated map's two more rotations (enclose/ball.cl ENC_STEP_GAIN)
         return mn, vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
 
