@@ -12,16 +12,26 @@
  * of them, 2^-20: 16 ulps of the result, where OpenCL's full profile allows each function
  * 3-6 ulps, so a product of two 8.5; no -cl-fast-relaxed-math or native_ functions are
  * used), plus ENC_TINY for results that flush to zero.  Radii are multiplied by ENC_UP after each operation, so
- * rounding in the radius itself cannot shrink it.  Double precision runs the same code:
- * the bounds are then only looser than they need be.
+ * rounding in the radius itself cannot shrink it.  Double precision (-D REAL_DOUBLE) has the
+ * same bounds in its own ulps (2^-50, 2^-48, 2^-46).  They matter where the orbit stretches
+ * its points apart fast: the float32 bound on the rounding of a point itself, amplified
+ * over 12 iterations of the commutative square (some 5e6 times), outgrew what its last
+ * iteration left beyond the bailout, so no segment there, however short, could be proven,
+ * and its default view stated a p99 of 0.31; in double, 1.7e-4.
  *
  * Non-finite values: an operation that cannot bound its image (a pole inside the disc,
  * a disc that meets a branch cut where no better bound is known, overflow) gives an
  * infinite radius, and comparisons with NaN are false, so such a disc proves nothing. */
 
+#ifdef REAL_DOUBLE
+#define ENC_ROUND ((real)8.8817841970012523e-16)  /* 2^-50 */
+#define ENC_ROUND_FN ((real)3.5527136788005009e-15) /* 2^-48 */
+#define ENC_UP ((real)1.0000000000000142108547152020037)  /* 1 + 2^-46 */
+#else
 #define ENC_ROUND ((real)2.384185791015625e-7)  /* 2^-22 */
 #define ENC_ROUND_FN ((real)9.5367431640625e-7) /* 2^-20 */
 #define ENC_UP ((real)1.0000038146972656)       /* 1 + 2^-18 */
+#endif
 #define ENC_TINY ((real)1e-30)
 #define ENC_PI ((real)3.14159274101257324)      /* float32 pi rounded up */
 

@@ -14,6 +14,7 @@ from pyjulia4d.pipeline.plan import Plan, make_plan
 from pyjulia4d.pipeline.result import RenderResult, count_guards
 from pyjulia4d.reference.antialias import flag_edges
 from pyjulia4d.reference.cone import cone_of_pixels, cone_starts
+from pyjulia4d.reference.enclose.disc import precision
 from pyjulia4d.reference.formula import formula_of
 from pyjulia4d.pipeline.film import Film
 from pyjulia4d.reference.march import march
@@ -46,7 +47,13 @@ def render(scene: Scene) -> RenderResult:
 
 
 def execute(plan: Plan, t0: float | None = None) -> RenderResult:
-    """Run ``plan`` (every pixel of its scene's image) in float64."""
+    """Run ``plan`` (every pixel of its scene's image) in float64, its proofs with the rounding
+    bounds of the plan's precision (reference/enclose/disc.py precision)."""
+    with precision(plan.double):
+        return _execute(plan, t0)
+
+
+def _execute(plan: Plan, t0: float | None) -> RenderResult:
     t0 = time.perf_counter() if t0 is None else t0
     frame, ma, sa = plan.frame, plan.march, plan.shade
     w, h = plan.image.width, plan.image.height

@@ -29,6 +29,7 @@ from pyjulia4d.measure.brute_force import brute_force_depth
 from pyjulia4d.pipeline import kernel_config
 from pyjulia4d.pipeline.plan import march_args
 from pyjulia4d.reference.formula import Formula, formula_of
+from pyjulia4d.reference.enclose.disc import precision
 from pyjulia4d.reference.march import enc_prove
 
 PAIRS = [(a, f) for a, fs in FUNCTIONS_OF.items() for f in fs]
@@ -97,6 +98,21 @@ def _segments(s, n, rng, lengths=(0.5, 0.05, 0.005, 5e-4)):
 
 @pytest.mark.parametrize("algebra,function,how", [c for c in CASES if c[2] not in ("julia_stack", "cubic_locus")])
 def test_orbit_enclosures_hold_the_orbits(algebra, function, how):
+    _check_orbits_held(algebra, function, how)
+
+
+# double precision's rounding bounds are 2^-28 of single's (kernels/enclose/disc.cl): the
+# enclosures must still hold float64's own orbits with them
+@pytest.mark.parametrize("algebra,function,how", [("quaternion", "sqr", 0.0), ("quaternion", "cube", -75.0),
+                                                  ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
+                                                  ("hypercomplex", "cube", 0.0), ("cquat", "cube", 0.0),
+                                                  ("commutative", "sqr", 0.0), ("hypercomplex", "exp", "mandelbrot")])
+def test_double_enclosures_hold_the_orbits(algebra, function, how):
+    with precision(True):
+        _check_orbits_held(algebra, function, how)
+
+
+def _check_orbits_held(algebra, function, how):
     s = _case(algebra, function, how)
     F = formula_of(s.fractal)
     K = F.kind_enclose
@@ -206,9 +222,18 @@ KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0
                 ("quaternion", "sqr", "cubic_locus")]
 
 
-@pytest.mark.parametrize("algebra,function,how", KERNEL_PAIRS)
+@pytest.mark.parametrize("algebra,function,how", KERNEL_PAIRS + [
+    pytest.param("commutative", "sqr", "double", id="commutative-sqr-double"),
+    pytest.param("hypercomplex", "sin", "double", id="hypercomplex-sin-double")])
 def test_kernel_proofs_match_the_twin(algebra, function, how):
-    s = _case(algebra, function, how).with_overrides(["march.method=proven"])
+    double = how == "double"   # the double kernel against the twin with double's rounding bounds
+    s = _case(algebra, function, 0.0 if double else how).with_overrides(
+        ["march.method=proven"] + (["render.float=double"] if double else []))
+    with precision(double):
+        _check_kernel_proofs(s)
+
+
+def _check_kernel_proofs(s):
     f, F = s.fractal, formula_of(s.fractal)
     R = Runner(kernel_config.scene_config(s, ray_buffers=True))
     rng = np.random.default_rng(5)
@@ -287,13 +312,18 @@ def march_on_rays(s, o, d):
                                                    ("quaternion", "sqr", "mandelbrot"),
                                                    pytest.param("hypercomplex", "cosh", "mandelbrot", marks=_SLOW),
                                                    pytest.param("quaternion", "sqr", "julia_stack", marks=_SLOW),
-                                                   pytest.param("quaternion", "sqr", "cubic_locus", marks=_SLOW)])
+                                                   pytest.param("quaternion", "sqr", "cubic_locus", marks=_SLOW),
+                                                   ("commutative", "sqr", "double"),
+                                                   pytest.param("hypercomplex", "sin", "double", marks=_SLOW)])
 def test_stated_interval_holds_the_brute_force(algebra, function, kind):
     # the cubic locus hits few pixels of a small view, and its spikes can be thinner than the
-    # floor's point spacing: one pixel of 43 is 2.3 %, so it takes a larger view
+    # floor's point spacing: one pixel of 43 is 2.3 %, so it takes a larger view; "double": the
+    # Julia set in double precision, whose proofs reach far closer (kernels/enclose/disc.cl)
     w, h = (40, 30) if kind == "cubic_locus" else (20, 15)
-    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "kind": kind},
-                         "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": w, "height": h}})
+    double = kind == "double"
+    s = Scene.from_dict({"fractal": {"algebra": algebra, "function": function, "kind": "julia" if double else kind},
+                         "march": {"method": "proven", "z_resolution": 5000}, "image": {"width": w, "height": h},
+                         "render": {"float": "double" if double else "single"}})
     from pyjulia4d import render
     s = render(s.with_overrides(["image.width=4", "image.height=3"])).scene   # camera.fit's camera
     o, d = ref.generate_rays(camera_frame(s), w, h)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius, least_norm, prefix_of
+from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
 def _norm(q):
@@ -23,7 +23,7 @@ def enc_segment(o, d, t0, t1, F):
     """The affine form of the points o + t d, t in [t0, t1] (per ray)."""
     tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
     m = o + tm[:, None] * d
-    return m, hw[:, None] * d, enc_radius(0.0, _norm(o) + np.abs(tm) * _norm(d), ENC_ROUND)
+    return m, hw[:, None] * d, enc_radius(0.0, _norm(o) + np.abs(tm) * _norm(d), rounding().sum)
 
 
 def enc_step(e, c, F):
@@ -48,26 +48,26 @@ def enc_step(e, c, F):
             mn = F.julia_f(m, c) + 0.5 * qv
             vn = F.julia_f_jvp(m, v) + 0.75 * cv
         gain = 8 if F.theta != 0 else 4   # the rotated map's two more rotations (enclose/ball.cl ENC_STEP_GAIN)
-        return mn, vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), ENC_ROUND)
+        return mn, vn, enc_radius(rn, gain * size + 2 * np.linalg.norm(c), rounding().sum)
 
 
 def enc_add(a, b):
     """The sum of two forms in the same s (enclose/ball.cl)."""
     (ma, va, ra), (mb, vb, rb) = a, b
-    return ma + mb, va + vb, enc_radius(ra + rb, _norm(ma) + _norm(mb) + _norm(va) + _norm(vb), ENC_ROUND)
+    return ma + mb, va + vb, enc_radius(ra + rb, _norm(ma) + _norm(mb) + _norm(va) + _norm(vb), rounding().sum)
 
 
 def enc_shift(e, k):
     """The form plus a constant k in the algebra's coordinates."""
     m, v, r = e
     k = np.asarray(k, np.float64)
-    return m + k, v, enc_radius(r, _norm(m) + np.linalg.norm(k), ENC_ROUND)
+    return m + k, v, enc_radius(r, _norm(m) + np.linalg.norm(k), rounding().sum)
 
 
 def enc_outside(e, bailout2):
     m, v, r = e
     with np.errstate(all="ignore"):
-        lo = least_norm(m, v) * (1 - ENC_ROUND) - r
+        lo = least_norm(m, v) * (1 - rounding().sum) - r
         return (lo > 0) & (lo * lo > bailout2)
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius, least_norm
+from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, rounding
 
 
 def caff_of(mx, my, vx, vy, r):
@@ -16,13 +16,13 @@ def caff_of(mx, my, vx, vy, r):
 
 def caff_add(a, b):
     (ma, va, ra), (mb, vb, rb) = a, b
-    return ma + mb, va + vb, enc_radius(ra + rb, np.abs(ma) + np.abs(mb) + np.abs(va) + np.abs(vb), ENC_ROUND)
+    return ma + mb, va + vb, enc_radius(ra + rb, np.abs(ma) + np.abs(mb) + np.abs(va) + np.abs(vb), rounding().sum)
 
 
 def caff_scale(k, a):
     m, v, r = a
     sk = np.abs(k)
-    return k * m, k * v, enc_radius(sk * r, 2 * sk * (np.abs(m) + np.abs(v)), ENC_ROUND)
+    return k * m, k * v, enc_radius(sk * r, 2 * sk * (np.abs(m) + np.abs(v)), rounding().sum)
 
 
 def caff_mul(a, b):
@@ -32,7 +32,7 @@ def caff_mul(a, b):
         m = m1 * m2 + 0.5 * (v1 * v2)
         v = m1 * v2 + v1 * m2
         r = 0.5 * b1 * b2 + (a1 + b1) * r2 + (a2 + b2) * r1 + r1 * r2
-        return m, v, enc_radius(r, 4 * (a1 * a2 + b1 * b2 + a1 * b2 + b1 * a2), ENC_ROUND)
+        return m, v, enc_radius(r, 4 * (a1 * a2 + b1 * b2 + a1 * b2 + b1 * a2), rounding().sum)
 
 
 def caff_sqr(a):
@@ -48,7 +48,7 @@ def caff_margin(z, bailout):
 def caff_outside(z, bailout2):
     m, v, r = z
     with np.errstate(all="ignore"):
-        lo = least_norm(np.stack([m.real, m.imag], -1), np.stack([v.real, v.imag], -1)) * (1 - ENC_ROUND) - r
+        lo = least_norm(np.stack([m.real, m.imag], -1), np.stack([v.real, v.imag], -1)) * (1 - rounding().sum) - r
         return (lo > 0) & (lo * lo > bailout2)
 
 
@@ -63,7 +63,7 @@ def segment_parts(o, d, t0, t1):
     radius of its points (enclose/ball.cl enc_segment's)."""
     tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
     m, v = o + tm[:, None] * d, hw[:, None] * d
-    r = enc_radius(0.0, np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1), ENC_ROUND)
+    r = enc_radius(0.0, np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1), rounding().sum)
     return m, v, r
 
 

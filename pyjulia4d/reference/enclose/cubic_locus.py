@@ -10,7 +10,7 @@ from pyjulia4d.reference.enclose.caff import (caff_add, caff_mul, caff_of, caff_
                                               orbit_hopeful as enc_hopeful, orbit_margin as enc_margin,
                                               orbit_outside as enc_outside)
 from pyjulia4d.reference.enclose.julia import enc_steps  # noqa: F401 (z_0 .. z_max_iter, as the Julia set's)
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, least_norm
+from pyjulia4d.reference.enclose.disc import least_norm, rounding
 
 
 def enc_start(o, d, t0, t1, c, F):
@@ -18,7 +18,7 @@ def enc_start(o, d, t0, t1, c, F):
     a = caff_of(m[:, 0], m[:, 1], v[:, 0], v[:, 1], r)
     a3 = caff_scale(3.0, caff_sqr(a))
     b = caff_of(m[:, 2], m[:, 3], v[:, 2], v[:, 3], r)
-    least = least_norm(m, v) * (1 - ENC_ROUND) - r
+    least = least_norm(m, v) * (1 - rounding().sum) - r
     off = (least > 0) & (least * least > F.locus_radius ** 2)
     sign = 1.0 if F.component == "plus" else -1.0
     return (caff_scale(sign, a), off), (a3, b)

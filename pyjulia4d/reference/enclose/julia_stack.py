@@ -9,7 +9,7 @@ from pyjulia4d.reference.enclose.caff import (caff_add, caff_of, caff_sqr, segme
                                               orbit_hopeful as enc_hopeful, orbit_margin as enc_margin,
                                               orbit_outside as enc_outside)
 from pyjulia4d.reference.enclose.julia import enc_steps  # noqa: F401 (z_0 .. z_max_iter, as the Julia set's)
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, enc_radius
+from pyjulia4d.reference.enclose.disc import enc_radius, rounding
 from pyjulia4d.reference.kind.julia_stack import c_line
 
 
@@ -18,7 +18,7 @@ def enc_start(o, d, t0, t1, c, F):
     cm, ch = c_line(F)
     sh = abs(ch)
     cform = (cm + m[:, 2] * ch, v[:, 2] * ch,
-             enc_radius(sh * r, abs(cm) + 2 * sh * (np.abs(m[:, 2]) + np.abs(v[:, 2])), ENC_ROUND))
+             enc_radius(sh * r, abs(cm) + 2 * sh * (np.abs(m[:, 2]) + np.abs(v[:, 2])), rounding().sum))
     off = (np.abs(m[:, 2]) - np.abs(v[:, 2]) - r) > 1
     return (caff_of(m[:, 0], m[:, 1], v[:, 0], v[:, 1], r), off), cform
 

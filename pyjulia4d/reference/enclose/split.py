@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from pyjulia4d.reference.enclose.caff import caff_add
-from pyjulia4d.reference.enclose.disc import ENC_ROUND, ENC_ROUND_FN, ENC_UP, enc_radius, least_norm, prefix_of
+from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
 def caff_f(z, fn):
@@ -20,18 +20,18 @@ def caff_f(z, fn):
         if fn.FUNC_M2 is not None:
             fm, d1 = fn.cfun(m), fn.cfun_d(m)
             vn = d1 * v
-            rn = np.abs(d1) * r * ENC_UP + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * ENC_UP
+            rn = np.abs(d1) * r * rounding().up + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * rounding().up
             size = np.abs(fm) + 4 * np.abs(vn)
             if fn.FUNC_ROUND_GAIN is not None:
                 size = size * fn.FUNC_ROUND_GAIN(m)
-            rn = enc_radius(np.where(np.isnan(rn) | np.isnan(size), np.inf, rn), size, ENC_ROUND_FN)
+            rn = enc_radius(np.where(np.isnan(rn) | np.isnan(size), np.inf, rn), size, rounding().fn)
             bad = ~(rn < np.inf)
         else:
             fm, vn, rn = m, v, r
             bad = np.ones(np.shape(m), bool)
         if not bad.any():
             return fm, vn, rn
-        wm, wr = fn.cfun_disc((m, enc_radius(rho, 0.0, ENC_ROUND)))
+        wm, wr = fn.cfun_disc((m, enc_radius(rho, 0.0, rounding().sum)))
     return np.where(bad, wm, fm), np.where(bad, 0j, vn), np.where(bad, wr, rn)
 
 
@@ -44,7 +44,7 @@ def enc_shift(e, k):
     """The form plus a constant k in the algebra's coordinates (the components' (x, y), (z, w))."""
     out = []
     for (m, v, r), kk in zip(e, (complex(k[0], k[1]), complex(k[2], k[3]))):
-        out.append((m + kk, v, enc_radius(r, np.abs(m) + abs(kk), ENC_ROUND)))
+        out.append((m + kk, v, enc_radius(r, np.abs(m) + abs(kk), rounding().sum)))
     return tuple(out)
 
 
@@ -52,7 +52,7 @@ def enc_segment(o, d, t0, t1, F):
     tm, hw = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
     q = F.ALG_IN(o + tm[:, None] * d)
     v = F.ALG_IN(hw[:, None] * d)
-    r = enc_radius(0.0, 2 * (np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1)), ENC_ROUND)
+    r = enc_radius(0.0, 2 * (np.linalg.norm(o, axis=-1) + np.abs(tm) * np.linalg.norm(d, axis=-1)), rounding().sum)
     return ((q[:, 0] + 1j * q[:, 1], v[:, 0] + 1j * v[:, 1], r), (q[:, 2] + 1j * q[:, 3], v[:, 2] + 1j * v[:, 3], r))
 
 
@@ -60,7 +60,7 @@ def enc_step(e, c, F):
     out = []
     for z, ck in zip(e, (complex(c[0], c[1]), complex(c[2], c[3]))):
         m, v, r = caff_f(z, F.fn)
-        out.append((m + ck, v, enc_radius(r, np.abs(m) + abs(ck), ENC_ROUND)))
+        out.append((m + ck, v, enc_radius(r, np.abs(m) + abs(ck), rounding().sum)))
     return tuple(out)
 
 
@@ -74,7 +74,7 @@ def _joined(e):
 def enc_outside(e, bailout2):
     m, v, ar, br = _joined(e)
     with np.errstate(all="ignore"):
-        lo = least_norm(m, v) * (1 - ENC_ROUND) - np.hypot(ar, br)
+        lo = least_norm(m, v) * (1 - rounding().sum) - np.hypot(ar, br)
         return (lo > 0) & (0.5 * lo * lo > bailout2)
 
 

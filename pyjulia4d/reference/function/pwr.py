@@ -36,7 +36,7 @@ def FUNC_M2(m, rho, p):
             bad = (qr < 0) & ~(np.abs(m) > rho)
         else:
             bad = D.d_meets_cut((m, rho)) | ~(np.abs(m) > rho)
-        return np.where(bad, np.inf, abs(p) * abs(p - 1) * np.exp(e) * D.ENC_UP)
+        return np.where(bad, np.inf, abs(p) * abs(p - 1) * np.exp(e) * D.rounding().up)
 
 
 def FUNC_ROUND_GAIN(m, p):
