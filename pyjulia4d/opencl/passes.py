@@ -19,7 +19,7 @@ from pyjulia4d.pipeline import antialias
 from pyjulia4d.pipeline.codes import STATUS_CAPPED, STATUS_HIT, STATUS_MISS
 from pyjulia4d.pipeline.plan import Plan, Tile, make_tiles
 from pyjulia4d.pipeline.progress import Progress
-from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards
+from pyjulia4d.pipeline.result import RenderResult, add_counts, count_guards, stored_depth
 from pyjulia4d.pipeline.store import IN_MEMORY, ImageStore, new_zeros
 from pyjulia4d.pipeline.workload import OUTPUTS_TABLE
 
@@ -64,10 +64,11 @@ class Filing:
             copy_xyz(img["color"][dst], got["rgba"][own])
         if "alpha" in keep:
             img["alpha"][dst] = got["rgba"][own][..., 3] if "rgba" in got else (st == STATUS_HIT)
-        for k, src in (("depth", "depth"), ("bracket", "bracket"), ("unresolved", "unresolved"), ("status", "status"),
-                       ("samples", "samples")):
-            if k in keep:
-                img[k][dst] = got[src][own]
+        src = {k: got[k][own] for k in ("depth", "bracket", "unresolved", "status", "samples") if k in keep}
+        if "depth" in src and "bracket" in src:
+            src["depth"], src["bracket"] = stored_depth(src["depth"], src["bracket"])
+        for k, v in src.items():
+            img[k][dst] = v
         if "normal" in keep:
             copy_xyz(img["normal"][dst], got["normal"][own])
         if "position" in keep:

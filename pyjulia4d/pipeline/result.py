@@ -20,6 +20,26 @@ if TYPE_CHECKING:
     from pyjulia4d.pipeline.calibrate import Prediction
 
 
+def stored_depth(depth: np.ndarray, bracket: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A double-precision render's depth and bracket as the float32 images keep them, the
+    statement kept true: the depth rounded towards the camera (never past the first
+    crossing's lower end) and the bracket widened by that rounding and rounded up, so
+    [depth - unresolved, depth + bracket] still holds the crossing (rounded to nearest, the
+    float32 depth of a render in double precision was off by up to half a spacing of t,
+    more than the 1.9e-7 brackets it stated: 5.6e-7 measured on the hypercomplex
+    reciprocal).  Single precision's arrays pass unchanged."""
+    if depth.dtype == np.float32:
+        return depth, bracket
+    d64, b64 = depth.astype(np.float64), bracket.astype(np.float64)
+    d32 = d64.astype(np.float32)
+    with np.errstate(invalid="ignore"):   # inf - inf off the hits
+        d32 = np.where(d32 > d64, np.nextafter(d32, np.float32(-np.inf)), d32)
+        want = b64 + np.where(np.isfinite(d64), d64 - d32.astype(np.float64), 0.0)
+    b32 = want.astype(np.float32)
+    with np.errstate(invalid="ignore"):
+        b32 = np.where(b32 < want, np.nextafter(b32, np.float32(np.inf)), b32)
+    return d32, b32
+
 @dataclass
 class RenderResult:
     """Image buffers (row 0 at the top) and what the render cost."""

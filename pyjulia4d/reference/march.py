@@ -215,7 +215,7 @@ def prefix_end(t0, t1, pre):
 
 
 PROVEN_FIRST = 0.125
-PROVEN_GAIN = 0.8
+PROVEN_GAIN = 1.2
 FLOOR_POINTS = 8   # the points an unproven floor segment is tested at (march/proven.cl)
 FLOOR_RUN = 32     # unproven floor segments in a row that double the floor (march/proven.cl)
 FLOOR_WIDEST = 0.001   # of the ray: the widest the floor grows to

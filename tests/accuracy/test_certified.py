@@ -13,7 +13,7 @@ from pyjulia4d.geometry.camera import camera_frame
 from pyjulia4d.opencl.executor import render
 from pyjulia4d.pipeline.codes import STATUS_HIT
 from pyjulia4d.pipeline.plan import march_args
-from pyjulia4d.pipeline.result import percentiles
+from pyjulia4d.pipeline.result import percentiles, stored_depth
 from pyjulia4d.scene.model import Scene
 
 W, H = 40, 30
@@ -121,3 +121,25 @@ def test_percentiles_are_numpys(n):
         got = percentiles(v, (0, 50, 99, 99.9, 100))
         want = np.percentile(v.astype(np.float64), [0, 50, 99, 99.9, 100])
         np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+
+
+def test_double_depth_is_stored_with_its_statement_kept():
+    """A double-precision render's depth in the float32 image (pipeline/result.py stored_depth):
+    never behind the float64 depth, and depth + bracket never in front of the float64 ones,
+    so [depth - unresolved, depth + bracket] holds what the kernel's interval held; misses stay
+    infinite, and single precision's arrays pass as they are."""
+    rng = np.random.default_rng(3)
+    d64 = np.concatenate([rng.uniform(0.5, 40.0, 20000), [np.inf, 3.0, 2.0 ** -20]])
+    b64 = np.concatenate([10.0 ** rng.uniform(-16, -3, 20000), [np.inf, 0.0, 1e-18]])
+    d32, b32 = stored_depth(d64, b64)
+    assert d32.dtype == b32.dtype == np.float32
+    fin = np.isfinite(d64)
+    assert np.all(d32[fin].astype(np.float64) <= d64[fin])
+    assert np.all(d32[fin].astype(np.float64) + b32[fin].astype(np.float64) >= d64[fin] + b64[fin])
+    assert np.isinf(d32[~fin]).all() and np.isinf(b32[~fin]).all()
+    # the widening is the rounding: at most a float32 spacing of the depth, and a spacing of the bracket
+    wide = b32[fin].astype(np.float64) - b64[fin]
+    assert np.all(wide <= np.spacing(d32[fin]).astype(np.float64) + np.spacing(b32[fin]).astype(np.float64))
+    single = (d64[fin].astype(np.float32), b64[fin].astype(np.float32))
+    got = stored_depth(*single)
+    assert got[0] is single[0] and got[1] is single[1]
