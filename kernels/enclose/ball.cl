@@ -88,12 +88,14 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     quat qv = julia_f_jvp(e.v, e.m);      /* Q(v), the second-order term at m along v */
     quat cv = julia_f(e.v, (real4)(0));   /* v^3 */
 #ifdef ALG_LBOUND_IS_LEN
-    lreal cvl = sv * sv * sv;             /* |v^3| = |v|^3 */
+    /* |v^3| = |v|^3, and |Q(v)| by its bound 3 |m| |v|^2: its own length, a square root an
+     * iteration, cost the quaternion cube 10 % of its march's time for 2 % fewer enclosures */
+    lreal cvl = sv * sv * sv, qvl = (real)3 * lm * sv * sv;
 #else
-    lreal cvl = QLEN(cv);
+    lreal cvl = QLEN(cv), qvl = QLEN(qv);
 #endif
     lreal jn = ALG_LBOUND_SQR(e.m) + (real)2 * lm * lm;
-    lreal r = jn * e.r + (real)0.5 * QLEN(qv) + (real)0.25 * cvl +
+    lreal r = jn * e.r + (real)0.5 * qvl + (real)0.25 * cvl +
               ((real)3 * K * lm * ((real)2 * sv + e.r) + K * K * ((real)3 * sv * sv + ((real)3 * sv + e.r) * e.r)) * e.r;
     lreal size = K * K * s * s * s + jn * sv + ((real)3 * K * lm + K * K * sv) * sv * sv;
     quat m = QADD(julia_f(e.m, c), QSCALE((lreal)0.5, qv));

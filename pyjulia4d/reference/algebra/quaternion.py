@@ -88,6 +88,7 @@ ALG_HAS_DE = True
 
 # reference/enclose/ball.py (kernels/algebra/quaternion.cl): |a b| = |a| |b|
 ALG_ENCLOSE_K = 1.0
+ALG_LBOUND_IS_LEN = True   # the bound on h -> m h is |m| itself (reference/enclose/ball.py)
 
 
 def ALG_LBOUND(m):

@@ -42,7 +42,9 @@ def enc_step(e, c, F):
         else:
             qv, cv = F.julia_f_jvp(v, m), F.julia_f(v, np.zeros(4))   # Q(v) and v^3
             jn = alg.ALG_LBOUND_SQR(m) + 2 * lm * lm
-            rn = jn * r + 0.5 * _norm(qv) + 0.25 * _norm(cv) + (
+            # the quaternions' |Q(v)| by its bound 3 |m| |v|^2 (enclose/ball.cl)
+            qvl = 3 * lm * sv * sv if getattr(alg, "ALG_LBOUND_IS_LEN", False) else _norm(qv)
+            rn = jn * r + 0.5 * qvl + 0.25 * _norm(cv) + (
                 3 * K * lm * (2 * sv + r) + K * K * (3 * sv * sv + (3 * sv + r) * r)) * r
             size = K * K * s ** 3 + jn * sv + (3 * K * lm + K * K * sv) * sv * sv
             mn = F.julia_f(m, c) + 0.5 * qv
