@@ -508,3 +508,15 @@ def test_path_noise_sources_report_runs(tmp_path):
     rows = [ln for ln in (tmp_path / "path_noise_sources.md").read_text().splitlines() if ln.startswith("| ") and "---" not in ln][1:]
     assert len(rows) == len(bench.VARIANTS)
     assert all(np.isfinite(float(ln.split("|")[3])) for ln in rows)
+
+
+def test_precision_cost_runs(tmp_path, capsys):
+    """benchmarks/accuracy/precision_cost.py on one pair, tiny: its row, both precisions."""
+    from harness import device
+    if "cl_khr_fp64" not in device().extensions:
+        pytest.skip("the device has no double precision")
+    assert load("precision_cost").main(["--size", "16x12", "--repeats", "1", "--only", "cquat_sqr",
+                                        "--out", str(tmp_path)]) == 0
+    row = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("| cquat sqr")]
+    assert len(row) == 1 and len(row[0].split("|")) == 10
+    assert "commit" in (tmp_path / "precision_cost.md").read_text()
