@@ -3,7 +3,9 @@
  * components a, b, each a complex number iterated on its own by f, so each gets an affine
  * form in the segment's s in [-1, 1] (enclose/ball.cl says why):
  *     a_n(s) in m + s v + B(r)   (complex m, v),
- * pushed through f by Taylor's theorem: with d = s v + e, |e| <= r, rho = |v| + r,
+ * pushed through f by Taylor's theorem (the powers, sqr and cube, by products of forms,
+ * enclose/caff.cl, whose s^2 terms go half into the centre): with d = s v + e, |e| <= r,
+ * rho = |v| + r,
  *     f(m + d) = f(m) + s f'(m) v + f'(m) e + R,   |R| <= rho^2 / 2 sup|f''|,
  * the sup over the disc of radius rho around m, which the function piece bounds
  * (FUNC_M2(m, rho), function/<name>.cl).  Where it gives no bound (a pole or a branch cut
@@ -18,6 +20,16 @@ typedef struct { caff a, b; } enclosure;   /* caff: enclose/caff.cl */
  * whole packet down the disc path) */
 inline caff caff_f(caff z, lmask live)
 {
+#ifdef FUNC_POWER
+    /* the powers by products of forms (enclose/caff.cl), which put half of each s^2 term into
+     * the centre: the square's remainder |v|^2 / 2 + 2 (|m| + |v|) r + r^2 against Taylor's
+     * rho^2, the cube's about 3/2 |m| |v|^2 + |v|^3 / 2 against 3 (|m| + rho) rho^2 */
+#if FUNC_POWER == 2
+    return caff_sqr(z);
+#else
+    return caff_mul(caff_sqr(z), z);
+#endif
+#else
     lreal rho = c_abs(z.v) + z.r;
     caff out = z;
 #ifdef FUNC_M2
@@ -41,6 +53,7 @@ inline caff caff_f(caff z, lmask live)
     cdisc w = cfun_disc(D(z.m, enc_radius(rho, (lreal)0, ENC_ROUND)));
     return A(C(L_SEL(out.m.re, w.m.re, bad), L_SEL(out.m.im, w.m.im, bad)),
              C(L_SEL(out.v.re, (lreal)0, bad), L_SEL(out.v.im, (lreal)0, bad)), L_SEL(out.r, w.r, bad));
+#endif
 }
 
 /* the points o + t d, t in [t0, t1]: centre, tangent and the rounding of o + t d and ALG_IN */

@@ -104,7 +104,7 @@ def test_orbit_enclosures_hold_the_orbits(algebra, function, how):
 # double precision's rounding bounds are 2^-28 of single's (kernels/enclose/disc.cl): the
 # enclosures must still hold float64's own orbits with them
 @pytest.mark.parametrize("algebra,function,how", [("quaternion", "sqr", 0.0), ("quaternion", "cube", -75.0),
-                                                  ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
+                                                  ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0), ("hypercomplex", "cube", 0.0),
                                                   ("hypercomplex", "cube", 0.0), ("cquat", "cube", 0.0),
                                                   ("commutative", "sqr", 0.0), ("hypercomplex", "exp", "mandelbrot")])
 def test_double_enclosures_hold_the_orbits(algebra, function, how):
@@ -213,7 +213,7 @@ def test_proven_segments_hold_no_inside_point(algebra, function, how):
 # each builds its own programs (seconds from cold): a sample by default, the rest marked slow
 _SLOW = pytest.mark.slow
 KERNEL_PAIRS = [("quaternion", "sqr", 0.0), pytest.param("quaternion", "cube", 0.0, marks=_SLOW),
-                ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0),
+                ("hypercomplex", "sin", 0.0), ("hypercomplex", "pwr", 0.0), ("hypercomplex", "cube", 0.0),
                 pytest.param("hypercomplex", "tan", 0.0, marks=_SLOW), pytest.param("hypercomplex", "ln", 0.0, marks=_SLOW),
                 pytest.param("hypercomplex", "asinh", 0.0, marks=_SLOW), ("cquat", "cube", 0.0),
                 pytest.param("commutative", "sqr", 0.0, marks=_SLOW), ("quaternion", "sqr", 30.0),

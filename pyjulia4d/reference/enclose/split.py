@@ -1,6 +1,7 @@
 """float64 twin of kernels/enclose/split.cl: orbit enclosures of a ray segment in a split
 algebra (the hypercomplex numbers), an affine form m + s v + B(r) (complex m, v; s in
-[-1, 1]) for each idempotent component, pushed through f by Taylor's theorem,
+[-1, 1]) for each idempotent component, pushed through f by Taylor's theorem (the powers by
+products of forms, reference/enclose/caff.py caff_mul),
     f(m + d) = f(m) + s f'(m) v + f'(m) e + R,  |R| <= rho^2 / 2 sup|f''|  (rho = |v| + r),
 with the function's FUNC_M2 bound on |f''| over the disc of radius rho; where there is none
 (the piece has no bound, or a pole or cut is in the disc), through cfun_disc on the
@@ -9,11 +10,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.caff import caff_add
+from pyjulia4d.reference.enclose.caff import caff_add, caff_mul
 from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
 def caff_f(z, fn):
+    power = getattr(fn, "FUNC_POWER", None)
+    if power:   # the powers by products of forms, half of each s^2 term in the centre (enclose/split.cl)
+        sq = caff_mul(z, z)
+        return sq if power == 2 else caff_mul(sq, z)
     m, v, r = z
     with np.errstate(all="ignore"):
         rho = np.abs(v) + r
