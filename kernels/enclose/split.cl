@@ -36,11 +36,24 @@ inline caff caff_f(caff z, lmask live)
     cplx fm = cfun(z.m), d1 = cfun_d(z.m);
     cplx v = c_mul(d1, z.v);
     lreal da = c_abs(d1);
+#ifdef FUNC_D2_SIGN
+    /* f'' = FUNC_D2_SIGN f and FUNC_M2 bounds f''' too (function/sin.cl and its kin): the
+     * second-order term f''(m) d^2 / 2 kept at m, its s^2 v^2 split as the powers' (half into
+     * the centre), Taylor's remainder of third order:
+     *     r' = |f'(m)| r + |f''(m)| (|v|^2 / 4 + (|v| + r / 2) r) + rho^3 / 6 sup|f'''|,
+     * against rho^2 / 2 sup|f''|; the centre and its size take f''(m) v^2 / 4 */
+    lreal fa = c_abs(fm), va = c_abs(z.v);
+    fm = c_add(fm, c_scale((lreal)((real)0.25 * (real)FUNC_D2_SIGN), c_mul(fm, c_sqr(z.v))));
+    lreal r = da * z.r * ENC_UP +
+              (fa * ((real)0.25 * va * va + (va + (real)0.5 * z.r) * z.r) + rho * rho * rho * FUNC_M2(z.m, rho) / (real)6) * ENC_UP;
+    lreal size = fa * ((real)1 + va * va) + (real)4 * c_abs(v);
+#else
     lreal r = da * z.r * ENC_UP + (real)0.5 * rho * rho * FUNC_M2(z.m, rho) * ENC_UP;
 #ifdef FUNC_ROUND_GAIN   /* a function whose value loses more than a few ulps (function/pwr.cl) */
     lreal size = (c_abs(fm) + (real)4 * c_abs(v)) * FUNC_ROUND_GAIN(z.m);
 #else
     lreal size = c_abs(fm) + (real)4 * c_abs(v);
+#endif
 #endif
     r = enc_radius(L_SEL(r, (lreal)INFINITY, isnan(r) | isnan(size)), size, ENC_ROUND_FN);
     out = A(fm, v, r);

@@ -50,7 +50,8 @@ class Formula:
                         functools.partial(mod.cfun_disc, p=p), functools.partial(mod.FUNC_M2, p=p),
                         functools.partial(mod.FUNC_ROUND_GAIN, p=p))
         else:
-            fn = _Bound(mod.cfun, mod.cfun_d, entry.degree, mod.cfun_disc, getattr(mod, "FUNC_M2", None))
+            fn = _Bound(mod.cfun, mod.cfun_d, entry.degree, mod.cfun_disc, getattr(mod, "FUNC_M2", None),
+                        FUNC_D2_SIGN=getattr(mod, "FUNC_D2_SIGN", None))
         object.__setattr__(self, "alg", alg)
         object.__setattr__(self, "fn", fn)
 
@@ -130,6 +131,7 @@ class _Bound:
     cfun_disc: Any = None   # its disc enclosure (reference/enclose/disc.py)
     FUNC_M2: Any = None     # its bound on |f''| over a disc, where it has one (reference/enclose/split.py)
     FUNC_ROUND_GAIN: Any = None   # how many times more than a few ulps its value loses, where it does
+    FUNC_D2_SIGN: int | None = None   # f'' = FUNC_D2_SIGN f, where that holds (reference/enclose/split.py)
 
 
 QUATERNION_SQR = Formula()

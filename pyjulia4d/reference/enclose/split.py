@@ -25,8 +25,15 @@ def caff_f(z, fn):
         if fn.FUNC_M2 is not None:
             fm, d1 = fn.cfun(m), fn.cfun_d(m)
             vn = d1 * v
-            rn = np.abs(d1) * r * rounding().up + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * rounding().up
-            size = np.abs(fm) + 4 * np.abs(vn)
+            if fn.FUNC_D2_SIGN is not None:   # f'' = sign f: second order kept, s^2 split (enclose/split.cl)
+                fa, va = np.abs(fm), np.abs(v)
+                rn = np.abs(d1) * r * rounding().up + (
+                    fa * (0.25 * va * va + (va + 0.5 * r) * r) + rho ** 3 * fn.FUNC_M2(m, rho) / 6) * rounding().up
+                size = fa * (1 + va * va) + 4 * np.abs(vn)
+                fm = fm + 0.25 * fn.FUNC_D2_SIGN * fm * (v * v)
+            else:
+                rn = np.abs(d1) * r * rounding().up + 0.5 * rho * rho * fn.FUNC_M2(m, rho) * rounding().up
+                size = np.abs(fm) + 4 * np.abs(vn)
             if fn.FUNC_ROUND_GAIN is not None:
                 size = size * fn.FUNC_ROUND_GAIN(m)
             rn = enc_radius(np.where(np.isnan(rn) | np.isnan(size), np.inf, rn), size, rounding().fn)

@@ -19,4 +19,7 @@ def FUNC_M2(m, rho):
         return np.cosh(np.abs(m.real) + rho)
 
 
+FUNC_D2_SIGN = 1   # f'' = FUNC_D2_SIGN f, FUNC_M2's bound holding f''' too (kernels/function/cosh.cl)
+
+
 cfun_disc = D.taylor_disc(cfun, cfun_d, FUNC_M2)   # kernels/function/cosh.cl, under -D ENCLOSE

@@ -23,3 +23,6 @@ def FUNC_M2(m, rho):
     """A bound on |f''| over the disc of radius rho around m (kernels/function/exp.cl)."""
     with np.errstate(all="ignore"):
         return np.exp(m.real + rho)
+
+
+FUNC_D2_SIGN = 1   # f'' = FUNC_D2_SIGN f, FUNC_M2's bound holding f''' too (kernels/function/exp.cl)
