@@ -4,8 +4,8 @@
  * form in the segment's s in [-1, 1] (enclose/ball.cl says why):
  *     a_n(s) in m + s v + B(r)   (complex m, v),
  * pushed through f by Taylor's theorem (the powers, sqr and cube, by products of forms,
- * enclose/caff.cl, whose s^2 terms go half into the centre): with d = s v + e, |e| <= r,
- * rho = |v| + r,
+ * enclose/caff.cl, whose s^2 terms go half into the centre; the functions with f'' = +-f to
+ * second order, caff_f below): with d = s v + e, |e| <= r, rho = |v| + r,
  *     f(m + d) = f(m) + s f'(m) v + f'(m) e + R,   |R| <= rho^2 / 2 sup|f''|,
  * the sup over the disc of radius rho around m, which the function piece bounds
  * (FUNC_M2(m, rho), function/<name>.cl).  Where it gives no bound (a pole or a branch cut

@@ -1,7 +1,8 @@
 """float64 twin of kernels/enclose/split.cl: orbit enclosures of a ray segment in a split
 algebra (the hypercomplex numbers), an affine form m + s v + B(r) (complex m, v; s in
 [-1, 1]) for each idempotent component, pushed through f by Taylor's theorem (the powers by
-products of forms, reference/enclose/caff.py caff_mul),
+products of forms, reference/enclose/caff.py caff_mul; the functions with f'' = +-f to second
+order, FUNC_D2_SIGN),
     f(m + d) = f(m) + s f'(m) v + f'(m) e + R,  |R| <= rho^2 / 2 sup|f''|  (rho = |v| + r),
 with the function's FUNC_M2 bound on |f''| over the disc of radius rho; where there is none
 (the piece has no bound, or a pole or cut is in the disc), through cfun_disc on the
