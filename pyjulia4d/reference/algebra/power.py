@@ -23,6 +23,13 @@ def maps(alg_mul):
 
 
 LBOUND_UP = 1 + 2.0 ** -19   # kernels/algebra/power.cl ALG_LBOUND_UP
+BASIS = np.eye(4)
+
+
+def product_matrix(alg_mul, m):
+    """The matrix of h -> m h (..., 4, 4), column j the product with the j-th basis vector."""
+    m = np.asarray(m, np.float64)
+    return np.stack([alg_mul(m, np.broadcast_to(BASIS[j], m.shape)) for j in range(4)], axis=-1)
 
 
 def enclose_bounds(alg_mul):
@@ -31,16 +38,14 @@ def enclose_bounds(alg_mul):
     h -> m h at most L(m) = min(sqrt(|m|^2 + sqrt(3/4 |S|_F^2)), |m|_1), S = L_m^T L_m - |m|^2 I,
     and of h -> (m m) h at most L(m m).  S comes from the product itself here (the matrix
     L_m column by column), where the kernel writes each algebra's |S|_F^2 out."""
-    basis = np.eye(4)
-
     def norm1(m):
         return np.sum(np.abs(m), axis=-1)
 
     def lbound(m):
         m = np.asarray(m, np.float64)
-        L = np.stack([alg_mul(m, np.broadcast_to(basis[j], m.shape)) for j in range(4)], axis=-1)
+        L = product_matrix(alg_mul, m)
         n2 = np.sum(m * m, axis=-1)
-        S = np.einsum("...ij,...ik->...jk", L, L) - n2[..., None, None] * basis
+        S = np.einsum("...ij,...ik->...jk", L, L) - n2[..., None, None] * BASIS
         with np.errstate(all="ignore"):
             return np.fmin(np.sqrt(n2 + np.sqrt(0.75 * np.sum(S * S, axis=(-2, -1)))) * LBOUND_UP, norm1(m))
 
