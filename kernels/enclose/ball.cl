@@ -136,6 +136,15 @@ inline lreal enc_prefix(enclosure e, real bailout, lmask live)
  * sizes its next segment by it */
 inline lreal enc_margin(enclosure e, real bailout) { return (e.ml - bailout) / (e.vl + e.r); }
 
+/* the lanes whose form may pass a test (march/proven.cl ENC_GATE): a positive margin needs
+ * |m| > bailout, the segment outside needs more, and a part outside needs its start
+ * |m - v| <= |m| + |v| beyond bailout + r */
+#define ENC_HAS_GATE
+inline lmask enc_gate(enclosure e, real bailout)
+{
+    return (e.ml > bailout) | (e.ml + e.vl > bailout + e.r);
+}
+
 /* whether the form may still prove the segment: an extent past twice the centre's distance
  * plus the bailout grows faster than the centre from here on (the proof only gives up) */
 inline lmask enc_hopeful(enclosure e, real bailout)

@@ -137,6 +137,17 @@ inline lreal enc_extent(enclosure e)
 
 inline lreal enc_margin(enclosure e, real bailout) { return (enc_centre_norm(e) - bailout) / enc_extent(e); }
 
+/* the lanes whose forms may pass a test (march/proven.cl ENC_GATE): a positive margin needs
+ * the centre's |h| past the bailout, a part outside needs the start's |(a, b)| <= |m| + |v|
+ * past sqrt(2) bailout + |(ra, rb)| */
+#define ENC_HAS_GATE
+inline lmask enc_gate(enclosure e, real bailout)
+{
+    lreal hm = enc_centre_norm(e);
+    lreal vl = sqrt(e.a.v.re * e.a.v.re + e.a.v.im * e.a.v.im + e.b.v.re * e.b.v.re + e.b.v.im * e.b.v.im);
+    return (hm > bailout) | ((real)1.4142135623730951 * (hm - bailout) + vl > lane_hypot(e.a.r, e.b.r));
+}
+
 /* whether the forms may still prove the segment (enclose/ball.cl enc_hopeful; NaN: no) */
 inline lmask enc_hopeful(enclosure e, real bailout)
 {

@@ -180,12 +180,13 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
 def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
     (reference/enclose/) outside the bailout ball at some n <= max_iter -, the largest
-    enc_margin over the iterations, and the largest s in [-1, 1] whose part [-1, s] of the
+    enc_margin over the iterations (0 where none is positive), and the largest s in [-1, 1] whose part [-1, s] of the
     segment some iteration's enclosure keeps outside (1 where proven, -1 where none, or where
     the enclosure piece has no enc_prefix) (march/proven.cl)."""
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
     enc_prefix = getattr(E, "enc_prefix", None)
+    enc_gate = getattr(E, "enc_gate", None)
     b2 = bailout * bailout
     # every ray's form is stepped, the decided ones too: their growth past the float64 range
     # is an infinite radius, no proof (as in the kernel), not a warning
@@ -193,16 +194,18 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
         e, p = K.enc_start(o, d, t0, t1, c, formula)
         proven = E.enc_outside(e, b2)
         live = ~proven
-        best = E.enc_margin(e, bailout)
+        best = np.fmax(E.enc_margin(e, bailout), 0.0)
         pre = enc_prefix(e, bailout) if enc_prefix else np.full(len(o), -1.0)
         for _ in range(K.enc_steps(max_iter)):
             if not live.any():
                 break
             e = K.enc_next(e, p, formula)
-            out = live & E.enc_outside(e, b2)
-            best = np.where(live, np.fmax(best, E.enc_margin(e, bailout)), best)
+            # only where the form may pass a test (march/proven.cl ENC_GATE)
+            near = live & enc_gate(e, bailout) if enc_gate else live
+            out = near & E.enc_outside(e, b2)
+            best = np.where(near, np.fmax(best, E.enc_margin(e, bailout)), best)
             if enc_prefix:
-                pre = np.where(live, np.fmax(pre, enc_prefix(e, bailout)), pre)
+                pre = np.where(near, np.fmax(pre, enc_prefix(e, bailout)), pre)
             proven |= out
             live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best, np.where(proven, 1.0, pre)

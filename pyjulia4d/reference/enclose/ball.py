@@ -86,6 +86,14 @@ def enc_margin(e, bailout):
         return (_norm(m) - bailout) / (_norm(v) + r)
 
 
+def enc_gate(e, bailout):
+    """Whether the form may pass a test (kernels/enclose/ball.cl enc_gate): |m| > bailout, or
+    |m| + |v| > bailout + r."""
+    m, v, r = e
+    ml, vl = _norm(m), _norm(v)
+    return (ml > bailout) | (ml + vl > bailout + r)
+
+
 def enc_hopeful(e, bailout):
     """Whether the form may still prove the segment: an extent past twice the centre's
     distance plus the bailout only grows faster than the centre (kernels/enclose/ball.cl)."""

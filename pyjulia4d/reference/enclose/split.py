@@ -112,6 +112,14 @@ def enc_margin(e, bailout):
         return (hm - bailout) / ext
 
 
+def enc_gate(e, bailout):
+    """Whether the forms may pass a test (kernels/enclose/split.cl enc_gate)."""
+    hm, _ = _centre_norm_extent(e)
+    m, v, ar, br = _joined(e)
+    with np.errstate(all="ignore"):
+        return (hm > bailout) | (np.sqrt(2.0) * (hm - bailout) + np.sqrt(np.sum(v * v, axis=-1)) > np.hypot(ar, br))
+
+
 def enc_hopeful(e, bailout):
     hm, ext = _centre_norm_extent(e)
     with np.errstate(all="ignore"):
