@@ -228,11 +228,20 @@ inline quat QSEL(quat a, quat b, lmask m)
 
 /* -D PACKET_PAIRS: a work-item of the march and of the light terms takes two packets, their
  * estimates side by side, where one packet's chain of dependent operations would leave the
- * vector units idle (march/march.cl, shade/light.cl; pipeline/kernel_config.py march_packets) */
+ * vector units idle (march/march.cl, shade/light.cl; pipeline/kernel_config.py march_packets).
+ * With -D MARCH_UNPAIRED as well, the light terms alone do (LIGHT_PACKETS): the proven march
+ * takes one packet, but its shadow rays and occlusion step by the estimate as the estimate
+ * march's do. */
 #if defined(PACKET_PAIRS) && LANES > 1
+#define LIGHT_PACKETS 2
+#ifdef MARCH_UNPAIRED
+#define PACKETS 1
+#else
 #define PACKETS 2
+#endif
 #else
 #define PACKETS 1
+#define LIGHT_PACKETS 1
 #endif
 
 /* A derivative carried only up to scale (the normals' Jacobians: normals/jacobian.cl,

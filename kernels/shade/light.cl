@@ -70,7 +70,7 @@ inline lreal shadow_ray(quat o, quat l, lreal tmax, lmask lit, julia_params jp, 
     return clamp(m.vis, (real)0, (real)1);
 }
 
-#if PACKETS == 2 && defined(ALG_HAS_DE)
+#if LIGHT_PACKETS == 2 && defined(ALG_HAS_DE)
 #define LIGHT_PAIRS   /* two packets' estimates side by side (iterate.cl julia_distance_formula_pair) */
 #endif
 
@@ -224,10 +224,10 @@ inline void key_light_shadows(const quat *o, const quat *p, const quat *nw, cons
                               julia_params jp, real radius, real step, real softness, int max_steps, lreal *vis)
 {
     quat lp = QUAT_UNIFORM(light_pos);
-    quat l[PACKETS];
-    lreal dist[PACKETS];
-    lmask facing[PACKETS];
-    for (int b = 0; b < PACKETS; ++b) {
+    quat l[LIGHT_PACKETS];
+    lreal dist[LIGHT_PACKETS];
+    lmask facing[LIGHT_PACKETS];
+    for (int b = 0; b < LIGHT_PACKETS; ++b) {
         quat lv = QADD(lp, QSCALE((lreal)-1, o[b]));
         dist[b] = QLEN(lv);
         l[b] = QSCALE((real)1 / fmax(dist[b], REAL_MIN), lv);
@@ -236,7 +236,7 @@ inline void key_light_shadows(const quat *o, const quat *p, const quat *nw, cons
 #ifdef LIGHT_PAIRS
     shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, vis);
 #else
-    for (int b = 0; b < PACKETS; ++b)
+    for (int b = 0; b < LIGHT_PACKETS; ++b)
         vis[b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
 #endif
 }
@@ -248,15 +248,15 @@ inline void key_light_shadows(const quat *o, const quat *p, const quat *nw, cons
 inline void extra_light_shadows(const quat *o, const quat *p, const quat *nw, const lmask *hit,
                                 __global const real4 *lights_geo, __global const float4 *lights_rgb, real4 right,
                                 real4 up, real4 forward, julia_params jp, real radius, real step, real softness,
-                                int max_steps, lreal (*ve)[PACKETS])
+                                int max_steps, lreal (*ve)[LIGHT_PACKETS])
 {
     for (int j = 0; j < EXTRA_LIGHTS; ++j) {
         real4 g = lights_geo[j];
         quat gq = QUAT_UNIFORM(g);
-        quat l[PACKETS];
-        lreal dist[PACKETS];
-        lmask facing[PACKETS];
-        for (int b = 0; b < PACKETS; ++b) {
+        quat l[LIGHT_PACKETS];
+        lreal dist[LIGHT_PACKETS];
+        lmask facing[LIGHT_PACKETS];
+        for (int b = 0; b < LIGHT_PACKETS; ++b) {
             quat lv, to;      /* towards the light from o, and from the hit as shade.cl takes it */
             if (lights_rgb[j].w != 0.0f) {
                 lv = to = gq;
@@ -276,7 +276,7 @@ inline void extra_light_shadows(const quat *o, const quat *p, const quat *nw, co
 #ifdef LIGHT_PAIRS
         shadow_ray_pair(o, l, dist, facing, jp, radius, step, softness, max_steps, ve[j]);
 #else
-        for (int b = 0; b < PACKETS; ++b)
+        for (int b = 0; b < LIGHT_PACKETS; ++b)
             ve[j][b] = shadow_ray(o[b], l[b], dist[b], facing[b], jp, radius, step, softness, max_steps);
 #endif
     }
@@ -287,7 +287,7 @@ inline void extra_light_shadows(const quat *o, const quat *p, const quat *nw, co
  * the unit ball, the orbit trap, or w over [-R/2, R/2] (the visible range) */
 inline void colour_values(const quat *p, const quat *pin, julia_params jp, real radius, real4 trap, lreal *val)
 {
-    for (int b = 0; b < PACKETS; ++b) {
+    for (int b = 0; b < LIGHT_PACKETS; ++b) {
 #if defined(COLOR_ITERATION)
         val[b] = orbit_value(pin[b], jp);
 #elif defined(COLOR_TRAP)
@@ -309,7 +309,7 @@ inline void light_gather(const size_t (*lane_index)[LANES], int n_items, __globa
                          real4 eye, real4 right, real4 up, real4 forward, real4 away, quat *p, quat *nw, quat *pin,
                          lmask *hit)
 {
-    for (int b = 0; b < PACKETS; ++b) {
+    for (int b = 0; b < LIGHT_PACKETS; ++b) {
         for (int k = 0; k < LANES; ++k) {
             size_t i = lane_index[b][k];
             int h = i < (size_t)n_items && status[i] == STATUS_HIT;
@@ -330,11 +330,11 @@ inline void light_gather(const size_t (*lane_index)[LANES], int n_items, __globa
 inline void light_scatter(const size_t (*lane_index)[LANES], int n_items, __global const int *status,
                           const lreal *vis, const lreal *amb, const lreal *val, __global float4 *terms
 #ifdef EXTRA_SHADOWS
-                          , lreal (*ve)[PACKETS], __global float4 *vis_extra
+                          , lreal (*ve)[LIGHT_PACKETS], __global float4 *vis_extra
 #endif
                           )
 {
-    for (int b = 0; b < PACKETS; ++b) {
+    for (int b = 0; b < LIGHT_PACKETS; ++b) {
         for (int k = 0; k < LANES; ++k) {
             size_t i = lane_index[b][k];
             if (i >= (size_t)n_items)
@@ -366,18 +366,19 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
                           __global const float4 *lights_rgb, __global float4 *terms,
                           __global float4 *vis_extra)
 {
-    /* PACKETS blocks per work-item, as the march's (march/march.cl, PACKET_PAIRS) */
+    /* LIGHT_PACKETS blocks per work-item (common/lanes.cl): the march's, or two where only the
+     * light terms pair their estimates (MARCH_UNPAIRED) */
 #if LANES == 1
     size_t i0 = get_global_id(0);
 #else
-    size_t lane_index[PACKETS][LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
-    for (int k = 0; k < PACKETS; ++k)
-        if (!packet_lanes(get_global_id(0), k, PACKETS, n_items, tile_w, lane_index[k]))
+    size_t lane_index[LIGHT_PACKETS][LANES];   /* the march's blocks (common/lanes.cl): neighbours take like paths */
+    for (int k = 0; k < LIGHT_PACKETS; ++k)
+        if (!packet_lanes(get_global_id(0), k, LIGHT_PACKETS, n_items, tile_w, lane_index[k]))
             return;
 #endif
     julia_params jp = { c, bailout * bailout, epsilon, max_iter };
-    quat p[PACKETS], nw[PACKETS], pin[PACKETS];
-    lmask hit[PACKETS];
+    quat p[LIGHT_PACKETS], nw[LIGHT_PACKETS], pin[LIGHT_PACKETS];
+    lmask hit[LIGHT_PACKETS];
 #if LANES == 1
     HITS_ONLY(i0, n_items, status, terms[i0] = (float4)(1, 1, 0, 0));
     hit[0] = L_TRUE;
@@ -389,12 +390,12 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
     light_gather(lane_index, n_items, point, normal, status, bracket, eye, right, up, forward,
                  (real4)((real)4 * (bailout + radius + ao_distance), 0, 0, 0), p, nw, pin, hit);
 #endif
-    lreal vis[PACKETS], amb[PACKETS], val[PACKETS];
+    lreal vis[LIGHT_PACKETS], amb[LIGHT_PACKETS], val[LIGHT_PACKETS];
 #ifdef EXTRA_SHADOWS
-    lreal ve[3][PACKETS];
+    lreal ve[3][LIGHT_PACKETS];
 #endif
     lmask any_hit = 0;
-    for (int b = 0; b < PACKETS; ++b) {
+    for (int b = 0; b < LIGHT_PACKETS; ++b) {
         vis[b] = amb[b] = (lreal)1;
         val[b] = (lreal)0;
 #ifdef EXTRA_SHADOWS
@@ -403,8 +404,8 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
         any_hit |= hit[b];
     }
     if (L_ANY(any_hit)) {   /* a block of misses (the background) has nothing to light */
-        quat o[PACKETS];     /* off the surface, outside: where shadow rays and occlusion start */
-        for (int b = 0; b < PACKETS; ++b)
+        quat o[LIGHT_PACKETS];     /* off the surface, outside: where shadow rays and occlusion start */
+        for (int b = 0; b < LIGHT_PACKETS; ++b)
             o[b] = QRAY(p[b], nw[b], (lreal)bias);
 #if (defined(SHADOW_HARD) || defined(SHADOW_SOFT)) && defined(LIGHT_POINT)
         key_light_shadows(o, p, nw, hit, light_pos, jp, radius, step, softness, max_steps, vis);
@@ -417,7 +418,7 @@ PACKET_KERNEL void light_terms(const int n_items, const int tile_w, __global con
 #ifdef LIGHT_PAIRS
         ambient_occlusion_pair(o, nw, jp, ao_distance, ao_strength, amb);
 #else
-        for (int b = 0; b < PACKETS; ++b)
+        for (int b = 0; b < LIGHT_PACKETS; ++b)
             amb[b] = ambient_occlusion(o[b], nw[b], jp, ao_distance, ao_strength);
 #endif
 #endif

@@ -64,7 +64,7 @@ def local_size(kernel: cl.Kernel, device: cl.Device) -> int:
 def march_items(n: int, tile_w: int, lanes: int, packets: int = 1) -> int:
     """Work-items of the march over a tile of n pixels, tile_w wide: one per ray, or one
     per ``packets`` neighbouring blocks of pixels in a row (kernels/march/march.cl,
-    kernel_config.march_packets; the light terms take the march's, the Jacobian normals one
+    kernel_config.march_packets; the light terms their own, light_packets, the Jacobian normals one
     block each)."""
     if lanes == 1:
         return n
@@ -283,7 +283,8 @@ class TileRunner:
         if plan.light_terms:
             kernels.append(launch(q, self.light_k, n, *self.light_args(
                 tile_w=tile.aw, point=bufs["point"], normal=bufs["normal"], status=bufs["status"],
-                bracket=bufs["bracket"], terms=bufs["terms"], vis_extra=bufs["vis_extra"]), items=items))
+                bracket=bufs["bracket"], terms=bufs["terms"], vis_extra=bufs["vis_extra"]),
+                items=march_items(n, tile.aw, plan.lanes, plan.light_packets)))
         if plan.shades:
             terms = bufs["terms"] if plan.light_terms else self.no_terms
             vis_extra = bufs["vis_extra"] if plan.light_terms else self.no_terms

@@ -201,6 +201,11 @@ class Plan:
         return kernel_config.config_packets(self.march_config)
 
     @property
+    def light_packets(self) -> int:
+        """Packets of rays a work-item of the light terms takes (kernel_config.light_packets)."""
+        return kernel_config.config_light_packets(self.march_config)
+
+    @property
     def normals_in_march_config(self) -> bool:
         """The Jacobian normals are built with the march, in its packets (kernel_config.march_config)."""
         return self.normals_args.method == "jacobian"

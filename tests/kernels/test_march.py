@@ -215,6 +215,13 @@ def test_packet_pairs_only_where_the_estimate_is_the_iterations():
                  ["fractal.algebra=hypercomplex", "fractal.function=sin"]):
         assert kernel_config.march_packets(d.with_overrides(over), 16) == 1, over
     assert march_items(48 * 36, 48, 16, 2) == 6 * 9 and march_items(146 * 9, 146, 16, 2) == 19 * 3
+    # the proven march takes one packet; its light terms, stepping by the estimate, take two
+    proven = d.with_overrides(["march.quality=normal"])
+    assert kernel_config.light_packets(proven, 16) == 2 and kernel_config.light_packets(proven, 16, pairs=False) == 1
+    cfg = kernel_config.march_config(proven, 16, pairs=True)
+    assert kernel_config.config_packets(cfg) == 1 and kernel_config.config_light_packets(cfg) == 2
+    sin = proven.with_overrides(["fractal.algebra=hypercomplex", "fractal.function=sin"])
+    assert kernel_config.light_packets(sin, 16) == 1   # no estimate: its shadows scan
 
 
 def test_pairs_where_a_packet_fills_one_vector_register():

@@ -293,11 +293,13 @@ def test_lights_and_reflection_compile_only_where_used():
     assert "EXTRA_SHADOWS" not in kernel_config.scene_config(lit.with_overrides(["shading.shadow=none"])).defines
 
 
-@pytest.mark.parametrize("name", ["soft+ao", "hard+trap", "three-lights-soft", "w", "mandelbrot-trap"])
+@pytest.mark.parametrize("name", ["soft+ao", "hard+trap", "three-lights-soft", "w", "mandelbrot-trap",
+                                  "proven-soft+ao"])
 def test_packet_pairs_light_the_same_pixels(name):
     """Two packets per work-item (-D PACKET_PAIRS: the march's and the light terms' shadow rays
-    and occlusion, their estimates side by side) give every output of one packet per work-item,
-    bit for bit, on a tile whose last pair of blocks is cut by the edge."""
+    and occlusion, their estimates side by side; for the proven march, the light terms' alone,
+    -D MARCH_UNPAIRED) give every output of one packet per work-item, bit for bit, on a tile
+    whose last pair of blocks is cut by the edge."""
     import dataclasses
 
     from harness import device, packet_widths
@@ -307,10 +309,13 @@ def test_packet_pairs_light_the_same_pixels(name):
     lanes = max(packet_widths((8, 16)), default=None)
     if lanes is None:
         pytest.skip("no packet width on this device")
-    s = Scene.default().with_overrides(LIGHT_SCENES[name] + ["image.width=44", "image.height=30"])
+    proven = name.startswith("proven-")
+    over = LIGHT_SCENES[name.removeprefix("proven-")] + (["march.quality=normal"] if proven else [])
+    s = Scene.default().with_overrides(over + ["image.width=44", "image.height=30"])
     dev = device()
     pair, one = make_plan(s, dev, lanes, pairs=True), make_plan(s, dev, lanes, pairs=False)
-    assert pair.march_packets == 2 and one.march_packets == 1 and pair.light_terms
+    assert pair.march_packets == (1 if proven else 2) and one.march_packets == 1 and pair.light_terms
+    assert pair.light_packets == 2 and one.light_packets == 1
     a, b = run_plan(pair, dev), run_plan(one, dev)
     for f in dataclasses.fields(a):
         x, y = getattr(a, f.name), getattr(b, f.name)
