@@ -51,30 +51,74 @@
 #else
 #define ENC_GATE(e, bailout) ((lmask)L_TRUE)
 #endif
-inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, lreal *margin,
-                       lreal *prefix)
+/* The radius a form must clear with j iterations left, t[min(j, LADDER_N - 1)] (t2: its
+ * square, bailout2 itself at j = 0): the bailout, or where the kind's piece says its map keeps
+ * norms to a power D (enclose/julia.cl ENC_LADDER_POWER) the least of it and rho_j, rho_0 =
+ * bailout, rho_j = (rho_(j-1) + |c|)^(1/D) raised by LADDER_UP for the rounding of |c|, the sum
+ * and the root (OpenCL's sqrt and cbrt: 3 and 2 ulps).  rho_j falls to the fixed point of x^D -
+ * |c| = x (rho_7 is within 1e-5 of it on the default scene) or rises to it from a smaller
+ * bailout, where the bailout itself is the least; either way t[LADDER_N - 1] holds for more
+ * iterations left.  On the default scene (float64 twin, 80x60) a proof then took 85 iterations
+ * of its form a ray instead of 133, and 12.7 enclosures instead of 18.0, for the same pixels. */
+#define LADDER_N 8
+#define LADDER_UP ((real)1.0000152587890625)   /* 1 + 2^-16 */
+typedef struct { real t[LADDER_N], t2[LADDER_N]; } enc_ladder;
+
+inline enc_ladder enc_ladder_of(julia_params jp)
+{
+    enc_ladder l;
+    real b = sqrt(jp.bailout2);
+#ifdef ENC_LADDER_POWER
+    real cl = sqrt(DOT4(jp.c, jp.c)), rho = b;
+#endif
+    l.t[0] = b;
+    l.t2[0] = jp.bailout2;
+    for (int j = 1; j < LADDER_N; ++j) {
+#ifdef ENC_LADDER_POWER
+#if ENC_LADDER_POWER == 2
+        rho = sqrt(rho + cl) * LADDER_UP;
+#else
+        rho = cbrt(rho + cl) * LADDER_UP;
+#endif
+        l.t[j] = fmin(b, rho);
+        l.t2[j] = rho < b ? rho * rho : jp.bailout2;
+#else
+        l.t[j] = b;
+        l.t2[j] = jp.bailout2;
+#endif
+    }
+    return l;
+}
+
+inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_params jp, const enc_ladder *lad,
+                       lreal *margin, lreal *prefix)
 {
     enc_param p;
     enclosure e = enc_start(o, d, t0, t1, jp, &p);
-    real bailout = sqrt(jp.bailout2);
-    lmask proven = todo & enc_outside(e, jp.bailout2);
+    int steps = ENC_STEPS(jp);
+    int j = min(steps, LADDER_N - 1);
+    real thr = lad->t[j];
+    lmask proven = todo & enc_outside(e, lad->t2[j]);
     lmask live = todo & !proven;
-    lreal best = fmax(enc_margin(e, bailout), (lreal)0);
+    lreal best = fmax(enc_margin(e, thr), (lreal)0);
 #ifdef ENC_HAS_PREFIX
-    lreal pre = enc_prefix(e, bailout, live);
+    lreal pre = enc_prefix(e, thr, live);
 #else
     lreal pre = (lreal)-1;
 #endif
+    real bailout = lad->t[0];
     int n = 0;
-    for (; n < ENC_STEPS(jp) && L_ANY(live); ++n) {
+    for (; n < steps && L_ANY(live); ++n) {
         e = enc_next(e, p, live);
-        lmask near = live & ENC_GATE(e, bailout);
+        j = min(steps - n - 1, LADDER_N - 1);
+        thr = lad->t[j];
+        lmask near = live & ENC_GATE(e, thr);
         lmask out = 0;
         if (L_ANY(near)) {   /* the tests below, only where a form may pass one */
-            out = near & enc_outside(e, jp.bailout2);
-            best = L_SEL(best, fmax(best, enc_margin(e, bailout)), near);
+            out = near & enc_outside(e, lad->t2[j]);
+            best = L_SEL(best, fmax(best, enc_margin(e, thr)), near);
 #ifdef ENC_HAS_PREFIX
-            pre = L_SEL(pre, fmax(pre, enc_prefix(e, bailout, near)), near);
+            pre = L_SEL(pre, fmax(pre, enc_prefix(e, thr, near)), near);
 #endif
         }
         proven |= out;
@@ -149,6 +193,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
                        int z_resolution, int post_steps, int max_steps, lmask *status,
                        lmask *samples, lmask *flags, lreal *width, lreal *unresolved)
 {
+    enc_ladder lad = enc_ladder_of(jp);
     lreal span = far - near;
     lreal floor_w = span / (real)z_resolution;
     lreal h = fmax(span * PROVEN_FIRST, floor_w);
@@ -163,7 +208,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     for (int i = 0; i < max_steps && L_ANY(active); ++i) {
         lreal t1 = fmin(t + h, far);
         lreal margin, pre;
-        lmask empty = enc_prove(o, d, t, t1, active, jp, &margin, &pre);
+        lmask empty = enc_prove(o, d, t, t1, active, jp, &lad, &margin, &pre);
         n = L_SEL(n, n + 1, active);
         lmask fine = fine_end > t;
         lmask at_floor = active & !empty & (h <= floor_here);
@@ -232,7 +277,7 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
      * front of the refined bracket, [t, a], is unproven unless a proof says otherwise */
     lreal tail_margin, tail_pre = (lreal)-1;
     lmask tail = bracketed & (a > t);
-    lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &tail_margin, &tail_pre) : (lmask)0;
+    lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &lad, &tail_margin, &tail_pre) : (lmask)0;
     /* its part a partial proof keeps is proven too */
     lreal t_from = clamp(prefix_end(t, a, tail_pre), t, fmax(a, t));
     open_w = L_SEL(open_w, open_w + (a - t_from), tail & !tail_empty);
@@ -259,7 +304,8 @@ __kernel void prove_segments(const int n_items, __global const real4 *origins, _
         return;
     julia_params jp = { c, bailout * bailout, (real)0, max_iter COUNTER_NONE };
     lreal m, pre;
-    proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &m, &pre) ? 1 : 0;
+    enc_ladder lad = enc_ladder_of(jp);
+    proven[i] = enc_prove(origins[i], dirs[i], t0s[i], t1s[i], 1, jp, &lad, &m, &pre) ? 1 : 0;
     margins[i] = m;
     prefixes[i] = pre;
 #endif

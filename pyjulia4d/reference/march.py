@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from pyjulia4d.pipeline.codes import FLAG_CUT_FACE, GUARD_SHELL_MISS, GUARD_ULP_STEP, STATUS_CAPPED, STATUS_HIT, STATUS_MISS
+from pyjulia4d.reference.enclose.julia import LADDER_N
 from pyjulia4d.reference.formula import QUATERNION_SQR, Formula
 from pyjulia4d.reference.iterate import REAL_MIN, dot4, julia_distance_formula, julia_inside, julia_level
 
@@ -179,33 +180,39 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
 
 def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
-    (reference/enclose/) outside the bailout ball at some n <= max_iter -, the largest
-    enc_margin over the iterations (0 where none is positive), and the largest s in [-1, 1] whose part [-1, s] of the
-    segment some iteration's enclosure keeps outside (1 where proven, -1 where none, or where
-    the enclosure piece has no enc_prefix) (march/proven.cl)."""
+    (reference/enclose/) outside the bailout ball at some n <= max_iter, or outside the
+    radius that passes it within the max_iter - n iterations left (the kind's ladder) -, the
+    largest enc_margin over the iterations (0 where none is positive), and the largest s in
+    [-1, 1] whose part [-1, s] of the segment some iteration's enclosure keeps outside (1 where
+    proven, -1 where none, or where the enclosure piece has no enc_prefix) (march/proven.cl)."""
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
     enc_prefix = getattr(E, "enc_prefix", None)
     enc_gate = getattr(E, "enc_gate", None)
-    b2 = bailout * bailout
+    steps = K.enc_steps(max_iter)
+    # the radius to clear with j iterations left (march/proven.cl enc_ladder_of)
+    lad = K.ladder(c, max_iter, bailout, formula) if hasattr(K, "ladder") else None
+    thr, thr2 = lad if lad else ([bailout] * LADDER_N, [bailout * bailout] * LADDER_N)
+    j = min(steps, LADDER_N - 1)
     # every ray's form is stepped, the decided ones too: their growth past the float64 range
     # is an infinite radius, no proof (as in the kernel), not a warning
     with np.errstate(all="ignore"):
         e, p = K.enc_start(o, d, t0, t1, c, formula)
-        proven = E.enc_outside(e, b2)
+        proven = E.enc_outside(e, thr2[j])
         live = ~proven
-        best = np.fmax(E.enc_margin(e, bailout), 0.0)
-        pre = enc_prefix(e, bailout) if enc_prefix else np.full(len(o), -1.0)
-        for _ in range(K.enc_steps(max_iter)):
+        best = np.fmax(E.enc_margin(e, thr[j]), 0.0)
+        pre = enc_prefix(e, thr[j]) if enc_prefix else np.full(len(o), -1.0)
+        for n in range(steps):
             if not live.any():
                 break
             e = K.enc_next(e, p, formula)
+            j = min(steps - n - 1, LADDER_N - 1)
             # only where the form may pass a test (march/proven.cl ENC_GATE)
-            near = live & enc_gate(e, bailout) if enc_gate else live
-            out = near & E.enc_outside(e, b2)
-            best = np.where(near, np.fmax(best, E.enc_margin(e, bailout)), best)
+            near = live & enc_gate(e, thr[j]) if enc_gate else live
+            out = near & E.enc_outside(e, thr2[j])
+            best = np.where(near, np.fmax(best, E.enc_margin(e, thr[j])), best)
             if enc_prefix:
-                pre = np.where(near, np.fmax(pre, enc_prefix(e, bailout)), pre)
+                pre = np.where(near, np.fmax(pre, enc_prefix(e, thr[j])), pre)
             proven |= out
             live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best, np.where(proven, 1.0, pre)

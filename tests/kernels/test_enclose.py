@@ -447,3 +447,33 @@ def test_a_lone_near_miss_is_looked_at_again(monkeypatch):
     monkeypatch.setattr(M, "FINE_LEAST", 1.0)   # no floor is that coarse: no look
     _, _, wide = twin()
     assert np.median(wide / np.maximum(ru, 1e-6)) >= 10
+
+
+@pytest.mark.parametrize("function,c,bailout", [("sqr", (-0.2, 0.8, 0.0, 0.0), 4.0), ("cube", (0.3, -0.5, 0.4, 0.1), 4.0),
+                                                ("sqr", (-1.1, 0.1, 0.2, -0.3), 16.0), ("sqr", (0.0, 1.9, 0.0, 0.0), 1.5)])
+def test_the_ladder_passes_the_bailout_in_time(function, c, bailout):
+    """The escape ladder (kernels/march/proven.cl enc_ladder_of, twin reference/enclose/julia.py
+    ladder): a point beyond t_j is beyond the bailout within j iterations.  Checked on the worst
+    first step, q^D opposite c (|q^D + c| = |q|^D - |c|, which makes the bound tight there:
+    a point 0.1 % inside t_1 need not pass), and on random directions, in float64; t_j never
+    exceeds the bailout, and with a bailout under the fixed point it is the bailout itself."""
+    F = Formula(algebra="quaternion", function=function)
+    D, c = F.fn.FUNC_POWER, np.asarray(c, float)
+    t, t2 = importlib.import_module("pyjulia4d.reference.enclose.julia").ladder(c, 30, bailout, F)
+    assert t[0] == bailout and all(x <= bailout for x in t) and np.allclose(np.square(t), t2, rtol=1e-12)
+    u = -c / np.linalg.norm(c)   # q^D = -|q|^D c / |c|: the principal D-th root of that quaternion
+    root = lambda s: (lambda a, v: np.concatenate([[s ** (1 / D) * np.cos(a)], s ** (1 / D) * np.sin(a) * v]))(
+        np.arccos(np.clip(u[0], -1, 1)) / D, u[1:] / max(np.linalg.norm(u[1:]), 1e-300))
+    rng = np.random.default_rng(7)
+    for j in range(1, len(t)):
+        q = np.vstack([root(t[j] ** D * (1 + 1e-9)), rng.normal(size=(500, 4))])
+        q[1:] *= t[j] * (1 + 1e-9) / np.linalg.norm(q[1:], axis=1, keepdims=True)
+        assert np.allclose(F.julia_f(q[:1], c * 0)[0], t[j] ** D * (1 + 1e-9) * u, rtol=1e-9)
+        passed = np.linalg.norm(q, axis=1) > bailout   # some |q_i| > bailout, i = 0 .. j: outside
+        for _ in range(j):
+            q = np.where(passed[:, None], 0.0, F.julia_f(q, c))   # the passed stop (no overflow)
+            passed |= np.linalg.norm(q, axis=1) > bailout
+        assert passed.all(), j
+    if t[1] < bailout:   # tight on the first step: just inside t_1 the worst point stays in
+        q = root(t[1] ** D * (1 - 1e-3))[None]
+        assert np.linalg.norm(F.julia_f(q, c)) <= bailout
