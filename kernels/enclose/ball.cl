@@ -74,19 +74,24 @@ inline enclosure enc_step(enclosure e, real4 c, lmask live)   /* ``live``: unuse
     /* the terms' sizes: of the centre's products (with v v's) and of the tangent's (J's bound
      * times |v|: the tangent may cancel to far less than its terms) */
 #if FUNC_POWER == 2
-    quat vv = julia_f(e.v, (real4)(0));   /* v v, the rotated map's too (kind/rotate.cl) */
+    /* v v, the rotated map's too (kind/rotate.cl); + (-0), which the compiler drops (+ 0 it may not) */
+    quat vv = julia_f(e.v, (real4)(-0.0));
 #ifdef ALG_LBOUND_IS_LEN
     lreal vvl = sv * sv, lv = sv;         /* |v v| = |v|^2 */
 #else
     lreal vvl = QLEN(vv), lv = ALG_LBOUND(e.v);
 #endif
     lreal r = (real)2 * lm * e.r + (real)0.5 * vvl + ((real)2 * lv + K * e.r) * e.r;
+#ifdef ALG_LBOUND_IS_LEN
+    lreal size = (s + sv) * (s + sv);     /* K = 1, L(m) = |m| */
+#else
     lreal size = K * s * s + (real)2 * lm * sv + K * sv * sv;
+#endif
     quat m = QADD(julia_f(e.m, c), QSCALE((lreal)0.5, vv));
     quat v = julia_f_jvp(e.m, e.v);
 #else
     quat qv = julia_f_jvp(e.v, e.m);      /* Q(v), the second-order term at m along v */
-    quat cv = julia_f(e.v, (real4)(0));   /* v^3 */
+    quat cv = julia_f(e.v, (real4)(-0.0));   /* v^3 */
 #ifdef ALG_LBOUND_IS_LEN
     /* |v^3| = |v|^3, and |Q(v)| by its bound 3 |m| |v|^2: its own length, a square root an
      * iteration, cost the quaternion cube 10 % of its march's time for 2 % fewer enclosures */
