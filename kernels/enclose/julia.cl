@@ -15,6 +15,12 @@
 #if defined(ALG_LBOUND_IS_LEN) && defined(FUNC_POWER)
 #define ENC_LADDER_POWER FUNC_POWER
 #endif
+/* A split algebra's components are complex orbits of their own, |a^D + c_a| >= |a|^D - |c_a|,
+ * and |h| >= |a| / sqrt(2): a ladder per component from sqrt(2) bailout (enclose/split.cl
+ * enc_outside_parts) */
+#if defined(ALG_SPLIT) && defined(FUNC_POWER)
+#define ENC_PART_LADDER_POWER FUNC_POWER
+#endif
 
 typedef real4 enc_param;
 

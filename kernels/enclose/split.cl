@@ -148,6 +148,32 @@ inline lmask enc_gate(enclosure e, real bailout)
     return (hm > bailout) | ((real)1.4142135623730951 * (hm - bailout) + vl > lane_hypot(e.a.r, e.b.r));
 }
 
+/* Each component on its own (march/proven.cl's part ladder, enclose/julia.cl
+ * ENC_PART_LADDER_POWER): |h| >= |a| / sqrt(2), so every point whose a lies beyond ta there
+ * is outside (ta: the ladder's radius for the iterations left), and likewise for b.  The
+ * gate, the test, the margin and the partial proof of those two forms. */
+inline lmask enc_gate_parts(enclosure e, real ta, real tb)
+{
+    return (c_abs(e.a.m) > ta) | (c_abs(e.b.m) > tb);
+}
+
+inline lmask enc_outside_parts(enclosure e, real ta2, real tb2)
+{
+    return caff_outside(e.a, ta2) | caff_outside(e.b, tb2);
+}
+
+inline lreal enc_margin_parts(enclosure e, real ta, real tb)
+{
+    return fmax(caff_margin(e.a, ta), caff_margin(e.b, tb));
+}
+
+inline lreal enc_prefix_parts(enclosure e, real ta, real tb, lmask live)
+{
+    quat ma = QUAT(e.a.m.re, e.a.m.im, (lreal)0, (lreal)0), va = QUAT(e.a.v.re, e.a.v.im, (lreal)0, (lreal)0);
+    quat mb = QUAT(e.b.m.re, e.b.m.im, (lreal)0, (lreal)0), vb = QUAT(e.b.v.re, e.b.v.im, (lreal)0, (lreal)0);
+    return fmax(enc_prefix_of(ma, va, QNORM2(ma), ta + e.a.r, live), enc_prefix_of(mb, vb, QNORM2(mb), tb + e.b.r, live));
+}
+
 /* whether the forms may still prove the segment (enclose/ball.cl enc_hopeful; NaN: no) */
 inline lmask enc_hopeful(enclosure e, real bailout)
 {

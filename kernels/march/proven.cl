@@ -62,12 +62,38 @@
  * of its form a ray instead of 133, and 12.7 enclosures instead of 18.0, for the same pixels. */
 #define LADDER_N 8
 #define LADDER_UP ((real)1.0000152587890625)   /* 1 + 2^-16 */
-typedef struct { real t[LADDER_N], t2[LADDER_N]; } enc_ladder;
+/* the power's root, raised for its rounding */
+#if defined(ENC_LADDER_POWER) || defined(ENC_PART_LADDER_POWER)
+inline real ladder_root(real x, int power) { return (power == 2 ? sqrt(x) : cbrt(x)) * LADDER_UP; }
+#endif
+/* pa, pb: a split algebra's per component (ENC_PART_LADDER_POWER: the least of sqrt(2)
+ * bailout, which holds at once, and a_j = (a_(j-1) + |c_a|)^(1/D)) */
+typedef struct {
+    real t[LADDER_N], t2[LADDER_N];
+#ifdef ENC_PART_LADDER_POWER
+    real pa[LADDER_N], pa2[LADDER_N], pb[LADDER_N], pb2[LADDER_N];
+#endif
+} enc_ladder;
 
 inline enc_ladder enc_ladder_of(julia_params jp)
 {
     enc_ladder l;
     real b = sqrt(jp.bailout2);
+#ifdef ENC_PART_LADDER_POWER
+    real4 cp = ALG_C(jp.c);
+    real ca = hypot(cp.x, cp.y), cb = hypot(cp.z, cp.w);
+    real a0 = (real)1.4142135623730951 * b * LADDER_UP, ra = a0, rb = a0;
+    for (int j = 0; j < LADDER_N; ++j) {
+        if (j > 0) {
+            ra = ladder_root(ra + ca, ENC_PART_LADDER_POWER);
+            rb = ladder_root(rb + cb, ENC_PART_LADDER_POWER);
+        }
+        l.pa[j] = fmin(a0, ra);
+        l.pb[j] = fmin(a0, rb);
+        l.pa2[j] = l.pa[j] * l.pa[j];
+        l.pb2[j] = l.pb[j] * l.pb[j];
+    }
+#endif
 #ifdef ENC_LADDER_POWER
     real cl = sqrt(DOT4(jp.c, jp.c)), rho = b;
 #endif
@@ -75,11 +101,7 @@ inline enc_ladder enc_ladder_of(julia_params jp)
     l.t2[0] = jp.bailout2;
     for (int j = 1; j < LADDER_N; ++j) {
 #ifdef ENC_LADDER_POWER
-#if ENC_LADDER_POWER == 2
-        rho = sqrt(rho + cl) * LADDER_UP;
-#else
-        rho = cbrt(rho + cl) * LADDER_UP;
-#endif
+        rho = ladder_root(rho + cl, ENC_LADDER_POWER);
         l.t[j] = fmin(b, rho);
         l.t2[j] = rho < b ? rho * rho : jp.bailout2;
 #else
@@ -121,6 +143,14 @@ inline lmask enc_prove(quat o, quat d, lreal t0, lreal t1, lmask todo, julia_par
             pre = L_SEL(pre, fmax(pre, enc_prefix(e, thr, near)), near);
 #endif
         }
+#ifdef ENC_PART_LADDER_POWER
+        lmask part_near = live & enc_gate_parts(e, lad->pa[j], lad->pb[j]);
+        if (L_ANY(part_near)) {   /* each component past its own ladder */
+            out |= part_near & enc_outside_parts(e, lad->pa2[j], lad->pb2[j]);
+            best = L_SEL(best, fmax(best, enc_margin_parts(e, lad->pa[j], lad->pb[j])), part_near);
+            pre = L_SEL(pre, fmax(pre, enc_prefix_parts(e, lad->pa[j], lad->pb[j], part_near)), part_near);
+        }
+#endif
         proven |= out;
         live &= (!out) & enc_hopeful(e, bailout);
     }

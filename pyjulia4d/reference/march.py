@@ -192,7 +192,7 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
     steps = K.enc_steps(max_iter)
     # the radius to clear with j iterations left (march/proven.cl enc_ladder_of)
     lad = K.ladder(c, max_iter, bailout, formula) if hasattr(K, "ladder") else None
-    thr, thr2 = lad if lad else ([bailout] * LADDER_N, [bailout * bailout] * LADDER_N)
+    thr, thr2, parts = lad if lad else ([bailout] * LADDER_N, [bailout * bailout] * LADDER_N, None)
     j = min(steps, LADDER_N - 1)
     # every ray's form is stepped, the decided ones too: their growth past the float64 range
     # is an infinite radius, no proof (as in the kernel), not a warning
@@ -213,6 +213,12 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
             best = np.where(near, np.fmax(best, E.enc_margin(e, thr[j])), best)
             if enc_prefix:
                 pre = np.where(near, np.fmax(pre, enc_prefix(e, thr[j])), pre)
+            if parts:   # each component past its own ladder (kernels/enclose/split.cl)
+                pa, pa2, pb, pb2 = parts
+                pn = live & E.enc_gate_parts(e, pa[j], pb[j])
+                out |= pn & E.enc_outside_parts(e, pa2[j], pb2[j])
+                best = np.where(pn, np.fmax(best, E.enc_margin_parts(e, pa[j], pb[j])), best)
+                pre = np.where(pn, np.fmax(pre, E.enc_prefix_parts(e, pa[j], pb[j])), pre)
             proven |= out
             live &= ~out & E.enc_hopeful(e, bailout)
     return proven, best, np.where(proven, 1.0, pre)

@@ -459,7 +459,8 @@ def test_the_ladder_passes_the_bailout_in_time(function, c, bailout):
     exceeds the bailout, and with a bailout under the fixed point it is the bailout itself."""
     F = Formula(algebra="quaternion", function=function)
     D, c = F.fn.FUNC_POWER, np.asarray(c, float)
-    t, t2 = importlib.import_module("pyjulia4d.reference.enclose.julia").ladder(c, 30, bailout, F)
+    t, t2, parts = importlib.import_module("pyjulia4d.reference.enclose.julia").ladder(c, 30, bailout, F)
+    assert parts is None
     assert t[0] == bailout and all(x <= bailout for x in t) and np.allclose(np.square(t), t2, rtol=1e-12)
     u = -c / np.linalg.norm(c)   # q^D = -|q|^D c / |c|: the principal D-th root of that quaternion
     root = lambda s: (lambda a, v: np.concatenate([[s ** (1 / D) * np.cos(a)], s ** (1 / D) * np.sin(a) * v]))(

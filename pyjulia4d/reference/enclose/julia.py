@@ -10,21 +10,42 @@ LADDER_N = 8
 LADDER_UP = 1.0 + 2.0 ** -16
 
 
+def _root(x, D):
+    return x ** (1.0 / D) * LADDER_UP
+
+
 def ladder(c, max_iter, bailout, F):
-    """(t, t2) per iterations left j = 0 .. LADDER_N - 1: the radius a form must clear and its
-    square (kernels/march/proven.cl enc_ladder_of).  Where the map keeps norms to a power D
-    (quaternions: ALG_LBOUND_IS_LEN, a polynomial function), |f(q) + c| >= |q|^D - |c|, so a point
-    beyond rho_j, rho_0 = bailout and rho_j = (rho_(j-1) + |c|)^(1/D), passes the bailout within
-    j iterations (kernels/enclose/julia.cl); t_j is the least of it and the bailout."""
+    """(t, t2, parts) per iterations left j = 0 .. LADDER_N - 1: the radius a form must clear
+    and its square (kernels/march/proven.cl enc_ladder_of).  Where the map keeps norms to a
+    power D (quaternions: ALG_LBOUND_IS_LEN, a polynomial function), |f(q) + c| >= |q|^D - |c|,
+    so a point beyond rho_j, rho_0 = bailout and rho_j = (rho_(j-1) + |c|)^(1/D), passes the
+    bailout within j iterations (kernels/enclose/julia.cl); t_j is the least of it and the
+    bailout.  ``parts``: for a split algebra's polynomials, (pa, pa2, pb, pb2), the same per
+    component from sqrt(2) bailout (|h| >= |a| / sqrt(2)), the least of that and the ladder's;
+    else None."""
+    b = float(bailout)
     D = F.fn.FUNC_POWER if getattr(F.alg, "ALG_LBOUND_IS_LEN", False) else None
-    t, t2 = [float(bailout)], [float(bailout) ** 2]
-    rho, cl = float(bailout), float(np.linalg.norm(np.asarray(c, np.float64)))
+    t, t2 = [b], [b * b]
+    rho, cl = b, float(np.linalg.norm(np.asarray(c, np.float64)))
     for _ in range(1, LADDER_N):
         if D:
-            rho = (rho + cl) ** (1.0 / D) * LADDER_UP
-        t.append(min(float(bailout), rho) if D else float(bailout))
-        t2.append(rho * rho if D and rho < bailout else float(bailout) ** 2)
-    return t, t2
+            rho = _root(rho + cl, D)
+        t.append(min(b, rho) if D else b)
+        t2.append(rho * rho if D and rho < b else b * b)
+    parts = None
+    if F.split and F.fn.FUNC_POWER:
+        Dp, cp = F.fn.FUNC_POWER, F.ALG_C(np.asarray(c, np.float64))
+        a0 = np.sqrt(2.0) * b * LADDER_UP
+        parts = []
+        for cn in (float(np.hypot(cp[0], cp[1])), float(np.hypot(cp[2], cp[3]))):
+            r, out = a0, []
+            for j in range(LADDER_N):
+                if j:
+                    r = _root(r + cn, Dp)
+                out.append(min(a0, r))
+            parts += [out, [x * x for x in out]]
+        parts = tuple(parts)
+    return t, t2, parts
 
 
 def enc_steps(max_iter: int) -> int:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.caff import caff_add, caff_mul
+from pyjulia4d.reference.enclose.caff import caff_add, caff_margin, caff_mul, caff_outside
 from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
@@ -118,6 +118,30 @@ def enc_gate(e, bailout):
     m, v, ar, br = _joined(e)
     with np.errstate(all="ignore"):
         return (hm > bailout) | (np.sqrt(2.0) * (hm - bailout) + np.sqrt(np.sum(v * v, axis=-1)) > np.hypot(ar, br))
+
+
+def enc_gate_parts(e, ta, tb):
+    """Each component on its own (kernels/enclose/split.cl): |h| >= |a| / sqrt(2), so a form
+    whose a-part clears ta (the ladder's radius for the iterations left) proves its points."""
+    (am, _, _), (bm, _, _) = e
+    return (np.abs(am) > ta) | (np.abs(bm) > tb)
+
+
+def enc_outside_parts(e, ta2, tb2):
+    return caff_outside(e[0], ta2) | caff_outside(e[1], tb2)
+
+
+def enc_margin_parts(e, ta, tb):
+    return np.fmax(caff_margin(e[0], ta), caff_margin(e[1], tb))
+
+
+def enc_prefix_parts(e, ta, tb):
+    out = []
+    for (m, v, r), t in zip(e, (ta, tb)):
+        z = np.zeros_like(m.real)
+        mq, vq = np.stack([m.real, m.imag, z, z], -1), np.stack([v.real, v.imag, z, z], -1)
+        out.append(prefix_of(mq, vq, np.sum(mq * mq, axis=-1), t + r))
+    return np.fmax(*out)
 
 
 def enc_hopeful(e, bailout):
