@@ -478,3 +478,27 @@ def test_the_ladder_passes_the_bailout_in_time(function, c, bailout):
     if t[1] < bailout:   # tight on the first step: just inside t_1 the worst point stays in
         q = root(t[1] ** D * (1 - 1e-3))[None]
         assert np.linalg.norm(F.julia_f(q, c)) <= bailout
+
+
+@pytest.mark.parametrize("function", ["sqr", "cube"])
+def test_the_part_ladder_passes_the_bailout_in_time(function):
+    """A split algebra's ladder per component (twin reference/enclose/julia.py ladder,
+    kernels/enclose/split.cl enc_outside_parts): a component a beyond pa_j has |a| > sqrt(2)
+    bailout within j iterations of a^D + c_a, so |h| >= |a| / sqrt(2) is past the bailout; on the
+    worst first step (a^D opposite c_a) and random ones, in float64."""
+    F = Formula(algebra="hypercomplex", function=function)
+    D, c, bailout = F.fn.FUNC_POWER, np.array([0.3, -0.5, 0.4, 0.1]), 4.0
+    _, _, parts = importlib.import_module("pyjulia4d.reference.enclose.julia").ladder(c, 30, bailout, F)
+    cp = F.ALG_C(c)
+    rng = np.random.default_rng(3)
+    for (pa, _), ck in zip((parts[0:2], parts[2:4]), (complex(cp[0], cp[1]), complex(cp[2], cp[3]))):
+        assert pa[0] >= np.sqrt(2) * bailout and max(pa) == pa[0]
+        for j in range(1, len(pa)):
+            r = pa[j] * (1 + 1e-9)
+            a = np.concatenate([[r * np.exp(1j * (np.angle(-ck) + 2 * np.pi * k) / D) for k in range(D)],
+                                r * np.exp(2j * np.pi * rng.random(200))])
+            passed = np.abs(a) > np.sqrt(2) * bailout
+            for _ in range(j):
+                a = np.where(passed, 0, a ** D + ck)
+                passed |= np.abs(a) > np.sqrt(2) * bailout
+            assert passed.all(), j
