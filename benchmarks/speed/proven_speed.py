@@ -7,7 +7,8 @@ The proven march runs in packets of 8 rays (opencl/lanes.py PROVEN_LANES) or of 
 widest, whichever its timed probe found faster; rows at 8 and at 16 lanes, where the device
 takes them, keep that choice measured.
 For each scene and march: the whole render's kernel seconds (median of --repeats after a
-warm-up), the march kernel alone (packets, rays from buffers), the tests per ray
+warm-up) and its CPU-seconds (the least of them; getrusage: the host's work and the kernels'
+threads), also as a multiple of the estimate's (custom's) CPU-seconds, the tests per ray
 (set tests for the scan, estimates for de, enclosures for proven), and what each render
 states: the p99 of its stated error (bracket plus unresolved, RenderResult.error_stats; the
 scan and the estimate state the whole ray in front of their hits) and its unresolved pixels.
@@ -21,6 +22,7 @@ Writes benchmarks/results/proven_speed.md (a section per run: commit, device, da
 from __future__ import annotations
 
 import importlib
+import resource
 import statistics
 import sys
 import warnings
@@ -50,6 +52,7 @@ MARCHES = {"proven, quality normal": ["march.quality=normal"],
            "proven, quality normal, 16 lanes": ["march.quality=normal"],
            "fixed, z_resolution 1000": ["march.method=fixed", "march.z_resolution=1000"],
            "custom (the estimate, else the scan at 250)": ["march.quality=custom"]}
+ESTIMATE = "custom (the estimate, else the scan at 250)"   # the CPU-seconds the others are set against
 
 
 def proof_share(scene: Scene) -> float:
@@ -75,19 +78,26 @@ def proof_share(scene: Scene) -> float:
     return counts[0] / max(counts[1], 1)
 
 
+def _cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
 def run(scene: Scene, dev, repeats: int, lanes: int | None = None) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         r = render(scene, device=dev, lanes=lanes)            # warm-up: builds, camera.fit
         fixed = r.scene
-        ts = []
+        ts, cpu = [], []
         for _ in range(repeats):
+            c0 = _cpu()
             r = render(fixed, device=dev, lanes=lanes)
+            cpu.append(_cpu() - c0)
             ts.append(r.kernel_seconds)
     hit = r.status == 1
     e = r.error_stats()
     un = r.unresolved_counts()
-    return {"kernel_s": statistics.median(ts), "tests": float(np.mean(r.samples[np.isfinite(r.depth) | ~hit])),
+    return {"kernel_s": statistics.median(ts), "cpu_s": min(cpu), "tests": float(np.mean(r.samples[np.isfinite(r.depth) | ~hit])),
             "p99": e["p99"], "unresolved": un["hit"] + un["miss"], "pixels": r.status.size,
             "proven": r.proven, "scene": fixed}
 
@@ -102,8 +112,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     w, h = size_of(a.size, "--size")
     dev = select_device(a.device)
-    head = ("| scene | march | kernel s | x the fixed scan | tests per ray | stated p99 error | unresolved pixels | "
-            "enclosures that proved |\n|---|---|---|---|---|---|---|---|\n")
+    head = ("| scene | march | kernel s | x the fixed scan | render CPU-s | x the estimate's | tests per ray | "
+            "stated p99 error | unresolved pixels | enclosures that proved |\n|---|---|---|---|---|---|---|---|---|---|\n")
     print(head, end="")
     rows = []
     for name, fractal in SCENES.items():
@@ -116,9 +126,11 @@ def main(argv=None) -> int:
             forced = next((k for k in (8, 16) if f", {k} lanes" in mname and width >= k), None)
             got[mname] = run(s, dev, a.repeats, forced)
         base = got["fixed, z_resolution 1000"]["kernel_s"]
+        est = got[ESTIMATE]["cpu_s"]
         for mname, g in got.items():
             share = f"{100 * proof_share(g['scene']):.0f} %" if g["proven"] else ""
-            row = (f"| {name} | {mname} | {g['kernel_s']:.3f} | {g['kernel_s'] / base:.2f} | {g['tests']:.1f} | "
+            row = (f"| {name} | {mname} | {g['kernel_s']:.3f} | {g['kernel_s'] / base:.2f} | {g['cpu_s']:.3f} | "
+                   f"{g['cpu_s'] / est:.2f} | {g['tests']:.1f} | "
                    f"{g['p99']:.2g} | {100 * g['unresolved'] / g['pixels']:.1f} % | {share} |")
             rows.append(row)
             print(row, flush=True)
