@@ -272,7 +272,7 @@ def test_pair_accuracy_benchmark_runs(tmp_path, capsys):
 
 def test_proven_speed_benchmark_runs(tmp_path, capsys):
     """benchmarks/speed/proven_speed.py on the quaternion default, tiny: a row per march, the fixed
-    scan its own unit, the proven march's share of proofs given."""
+    scan the kernels' unit, the estimate the CPU-seconds', the proven march's share of proofs given."""
     spec = importlib.util.spec_from_file_location("proven_speed", script("proven_speed"))
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
@@ -282,7 +282,9 @@ def test_proven_speed_benchmark_runs(tmp_path, capsys):
     assert len(rows) == 5   # the device's width, 8 and 16 lanes, the scan, the estimate
     cells = {r.split("|")[2].strip(): [c.strip() for c in r.strip("|").split("|")] for r in rows}
     assert cells["fixed, z_resolution 1000"][3] == "1.00"
-    assert cells["proven, quality normal"][7].endswith("%") and cells["fixed, z_resolution 1000"][7] == ""
+    assert cells["custom (the estimate, else the scan at 250)"][5] == "1.00"   # the CPU-seconds' unit
+    assert float(cells["proven, quality normal"][4]) > 0
+    assert cells["proven, quality normal"][9].endswith("%") and cells["fixed, z_resolution 1000"][9] == ""
     assert "commit" in (tmp_path / "proven_speed.md").read_text()
 
 
