@@ -304,9 +304,11 @@ inline lreal march_ray(quat o, quat d, lreal near, lreal far, lmask live, julia_
     *width = L_SEL(*width, L_SEL((lreal)0, w, bracketed), hit);
     lreal depth = L_SEL((lreal)INFINITY, L_SEL(t_in, a, bracketed), hit);
     /* refinement finds a crossing in [t, t_in], not the first: the floor segment's part in
-     * front of the refined bracket, [t, a], is unproven unless a proof says otherwise */
+     * front of the refined bracket, [t, a], is unproven unless a proof says otherwise.  Where
+     * a segment in front was left unproven already (t_open < t), the statement reaches back to
+     * it whatever this proof gives, so it is not tried. */
     lreal tail_margin, tail_pre = (lreal)-1;
-    lmask tail = bracketed & (a > t);
+    lmask tail = bracketed & (a > t) & !(t_open < t);
     lmask tail_empty = L_ANY(tail) ? enc_prove(o, d, t, a, tail, jp, &lad, &tail_margin, &tail_pre) : (lmask)0;
     /* its part a partial proof keeps is proven too */
     lreal t_from = clamp(prefix_end(t, a, tail_pre), t, fmax(a, t));

@@ -331,8 +331,9 @@ def march_proven(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, p
     if k.size:
         depth[k], width[k] = refine_bracket(o[k], d[k], t_out[k], t_in[k], post_steps, c, max_iter, bailout, itp,
                                             formula=formula)
-        # the hit segment's part in front of the refined bracket: proven, or unproven
-        j = k[depth[k] > t[k]]
+        # the hit segment's part in front of the refined bracket: proven, or unproven (not tried
+        # where a segment in front was left unproven: the statement reaches back to it anyway)
+        j = k[(depth[k] > t[k]) & ~(t_open[k] < t[k])]
         if j.size:
             tail_empty, _, tail_pre = enc_prove(o[j], d[j], t[j], depth[j], c, max_iter, bailout, formula)
             # its part a partial proof keeps is proven too
