@@ -145,12 +145,15 @@ def _encode(result: Any, suffix: str, header: dict) -> EncodedImage:
 
 
 def fit_unit(scene: Scene, device: str | None = None, force: bool = False) -> Scene:
-    """camera.fit resolved once (framing.fit_camera), so that every tile of one frame uses
-    the same fitted camera."""
+    """render.float "auto" and camera.fit resolved once (executor.resolve_float,
+    framing.fit_camera), so that every tile of one frame uses the same precision and camera."""
     from pyjulia4d.pipeline.framing import fit_camera
-    from pyjulia4d.opencl.executor import render
+    from pyjulia4d.opencl.executor import render, resolve_float
 
     dev = worker_device(device)
+    scene = resolve_float(scene, dev)
+    if not scene.camera.fit:
+        return scene
     fitted, _ = fit_camera(scene, lambda s, outs: render(s, device=dev, force=force, outputs=outs))
     return fitted
 
@@ -362,8 +365,9 @@ def render_many(client: Any, units: Sequence[tuple[Any, Scene, dict]],
 
 
 def fitted(client: Any, scene: Scene, device: str | None = None, force: bool = False) -> Scene:
-    """``scene`` with camera.fit resolved once (on the cluster when there is one)."""
-    if not scene.camera.fit:
+    """``scene`` with camera.fit and render.float "auto" resolved once (on the cluster when
+    there is one)."""
+    if not scene.camera.fit and scene.render.float != "auto":
         return scene
     if client is None:
         return fit_unit(scene, device, force)

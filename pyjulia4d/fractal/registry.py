@@ -43,12 +43,16 @@ class Function(_Entry):
     bounding_radius, iterate.cl); None for the others.  ``critical``: f's one critical (or
     asymptotic) value v, in the point's own coordinates, where the Mandelbrot set's orbit
     starts (q_1 = v + c, kernels/kind/mandelbrot.cl); None where f has several singular
-    values (tan, tanh) or none (ln, the inverse functions): no one Mandelbrot set."""
+    values (tan, tanh) or none (ln, the inverse functions): no one Mandelbrot set.
+    ``prefers_double``: its orbits stretch their points apart so fast that float32's rounding
+    bounds stop the proven march's proofs short of the surface (render.float "auto" takes
+    double for it: scene/quality.py auto_precision)."""
 
     folder = "function"
     name: str
     degree: int | None = None
     critical: Vec4 | None = None
+    prefers_double: bool = False
 
 
 @dataclass(frozen=True)
@@ -59,7 +63,8 @@ class Algebra(_Entry):
     components); CQuats and the commutative rules have zero divisors with |q^2| < |q|^2.
     ``estimate``: the polynomial maps have a distance estimate (Hart, Sandin & Kauffman 1989 §3.1 eq. 8 for
     quaternions; the product of two complex Julia sets for the hypercomplex numbers).
-    ``table``: a multiplication-table algebra whose powers come from algebra/power.cl."""
+    ``table``: a multiplication-table algebra whose powers come from algebra/power.cl.
+    ``prefers_double``: as Function's, for every function of the algebra."""
 
     folder = "algebra"
     name: str
@@ -68,6 +73,7 @@ class Algebra(_Entry):
     estimate: bool = False
     table: bool = False
     enclosure: str = "ball"
+    prefers_double: bool = False
 
     @property
     def enclosure_piece(self) -> str:
@@ -119,11 +125,11 @@ FUNCTIONS_TABLE: dict[str, Function] = {f.name: f for f in (
     Function("cube", degree=3, critical=_ZERO),
     Function("exp", critical=_ZERO),          # asymptotic value 0
     Function("reciprocal", critical=_ZERO),   # asymptotic value 0: the orbit of c
-    Function("sin", critical=(1.0, 0.0, 0.0, 0.0)),    # sin(pi/2)
+    Function("sin", critical=(1.0, 0.0, 0.0, 0.0), prefers_double=True),    # sin(pi/2)
     Function("asin"),
     Function("sinh", critical=(0.0, 1.0, 0.0, 0.0)),   # sinh(i pi/2) = i, per hypercomplex component
     Function("asinh"),
-    Function("cos", critical=(1.0, 0.0, 0.0, 0.0)),    # cos(0)
+    Function("cos", critical=(1.0, 0.0, 0.0, 0.0), prefers_double=True),    # cos(0)
     Function("acos"),
     Function("cosh", critical=(1.0, 0.0, 0.0, 0.0)),   # cosh(0)
     Function("acosh"),
@@ -140,8 +146,8 @@ FUNCTIONS = tuple(FUNCTIONS_TABLE)
 ALGEBRAS_TABLE: dict[str, Algebra] = {a.name: a for a in (
     Algebra("quaternion", ("sqr", "cube"), norm_bounded=True, estimate=True),
     Algebra("hypercomplex", FUNCTIONS, norm_bounded=True, estimate=True, enclosure="split"),
-    Algebra("cquat", ("sqr", "cube"), table=True),
-    Algebra("commutative", ("sqr", "cube"), table=True),
+    Algebra("cquat", ("sqr", "cube"), table=True, prefers_double=True),
+    Algebra("commutative", ("sqr", "cube"), table=True, prefers_double=True),
 )}
 
 ALGEBRAS = tuple(ALGEBRAS_TABLE)

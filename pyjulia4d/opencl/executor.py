@@ -16,7 +16,8 @@ from typing import Callable
 import pyopencl as cl
 
 from pyjulia4d.fractal.registry import march_method
-from pyjulia4d.opencl.devices import DeviceError, check_device, device_key, device_of, has_fp64, select_device
+from pyjulia4d.opencl.devices import (DeviceError, check_device, device_key, device_of, device_type, has_fp64,
+                                      select_device)
 from pyjulia4d.opencl.failures import DeviceFailure, on_device
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes, packet_pairs
 from pyjulia4d.opencl.passes import kernel_seconds, run_plan, run_tiles
@@ -101,6 +102,16 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     return result
 
 
+def resolve_float(scene: Scene, dev: cl.Device) -> Scene:
+    """``scene`` with render.float "auto" replaced by what runs on ``dev``: the set's choice
+    (Scene.precision, quality.auto_precision) on a CPU with fp64, else "single" (a GPU's double
+    rate is a fraction of its single; a device without fp64 has none)."""
+    if scene.render.float != "auto":
+        return scene
+    chosen = scene.precision if device_type(dev) == "CPU" and has_fp64(dev) else "single"
+    return scene.replace(**{"render.float": chosen})
+
+
 def plan_render(scene: Scene, dev: cl.Device, args: RenderArgs, lanes: int | None = None,
                 calibrate: bool = True) -> tuple[Plan, Prediction | None]:
     """Planning, the steps before the render's tiles, for arguments already checked
@@ -109,8 +120,10 @@ def plan_render(scene: Scene, dev: cl.Device, args: RenderArgs, lanes: int | Non
     camera from a first pass (framing.py: the plan of a small probe image, run by run_plan);
     the plan (pipeline/plan.py), made once; and, with ``calibrate``, the time predicted from a
     probe of the plan's own kernels (calibrate.py: refuse, warn, retile).  Returns the plan
-    and the prediction (None where none was made)."""
-    double = scene.render.float == "double"
+    and the prediction (None where none was made).  render.float "auto" is resolved for the
+    device first (resolve_float), so the plan and the result state the precision that ran."""
+    scene = resolve_float(scene, dev)
+    double = scene.precision == "double"
     if double and not has_fp64(dev):   # before any kernel is built, the framing pass's included
         raise SceneError("render.float", f"device '{dev.name.strip()}' has no cl_khr_fp64 (double precision); use \"single\"")
     if lanes is None:

@@ -59,7 +59,7 @@ def fractal_defines(scene: Scene) -> tuple[str, ...]:
 
 
 def precision_defines(scene: Scene) -> tuple[str, ...]:
-    return ("REAL_DOUBLE",) if scene.render.float == "double" else ()
+    return ("REAL_DOUBLE",) if scene.precision == "double" else ()
 
 
 def cone_start(scene: Scene) -> bool:

@@ -49,7 +49,7 @@ class MeshPlan:
 
     @property
     def double(self) -> bool:
-        return self.scene.render.float == "double"
+        return self.scene.precision == "double"
 
     # the kernels' names for what they take (pipeline/signatures.py MESH_SAMPLE, MESH_VERTICES)
     origin4 = property(lambda self: tuple(self.origin) + (0.0,))

@@ -315,7 +315,7 @@ def plan_from(scene: Scene, device, lanes: int, args: RenderArgs, pairs: bool = 
     return Plan(
         scene=scene, image=scene.image, fractal=scene.fractal, frame=frame, march=records["march"],
         clip=records["clip"], normals_args=records["normals"], light_args=records["light_args"],
-        shade=records["shade"], double=scene.render.float == "double", lanes=lanes, outputs=args.outputs,
+        shade=records["shade"], double=scene.precision == "double", lanes=lanes, outputs=args.outputs,
         config=kernel_config.shade_config(scene),
         march_config=kernel_config.march_config(scene, lanes, pairs=pairs),
         reflect_config=(kernel_config.march_config(scene, lanes, ray_buffers=True, pairs=pairs)
@@ -338,7 +338,7 @@ def gradient_step(scene: Scene) -> float:
     floored at GRADIENT_STEP_FLOOR[render.float]."""
     if scene.normals.step != "auto":
         return float(scene.normals.step)
-    return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.render.float])
+    return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.precision])
 
 
 def fog_start(eye, radius: float) -> float:

@@ -98,7 +98,7 @@ def estimate(scene: Scene, device=None, outputs=None) -> Estimate:
     its = float(pixels) * per_ray * f.max_iter
     its += float(pixels) * f.max_iter * NORMAL_COST.get(scene.normals.method, 6)
     kind = _kind(device)
-    ips = ITERATIONS_PER_SECOND[kind, scene.render.float]
+    ips = ITERATIONS_PER_SECOND[kind, scene.precision]
     factors = {"image": pixels, march_key: getattr(m, march_key.split(".")[1]),
                "march.post_steps": max(m.post_steps, 1), "fractal.max_iter": f.max_iter}
     dominant = max(factors, key=lambda k: factors[k] / _TYPICAL[k])
@@ -128,15 +128,15 @@ def check_numerics(scene: Scene) -> None:
     """Refuse settings the kernels' arithmetic cannot hold (always; not skipped by force)."""
     f, m = scene.fractal, scene.march
     cabs = math.sqrt(sum(x * x for x in f.c))
-    lim = max_bailout(scene.render.float, cabs)
+    lim = max_bailout(scene.precision, cabs)
     if f.bailout > lim:
-        alt = ' or render.float="double"' if scene.render.float == "single" else ""
+        alt = ' or render.float="double"' if scene.precision == "single" else ""
         raise WorkloadError("fractal.bailout",
-                            f"{f.bailout:g} overflows {scene.render.float} precision (|q|^2 "
+                            f"{f.bailout:g} overflows {scene.precision} precision (|q|^2 "
                             f"reaches ~1e{4 * math.log10(f.bailout):.0f} one squaring past the "
-                            f"bailout, above {REAL_MAX[scene.render.float]:.1e}); use at most "
+                            f"bailout, above {REAL_MAX[scene.precision]:.1e}); use at most "
                             f"{lim:.2g}{alt}")
-    if march_method(scene) == "de" and scene.render.float == "single":
+    if march_method(scene) == "de" and scene.precision == "single":
         t_far = float(sum(x * x for x in to_world(scene, scene.camera.position))) ** 0.5 + march_radius(scene)
         ulp = t_far * 2.0 ** -23
         if m.epsilon < ulp / 2:
@@ -272,7 +272,7 @@ def check(scene: Scene, device=None, force: bool = False, outputs=None) -> Estim
     if (est.iterations > REFUSE_ITERATIONS and probe_iterations(scene, est, outputs) > PROBE_LIMIT_ITERATIONS
             and not force):
         text = (f"~{est.iterations:.1e} set-test iterations (upper bound), "
-                f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.render.float]:.1e} it/s "
+                f"~{est.hours:.2g} h at {ITERATIONS_PER_SECOND[est.kind, scene.precision]:.1e} it/s "
                 f"on a {est.kind}")
         raise WorkloadError(est.dominant,
                             f"{est.value} could take {text}, over the limit of "

@@ -95,7 +95,7 @@ MEANINGS = {
     "image.tonemap": "linear light to the display: clamp, aces (ACES 1.0 SDR through OpenColorIO) or agx",
     "image.denoise": "path: Intel's Open Image Denoise over the whole picture (pip install 'pyjulia4d[denoise]')",
     "clip.planes": "cut-away half-spaces n . p <= offset that cut the set open",
-    "render.float": "single, or double (float64 kernels, devices with cl_khr_fp64: proofs reach closer, statements tighten)",
+    "render.float": "auto (double where float32 stops proofs short, on CPUs with fp64), single, or double (float64 kernels, devices with cl_khr_fp64: proofs reach closer, statements tighten)",
     "render.variant": "rays per work-item of the march: scalar (one), packet (16, 8 or 4; 8 or 4 in double) or auto",
 }
 

@@ -18,7 +18,7 @@ from typing import Any, Iterable, Literal, Mapping, Union
 
 from pyjulia4d.scene import rules
 from pyjulia4d.scene.checks import SceneError, show, show_key, unknown_key
-from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, auto_values, preset_values
+from pyjulia4d.scene.quality import CUSTOM, MARCH_KEYS, auto_precision, auto_values, preset_values
 from pyjulia4d.scene.ranges import CHECKS, Light, Vec3, Vec4, check_section
 from pyjulia4d.scene.text import override_list, parse_override, read_scene_table, toml_value
 
@@ -215,7 +215,7 @@ class Clip:
 class Render:
     """[render]: device-side settings."""
 
-    float: str = "single"
+    float: str = "auto"
     variant: str = "auto"
 
     def __post_init__(self) -> None:
@@ -357,6 +357,13 @@ class Scene:
     def with_overrides(self, overrides: Iterable[str]) -> Scene:
         """A new scene with ``section.key=VALUE`` strings applied."""
         return Scene.from_dict(self.to_dict(), overrides)
+
+    @property
+    def precision(self) -> str:
+        """The kernels' precision, "single" or "double": render.float, with "auto" resolved for
+        the set (quality.auto_precision; a device without fp64 or a GPU takes "single",
+        opencl/executor.py)."""
+        return auto_precision(self) if self.render.float == "auto" else self.render.float
 
     def replace(self, **changes: Any) -> Scene:
         """A new scene with typed values set by dotted key: ``replace(**{"march.post_steps": 10})``."""

@@ -36,7 +36,7 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-from pyjulia4d.fractal.registry import FUNCTIONS_TABLE, has_distance_estimate
+from pyjulia4d.fractal.registry import ALGEBRAS_TABLE, FUNCTIONS_TABLE, has_distance_estimate
 
 QUALITIES = ("auto", "custom", "draft", "normal", "final")
 
@@ -179,3 +179,18 @@ def apply_quality(scene: Any, quality: str) -> Any:
         return scene
     preset_values(quality)  # the error for an unknown name
     return scene.with_overrides([f"march.quality={quality}"])
+
+
+def auto_precision(scene: Any) -> str:
+    """What render.float "auto" (the default) is for a scene, where the device has fp64 and is a
+    CPU (opencl/executor.py takes "single" elsewhere: a GPU's double rate is a fraction of its
+    single): "double" for a proven march of a set whose algebra or function prefers it
+    (registry ``prefers_double``: the CQuats, the commutative rules, the hypercomplex sin and
+    cos), whose float32 rounding bounds stop proofs short of the surface; "single" otherwise.
+    On their default views (64x48, benchmarks/accuracy/pair_accuracy.py --set
+    render.float=double) the stated p99 fell from 9.0e-3 to 3.0e-4 (sin), 2.3e-3 to 2.8e-4
+    (cos), 0.34 to 1.8e-4 (commutative square), 0.26 to 4.2e-3 (CQuat cube) and 0.90 to 0.032
+    (commutative cube), for 1.2-2.1x the CPU-seconds (precision_cost.py, 320x240)."""
+    f = scene.fractal
+    prefers = ALGEBRAS_TABLE[f.algebra].prefers_double or FUNCTIONS_TABLE[f.function].prefers_double
+    return "double" if prefers and scene.march.method == "proven" else "single"   # "auto" is never proven

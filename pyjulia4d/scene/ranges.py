@@ -164,7 +164,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
         "planes": Planes(4),
     },
     "render": {
-        "float": Choice("single", "double"),
+        "float": Choice("auto", "single", "double"),
         "variant": Choice("auto", "scalar", "packet"),
     },
 }

@@ -35,7 +35,7 @@ def test_defaults() -> None:
     assert s.normals.method == "jacobian" and s.shading.light == (-2.0, 5.0, -4.0, 0.0)
     assert s.shading.shadow == "soft" and s.shading.ao == 0.6
     assert (s.image.width, s.image.height) == (640, 480)
-    assert s.render.float == "single"
+    assert s.render.float == "auto" and s.precision == "single"   # double only where float32 stops proofs short
 
 
 def test_checks_cover_every_field() -> None:
