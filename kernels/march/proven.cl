@@ -44,8 +44,8 @@
 /* ENC_GATE(e, bailout): the lanes whose form may pass a test this iteration - its margin
  * positive, the segment or a part of it outside - where the enclosure piece can tell
  * (enc_gate); the rest skip enc_outside, enc_margin and enc_prefix, which would find nothing
- * there.  Most iterations of a proof are spent with the centre inside the bailout, and on the
- * default scene the tests took a sixth of the march's time. */
+ * there.  Most iterations of a proof are spent with the centre inside the bailout: on the
+ * default scene the march took 0.89x the time with the gate (benchmarks/speed/commit_ratio.py). */
 #ifdef ENC_HAS_GATE
 #define ENC_GATE(e, bailout) enc_gate(e, bailout)
 #else
@@ -56,10 +56,11 @@
  * norms to a power D (enclose/julia.cl ENC_LADDER_POWER) the least of it and rho_j, rho_0 =
  * bailout, rho_j = (rho_(j-1) + |c|)^(1/D) raised by LADDER_UP for the rounding of |c|, the sum
  * and the root (OpenCL's sqrt and cbrt: 3 and 2 ulps).  rho_j falls to the fixed point of x^D -
- * |c| = x (rho_7 is within 1e-5 of it on the default scene) or rises to it from a smaller
+ * |c| = x (rho_7 is within 0.05 % of it on the default scene) or rises to it from a smaller
  * bailout, where the bailout itself is the least; either way t[LADDER_N - 1] holds for more
- * iterations left.  On the default scene (float64 twin, 80x60) a proof then took 85 iterations
- * of its form a ray instead of 133, and 12.7 enclosures instead of 18.0, for the same pixels. */
+ * iterations left.  On the default scene (float64 twin, 80x60: benchmarks/studies/
+ * proof_budget.py) the march then took 12.7 enclosures a ray instead of 18.0, for the same
+ * pixels. */
 #define LADDER_N 8
 #define LADDER_UP ((real)1.0000152587890625)   /* 1 + 2^-16 */
 /* the power's root, raised for its rounding */
