@@ -90,7 +90,10 @@ def run_scene(scene: Scene, dev, names, repeats: int) -> tuple[list[dict], float
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = render(scene.with_overrides(["image.width=8", "image.height=6"]), device=dev).scene
-    view = fitted.with_overrides([f"image.width={scene.image.width}", f"image.height={scene.image.height}"])
+    # the fitted camera, with the scene's own render.float: the framing render states the precision
+    # it ran (render.float "auto" resolved), which each setting resolves again for its own march
+    view = fitted.with_overrides([f"image.width={scene.image.width}", f"image.height={scene.image.height}",
+                                  f"render.float={scene.render.float}"])
     t0 = time.perf_counter()
     truth = truth_of(view)
     truth_s = time.perf_counter() - t0
