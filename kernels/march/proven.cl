@@ -63,9 +63,19 @@
  * pixels. */
 #define LADDER_N 8
 #define LADDER_UP ((real)1.0000152587890625)   /* 1 + 2^-16 */
-/* the power's root, raised for its rounding */
+/* t[j] = min(start, rho_j), rho_0 = start, rho_j = (rho_(j-1) + cn)^(1/power) raised by
+ * LADDER_UP, and t2[j] its square (start2, the exact square of start, where that is the least) */
 #if defined(ENC_LADDER_POWER) || defined(ENC_PART_LADDER_POWER)
-inline real ladder_root(real x, int power) { return (power == 2 ? sqrt(x) : cbrt(x)) * LADDER_UP; }
+inline void ladder_rungs(real start, real start2, real cn, int power, real *t, real *t2)
+{
+    real rho = start;
+    for (int j = 0; j < LADDER_N; ++j) {
+        if (j > 0)
+            rho = (power == 2 ? sqrt(rho + cn) : cbrt(rho + cn)) * LADDER_UP;
+        t[j] = fmin(start, rho);
+        t2[j] = rho < start ? rho * rho : start2;
+    }
+}
 #endif
 /* pa, pb: a split algebra's per component (ENC_PART_LADDER_POWER: the least of sqrt(2)
  * bailout, which holds at once, and a_j = (a_(j-1) + |c_a|)^(1/D)) */
@@ -82,34 +92,18 @@ inline enc_ladder enc_ladder_of(julia_params jp)
     real b = sqrt(jp.bailout2);
 #ifdef ENC_PART_LADDER_POWER
     real4 cp = ALG_C(jp.c);
-    real ca = hypot(cp.x, cp.y), cb = hypot(cp.z, cp.w);
-    real a0 = (real)1.4142135623730951 * b * LADDER_UP, ra = a0, rb = a0;
-    for (int j = 0; j < LADDER_N; ++j) {
-        if (j > 0) {
-            ra = ladder_root(ra + ca, ENC_PART_LADDER_POWER);
-            rb = ladder_root(rb + cb, ENC_PART_LADDER_POWER);
-        }
-        l.pa[j] = fmin(a0, ra);
-        l.pb[j] = fmin(a0, rb);
-        l.pa2[j] = l.pa[j] * l.pa[j];
-        l.pb2[j] = l.pb[j] * l.pb[j];
-    }
+    real a0 = (real)1.4142135623730951 * b * LADDER_UP;
+    ladder_rungs(a0, a0 * a0, hypot(cp.x, cp.y), ENC_PART_LADDER_POWER, l.pa, l.pa2);
+    ladder_rungs(a0, a0 * a0, hypot(cp.z, cp.w), ENC_PART_LADDER_POWER, l.pb, l.pb2);
 #endif
 #ifdef ENC_LADDER_POWER
-    real cl = sqrt(DOT4(jp.c, jp.c)), rho = b;
-#endif
-    l.t[0] = b;
-    l.t2[0] = jp.bailout2;
-    for (int j = 1; j < LADDER_N; ++j) {
-#ifdef ENC_LADDER_POWER
-        rho = ladder_root(rho + cl, ENC_LADDER_POWER);
-        l.t[j] = fmin(b, rho);
-        l.t2[j] = rho < b ? rho * rho : jp.bailout2;
+    ladder_rungs(b, jp.bailout2, sqrt(DOT4(jp.c, jp.c)), ENC_LADDER_POWER, l.t, l.t2);
 #else
+    for (int j = 0; j < LADDER_N; ++j) {
         l.t[j] = b;
         l.t2[j] = jp.bailout2;
-#endif
     }
+#endif
     return l;
 }
 

@@ -10,8 +10,15 @@ LADDER_N = 8
 LADDER_UP = 1.0 + 2.0 ** -16
 
 
-def _root(x, D):
-    return x ** (1.0 / D) * LADDER_UP
+def _rungs(start, cn, D):
+    """min(start, rho_j), rho_0 = start, rho_j = (rho_(j-1) + cn)^(1/D) raised by LADDER_UP, and
+    their squares (kernels/march/proven.cl ladder_rungs)."""
+    rho, t = start, []
+    for j in range(LADDER_N):
+        if j:
+            rho = (rho + cn) ** (1.0 / D) * LADDER_UP
+        t.append(min(start, rho))
+    return t, [x * x for x in t]
 
 
 def ladder(c, max_iter, bailout, F):
@@ -24,27 +31,15 @@ def ladder(c, max_iter, bailout, F):
     component from sqrt(2) bailout (|h| >= |a| / sqrt(2)), the least of that and the ladder's;
     else None."""
     b = float(bailout)
-    D = F.fn.FUNC_POWER if getattr(F.alg, "ALG_LBOUND_IS_LEN", False) else None
-    t, t2 = [b], [b * b]
-    rho, cl = b, float(np.linalg.norm(np.asarray(c, np.float64)))
-    for _ in range(1, LADDER_N):
-        if D:
-            rho = _root(rho + cl, D)
-        t.append(min(b, rho) if D else b)
-        t2.append(rho * rho if D and rho < b else b * b)
+    if getattr(F.alg, "ALG_LBOUND_IS_LEN", False) and F.fn.FUNC_POWER:
+        t, t2 = _rungs(b, float(np.linalg.norm(np.asarray(c, np.float64))), F.fn.FUNC_POWER)
+    else:
+        t, t2 = [b] * LADDER_N, [b * b] * LADDER_N
     parts = None
     if F.split and F.fn.FUNC_POWER:
-        Dp, cp = F.fn.FUNC_POWER, F.ALG_C(np.asarray(c, np.float64))
-        a0 = np.sqrt(2.0) * b * LADDER_UP
-        parts = []
-        for cn in (float(np.hypot(cp[0], cp[1])), float(np.hypot(cp[2], cp[3]))):
-            r, out = a0, []
-            for j in range(LADDER_N):
-                if j:
-                    r = _root(r + cn, Dp)
-                out.append(min(a0, r))
-            parts += [out, [x * x for x in out]]
-        parts = tuple(parts)
+        cp, a0 = F.ALG_C(np.asarray(c, np.float64)), float(np.sqrt(2.0) * b * LADDER_UP)
+        parts = (*_rungs(a0, float(np.hypot(cp[0], cp[1])), F.fn.FUNC_POWER),
+                 *_rungs(a0, float(np.hypot(cp[2], cp[3])), F.fn.FUNC_POWER))
     return t, t2, parts
 
 
