@@ -80,6 +80,8 @@ def make_mesh_plan(scene: Scene, resolution: int) -> MeshPlan:
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"expected a pyjulia4d.Scene, got {type(scene).__name__}")
     n = check_resolution(resolution)
+    if scene.render.float == "auto":   # "auto" is for the proven march's proofs; the mesh samples the set test
+        scene = scene.replace(**{"render.float": "single"})
     f = scene.fractal
     radius = set_radius(scene)   # the set's ball (the estimate march's shell is no part of the set)
     d = float(scene.slice.distance)

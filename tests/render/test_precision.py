@@ -44,3 +44,12 @@ def test_auto_is_resolved_for_the_device(monkeypatch):
     monkeypatch.undo()
     monkeypatch.setattr(EXECUTOR, "has_fp64", lambda dev: False)
     assert render(s).scene.render.float == "single"
+
+
+def test_a_mesh_samples_in_single_under_auto():
+    """"auto" serves the proven march's proofs; the mesh samples the set test (pipeline/mesh_plan.py)."""
+    from pyjulia4d.pipeline.mesh_plan import make_mesh_plan
+    s = Scene.default().with_overrides(["fractal.algebra=commutative"])
+    assert s.precision == "double"
+    assert not make_mesh_plan(s, 16).double and "REAL_DOUBLE" not in make_mesh_plan(s, 16).config.defines
+    assert make_mesh_plan(s.with_overrides(["render.float=double"]), 16).double
