@@ -190,7 +190,8 @@ def auto_precision(scene: Any) -> str:
     On their default views (64x48, benchmarks/accuracy/pair_accuracy.py --set
     render.float=double) the stated p99 fell from 9.0e-3 to 3.0e-4 (sin), 2.3e-3 to 2.8e-4
     (cos), 0.34 to 1.8e-4 (commutative square), 0.26 to 4.2e-3 (CQuat cube) and 0.90 to 0.032
-    (commutative cube), for 1.2-2.1x the CPU-seconds (precision_cost.py, 320x240)."""
+    (commutative cube), for 0.9-1.6x the CPU-seconds on the AMD EPYC and 1.2-2.1x on the Intel
+    Xeon (benchmarks/accuracy/precision_cost.py, 320x240)."""
     f = scene.fractal
     prefers = ALGEBRAS_TABLE[f.algebra].prefers_double or FUNCTIONS_TABLE[f.function].prefers_double
     return "double" if prefers and scene.march.method == "proven" else "single"   # "auto" is never proven
