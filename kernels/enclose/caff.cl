@@ -53,6 +53,14 @@ inline lmask caff_outside(caff z, real bailout2)
     return (l > (real)0) & (l * l > bailout2);
 }
 
+/* the part [-1, s] of the segment the form keeps beyond ``bailout`` (-1: none; ``live``: the
+ * lanes that ask; enclose/disc.cl enc_prefix_of) */
+inline lreal caff_prefix(caff z, real bailout, lmask live)
+{
+    quat m = QUAT(z.m.re, z.m.im, (lreal)0, (lreal)0);
+    return enc_prefix_of(m, QUAT(z.v.re, z.v.im, (lreal)0, (lreal)0), QNORM2(m), bailout + z.r, live);
+}
+
 /* whether the form may still prove the segment (enclose/ball.cl enc_hopeful) */
 inline lmask caff_hopeful(caff z, real bailout) { return c_abs(z.v) + z.r < (real)2 * (c_abs(z.m) + bailout); }
 

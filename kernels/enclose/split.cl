@@ -169,9 +169,7 @@ inline lreal enc_margin_parts(enclosure e, real ta, real tb)
 
 inline lreal enc_prefix_parts(enclosure e, real ta, real tb, lmask live)
 {
-    quat ma = QUAT(e.a.m.re, e.a.m.im, (lreal)0, (lreal)0), va = QUAT(e.a.v.re, e.a.v.im, (lreal)0, (lreal)0);
-    quat mb = QUAT(e.b.m.re, e.b.m.im, (lreal)0, (lreal)0), vb = QUAT(e.b.v.re, e.b.v.im, (lreal)0, (lreal)0);
-    return fmax(enc_prefix_of(ma, va, QNORM2(ma), ta + e.a.r, live), enc_prefix_of(mb, vb, QNORM2(mb), tb + e.b.r, live));
+    return fmax(caff_prefix(e.a, ta, live), caff_prefix(e.b, tb, live));
 }
 
 /* whether the forms may still prove the segment (enclose/ball.cl enc_hopeful; NaN: no) */

@@ -200,9 +200,7 @@ def light_packets(scene: Scene, lanes: int, pairs: bool = True) -> int:
     the march's, or two where the march takes one but the shadow rays and occlusion step by a
     distance estimate all the same (the proven march of a set with one: -D MARCH_UNPAIRED), which
     took 0.70x their time on the default scene at the normal preset."""
-    f = scene.fractal
-    if march_packets(scene, lanes, pairs) == 2:
-        return 2
+    f = scene.fractal   # a march in pairs (the estimate's) implies all of these (scene/rules.py)
     return 2 if pairs and lanes > 1 and KINDS_TABLE[f.kind].packet_pairs and has_distance_estimate(f) else 1
 
 

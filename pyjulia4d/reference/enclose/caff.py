@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, rounding
+from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
 def caff_of(mx, my, vx, vy, r):
@@ -50,6 +50,14 @@ def caff_outside(z, bailout2):
     with np.errstate(all="ignore"):
         lo = least_norm(np.stack([m.real, m.imag], -1), np.stack([v.real, v.imag], -1)) * (1 - rounding().sum) - r
         return (lo > 0) & (lo * lo > bailout2)
+
+
+def caff_prefix(z, bailout):
+    """The part [-1, s] of the segment the form keeps beyond ``bailout`` (-1: none;
+    kernels/enclose/caff.cl)."""
+    m, v, r = z
+    mq, vq = np.stack([m.real, m.imag], -1), np.stack([v.real, v.imag], -1)
+    return prefix_of(mq, vq, np.sum(mq * mq, axis=-1), bailout + r)
 
 
 def caff_hopeful(z, bailout):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pyjulia4d.reference.enclose.caff import caff_add, caff_margin, caff_mul, caff_outside
+from pyjulia4d.reference.enclose.caff import caff_add, caff_margin, caff_mul, caff_outside, caff_prefix
 from pyjulia4d.reference.enclose.disc import enc_radius, least_norm, prefix_of, rounding
 
 
@@ -136,12 +136,7 @@ def enc_margin_parts(e, ta, tb):
 
 
 def enc_prefix_parts(e, ta, tb):
-    out = []
-    for (m, v, r), t in zip(e, (ta, tb)):
-        z = np.zeros_like(m.real)
-        mq, vq = np.stack([m.real, m.imag, z, z], -1), np.stack([v.real, v.imag, z, z], -1)
-        out.append(prefix_of(mq, vq, np.sum(mq * mq, axis=-1), t + r))
-    return np.fmax(*out)
+    return np.fmax(caff_prefix(e[0], ta), caff_prefix(e[1], tb))
 
 
 def enc_hopeful(e, bailout):
