@@ -22,6 +22,10 @@ ray's iterations at every step, and replays them through these schedules:
   estimate, its step and its next point's orbit at once).  Its cost is its slowest lane's
   iterations summed over that ray's steps, and the estimate (log, sqrt, the step) is then
   taken in every round where any lane's orbit ends, where the blocks take it once a step;
+* wavefront: every ray's march in launches of K steps, the rays still marching after each
+  launch packed again, 16 to a packet in the blocks' order (a global compaction between
+  launches, as a wavefront path tracer does; the launches, the state kept between them and
+  the packing are left out).
 * coarse to fine: a cone march per B x B block finds the depth where the estimate first
   falls below the block's footprint (B pixels at that distance) on any of its rays; every
   ray of the block starts there, and the steps in front of it are skipped.  The coarse
@@ -29,6 +33,12 @@ ray's iterations at every step, and replays them through these schedules:
 * blocks and refill again after 4x4 cone starts (the kernel's march/cone.cl, modelled by the
   rule above): each ray's steps in front of its block's start left out, so the rays a refilled
   lane takes begin near the surface, as they do in the kernel.
+
+--march proven models the proven march (kernels/march/proven.cl) instead: a step there is one
+segment's enclosure, costing 1 (its start and tests) plus the iterations its lane stays live
+(until the enclosure is proven outside or no longer hopeful), recorded from the float64 twin
+(reference/march.py march_proven) at the normal preset; the coarse-to-fine rows, which rest on
+the estimate, are then left out.
 
 What is left out, so these are upper bounds of the gain: the refinement of each hit
 (march/refine.cl, the same in every schedule), the per-step work that does not iterate (the
@@ -38,10 +48,11 @@ the image run 2.3-2.8x slower in packets, benchmarks/speed/throughput.py "rays s
 
 Writes benchmarks/results/march_levers.md (appends a section per run).
 
-    python benchmarks/studies/march_levers.py [--size 320x240] [--set KEY=VALUE ...]
+    python benchmarks/studies/march_levers.py [--size 320x240] [--march de|proven] [--set KEY=VALUE ...]
 """
 from __future__ import annotations
 
+import importlib
 import math
 import sys
 from pathlib import Path
@@ -54,6 +65,8 @@ if str(ROOT) not in sys.path:   # the checkout: its pyjulia4d, and benchmarks/ a
 
 from pyjulia4d.geometry.camera import camera_frame, march_radius  # noqa: E402
 from pyjulia4d.reference.iterate import julia_distance_formula  # noqa: E402
+from pyjulia4d.pipeline.plan import march_args  # noqa: E402
+from pyjulia4d.reference.formula import formula_of  # noqa: E402
 from pyjulia4d.reference.march import DE_OVER_RELAX  # noqa: E402
 from pyjulia4d.reference.rays import generate_rays  # noqa: E402
 from pyjulia4d.scene.model import Scene  # noqa: E402
@@ -118,6 +131,61 @@ def record(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.stack(its, 1), np.stack(ts, 1), np.stack(ds, 1)
 
 
+def enclosure_iterations(o, d, t0, t1, c, max_iter, bailout, formula) -> np.ndarray:
+    """Per ray, 1 + the iterations its lane of reference/march.py enc_prove stays live: until its
+    form is outside the bailout or the ladder's radius (each component's too, for a split
+    algebra) or no longer hopeful, at most the kind's steps (kernels/march/proven.cl enc_prove)."""
+    K = formula.kind_enclose
+    E = K if formula.own_map else formula.enclose
+    steps = K.enc_steps(max_iter)
+    lad = K.ladder(c, max_iter, bailout, formula) if hasattr(K, "ladder") else None
+    thr, thr2, parts = lad if lad else ([bailout] * 8, [bailout * bailout] * 8, None)
+    j = min(steps, len(thr) - 1)
+    with np.errstate(all="ignore"):
+        e, p = K.enc_start(o, d, t0, t1, c, formula)
+        live = ~E.enc_outside(e, thr2[j])
+        n = np.ones(len(o), np.int64)
+        for k in range(steps):
+            if not live.any():
+                break
+            e = K.enc_next(e, p, formula)
+            n += live
+            j = min(steps - k - 1, len(thr) - 1)
+            out = E.enc_outside(e, thr2[j])
+            if parts:
+                out |= E.enc_outside_parts(e, parts[1][j], parts[3][j])
+            live &= ~out & E.enc_hopeful(e, bailout)
+    return n
+
+
+def record_proven(scene: Scene) -> np.ndarray:
+    """Every ray's cost at each step of the proven march (enclosure_iterations, from the float64
+    twin's own march at the scene's preset): an (n, steps) array, 0 beyond its last step.  The
+    twin's enc_prove is wrapped for the run; rays are told apart by their directions (one ray a
+    pixel)."""
+    rm = importlib.import_module("pyjulia4d.reference.march")
+    W, H = scene.image.width, scene.image.height
+    o, d = (np.asarray(a, np.float64) for a in generate_rays(camera_frame(scene), W, H)[:2])
+    index = {row.tobytes(): i for i, row in enumerate(d)}
+    rows: list[list[int]] = [[] for _ in range(len(d))]
+    original = rm.enc_prove
+
+    def counted(o_, d_, t0, t1, c, max_iter, bailout, formula):
+        for row, k in zip(d_, enclosure_iterations(o_, d_, t0, t1, c, max_iter, bailout, formula)):
+            rows[index[row.tobytes()]].append(int(k))
+        return original(o_, d_, t0, t1, c, max_iter, bailout, formula)
+
+    rm.enc_prove = counted
+    try:
+        rm.march(o, d, march_args(scene, method="proven"), None, None, formula_of(scene.fractal), None)
+    finally:
+        rm.enc_prove = original
+    its = np.zeros((len(d), max(map(len, rows), default=0) or 1), np.int64)
+    for i, r in enumerate(rows):
+        its[i, :len(r)] = r
+    return its
+
+
 def block_order(W: int, H: int) -> np.ndarray:
     """Ray indices block by block (BLOCK x BLOCK, row-major blocks): the packets' order."""
     return np.arange(W * H).reshape(H // BLOCK, BLOCK, W // BLOCK, BLOCK).transpose(0, 2, 1, 3).reshape(-1)
@@ -148,6 +216,25 @@ def cost_refill(its: np.ndarray, order: np.ndarray, queue_blocks: int) -> int:
                         lane[j], pos[j] = (queue.pop() if queue else -1), 0
             cost += int(m)
     return cost
+
+
+def cost_wavefront(its: np.ndarray, order: np.ndarray, k: int) -> tuple[int, int]:
+    """(cost, launches) of launches of ``k`` steps, the rays still marching packed again after
+    each, LANES to a packet in ``order`` (cost_blocks within a launch)."""
+    lengths = (its > 0).sum(1)
+    alive, pos, cost, launches = order[lengths[order] > 0], np.zeros(len(its), np.int64), 0, 0
+    cols = np.arange(k)
+    while alive.size:
+        launches += 1
+        pad = (-alive.size) % LANES
+        rays = np.concatenate([alive, np.full(pad, -1)])
+        idx = pos[rays][:, None] + cols
+        part = np.where((rays[:, None] >= 0) & (idx < its.shape[1]),
+                        its[rays[:, None], np.minimum(idx, its.shape[1] - 1)], 0)
+        cost += int(part.reshape(-1, LANES, k).max(axis=1).sum())
+        pos[alive] += k
+        alive = alive[pos[alive] < lengths[alive]]
+    return cost, launches
 
 
 def cost_own_pace(its: np.ndarray, order: np.ndarray) -> tuple[int, int]:
@@ -192,9 +279,15 @@ def schedules(its: np.ndarray, order: np.ndarray, title: str) -> list[str]:
         c = cost_refill(its, order, q)
         rows.append(f"| refill from a queue of {q} blocks | {total / (LANES * c):.1%} | {c / base:.2f} |")
         print(rows[-1], flush=True)
+    for k in (4, 8, 16):
+        c, n = cost_wavefront(its, order, k)
+        rows.append(f"| wavefront: launches of {k} steps, packed again after each ({n} launches) | "
+                    f"{total / (LANES * c):.1%} | {c / base:.2f} |")
+        print(rows[-1], flush=True)
     rounds, ends = cost_own_pace(its, order)
     steps = int((its[order].reshape(-1, LANES, its.shape[1]).max(1) > 0).sum())
-    rows.append(f"| each lane at its own pace (estimates in {ends / steps:.1f}x the blocks' rounds) | "
+    rows.append(f"| each lane at its own pace (steps' ends - estimates, proofs' outcomes - in {ends / steps:.1f}x "
+                f"the blocks' rounds) | "
                 f"{total / (LANES * rounds):.1%} | {rounds / base:.2f} |")
     print(rows[-1], flush=True)
     rows.append(f"| every lane always busy (the bound of any compaction) | 100 % | {total / (LANES * base):.2f} |")
@@ -223,30 +316,46 @@ def main(argv=None) -> int:
     ap.add_argument("--size", default="320x240")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="scene overrides (e.g. fractal.max_iter=20 march.epsilon=0.05)")
+    ap.add_argument("--march", choices=("de", "proven"), default="de",
+                    help="the distance-estimate march (default) or the proven march at the normal preset")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     W, H = size_of(a.size, "--size")
-    scene = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", *a.set])
-    its, ts, ds = record(scene)
-    total = int(its.sum())
+    if W % BLOCK or H % BLOCK:
+        raise SystemExit(f"--size: width and height must be multiples of {BLOCK}, got {a.size}")
+    quality = ["march.quality=normal"] if a.march == "proven" else []
+    scene = Scene.default().with_overrides([f"image.width={W}", f"image.height={H}", *quality, *a.set])
     order = block_order(W, H)
-    base = cost_blocks(its, order)
     what = f"the default scene with {', '.join(a.set)}" if a.set else "default scene"
-    lines = [f"\n## {utc_now()}, commit {git_commit()}, {what} {W}x{H}, {LANES} lanes\n",
-             f"{total:.4g} iterations in the march ({total / (W * H):.0f} per ray, refinement left out); "
-             f"packets of 4x4 blocks use {total / (LANES * base):.1%} of their lanes' iteration slots.\n"]
-    lines += schedules(its, order, "schedule")
-    pixel = 2 * math.tan(math.radians(scene.camera.fov) / 2) / H
-    lines += ["", "| coarse to fine, block | iterations skipped | coarse pass | net |", "|---|---|---|---|"]
-    for side in (4, 8, 16):
-        skip, coarse = coarse_to_fine(its, ts, ds, W, H, side, pixel)
-        lines.append(f"| {side}x{side} | {skip:.1%} | {coarse:.1%} | {skip - coarse:.1%} |")
-        print(lines[-1], flush=True)
-    cut = cone_trim(its, ts, ds, W, H, BLOCK, pixel)
-    left = int(cut.sum())
-    lines += ["", f"After 4x4 cone starts: {left:.4g} iterations ({left / total:.1%} of the above), "
-              f"the blocks' lanes' use {left / (LANES * cost_blocks(cut, order)):.1%}.", ""]
-    lines += schedules(cut, order, "schedule after the cone starts")
+    if a.march == "proven":
+        its = record_proven(scene)
+        total = int(its.sum())
+        base = cost_blocks(its, order)
+        lines = [f"\n## {utc_now()}, commit {git_commit()}, the proven march (normal preset), {what} {W}x{H}, "
+                 f"{LANES} lanes\n",
+                 f"{total:.4g} lane-slots in the march ({(its > 0).sum() / (W * H):.1f} enclosures and "
+                 f"{total / (W * H):.0f} slots per ray, each enclosure 1 plus its iterations; refinement and "
+                 f"floor tests left out); packets of 4x4 blocks use {total / (LANES * base):.1%} of them.\n"]
+        lines += schedules(its, order, "schedule")
+    else:
+        its, ts, ds = record(scene)
+        total = int(its.sum())
+        base = cost_blocks(its, order)
+        lines = [f"\n## {utc_now()}, commit {git_commit()}, {what} {W}x{H}, {LANES} lanes\n",
+                 f"{total:.4g} iterations in the march ({total / (W * H):.0f} per ray, refinement left out); "
+                 f"packets of 4x4 blocks use {total / (LANES * base):.1%} of their lanes' iteration slots.\n"]
+        lines += schedules(its, order, "schedule")
+        pixel = 2 * math.tan(math.radians(scene.camera.fov) / 2) / H
+        lines += ["", "| coarse to fine, block | iterations skipped | coarse pass | net |", "|---|---|---|---|"]
+        for side in (4, 8, 16):
+            skip, coarse = coarse_to_fine(its, ts, ds, W, H, side, pixel)
+            lines.append(f"| {side}x{side} | {skip:.1%} | {coarse:.1%} | {skip - coarse:.1%} |")
+            print(lines[-1], flush=True)
+        cut = cone_trim(its, ts, ds, W, H, BLOCK, pixel)
+        left = int(cut.sum())
+        lines += ["", f"After 4x4 cone starts: {left:.4g} iterations ({left / total:.1%} of the above), "
+                  f"the blocks' lanes' use {left / (LANES * cost_blocks(cut, order)):.1%}.", ""]
+        lines += schedules(cut, order, "schedule after the cone starts")
     md = a.out / "march_levers.md"
     append_run(md, "# Compaction and coarse-to-fine, modelled on the default scene's rays\n\nWritten by "
                "`python benchmarks/studies/march_levers.py` (its docstring says what is modelled and what is "
