@@ -350,7 +350,24 @@ def test_march_levers_schedules_count_rounds_exactly():
     assert lev.cost_own_pace(its, order) == (4, 4)
     assert lev.cost_refill(its, order, 1) == 6     # no queue to refill from: the blocks' cost
     lines = lev.schedules(its, order, "hand")
-    assert "| each lane at its own pace (estimates in 2.0x the blocks' rounds) | 56.2% | 0.67 |" in lines
+    assert ("| each lane at its own pace (steps' ends - estimates, proofs' outcomes - in 2.0x the blocks' "
+            "rounds) | 56.2% | 0.67 |") in lines
+
+
+def test_march_levers_wavefront_packs_the_rays_left():
+    """march_levers.py's wavefront on two packets worked by hand: in each, ray 0 takes steps of 1,
+    4 and 4 iterations and the other 15 one step of 1.  The blocks cost 9 each; launches of one
+    step cost 1 + 1, then the two rays left share one packet: 4, and 4 (3 launches, 10 in all);
+    launches of two steps cost 5 + 5, then 4."""
+    lev = load("march_levers")
+    its = np.zeros((2 * lev.LANES, 3), np.int64)
+    its[:, 0] = 1
+    its[0, 1:] = its[lev.LANES, 1:] = 4
+    order = np.arange(2 * lev.LANES)
+    assert lev.cost_blocks(its, order) == 18
+    assert lev.cost_wavefront(its, order, 1) == (10, 3)
+    assert lev.cost_wavefront(its, order, 2) == (14, 2)
+    assert lev.cost_wavefront(its, order, 3) == (18, 1)   # one launch: the blocks
 
 
 def test_march_levers_report_runs(tmp_path):
@@ -358,7 +375,15 @@ def test_march_levers_report_runs(tmp_path):
     assert load("march_levers").main(["--size", "32x24", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "march_levers.md").read_text()
     assert "commit" in md and md.count("| each lane at its own pace") == 2
-    assert md.count("| refill from a queue of 16 blocks |") == 2
+    assert md.count("| refill from a queue of 16 blocks |") == 2 and md.count("| wavefront: launches of 4 steps") == 2
+
+
+def test_march_levers_proven_report_runs(tmp_path):
+    """march_levers.py --march proven, tiny: the twin's enclosures per ray and every schedule's row."""
+    assert load("march_levers").main(["--size", "32x24", "--march", "proven", "--out", str(tmp_path)]) == 0
+    md = (tmp_path / "march_levers.md").read_text()
+    assert "the proven march (normal preset)" in md and "enclosures and" in md
+    assert md.count("| wavefront: launches of") == 3 and "| every lane always busy" in md
 
 
 @pytest.mark.slow   # eight runs of the whole command, each a process of its own
