@@ -33,6 +33,12 @@ from pyjulia4d.scene.checks import SceneError
 SHIPPED = {"sky": "sky.exr"}   # the words shading.environment takes for the packaged images
 MAX_SIDE = 16384               # pixels: an 8k map is 400 MB of float32 RGBA already
 LUMA = np.array([0.2126, 0.7152, 0.0722])
+# The brightest pixel a map may hold.  A path's light is the map's times shading.ambient and
+# shading.sky (each at most 1e3), and a pixel's film keeps the sum of its squared deviations in
+# float32 (Welford's M2, up to 65536 paths): under 1e9 that stays below 1e35, where float32
+# ends at 3.4e38; a map of 1e20 made it infinite and the stated noise 0.  An unclipped sun
+# in a photographed sky reaches about 1e5.
+MAX_RADIANCE = 1e9
 
 
 @dataclass(frozen=True)
@@ -63,7 +69,7 @@ def path_of(value: str) -> Path:
 def load(value: str) -> Environment:
     """The environment ``value`` names (shading.environment other than "uniform"), read and
     checked; a SceneError naming the key where the file is missing, unreadable, not an
-    image, not 2:1 or holds values that are not light (negative, NaN, inf)."""
+    image, not 2:1 or holds values that are not light (negative, NaN, inf) or above MAX_RADIANCE."""
     p = path_of(value)
     try:
         st = os.stat(p)
@@ -97,6 +103,9 @@ def _load(path: str, size: int, mtime: int, value: str) -> Environment:
     rgb = three_channels(np.asarray(pixels, np.float32).reshape(h, w, -1))
     if not np.all(np.isfinite(rgb)) or np.any(rgb < 0):
         raise SceneError(key, f"{value}: holds negative or non-finite values, which are not light")
+    if np.any(rgb > MAX_RADIANCE):
+        raise SceneError(key, f"{value}: holds values up to {float(rgb.max()):.3g}; a map's light is 0 to "
+                              f"{MAX_RADIANCE:.0e}")
     return build(rgb, value)
 
 

@@ -132,6 +132,7 @@ def _exr(path, img) -> None:
 @pytest.mark.parametrize("case, reason", [
     ("missing", "cannot read it"), ("truncated", "cannot read its pixels|not an image"), ("text", "not an image"),
     ("square", "not an equirectangular map"), ("negative", "not light"), ("nan", "not light"),
+    ("too bright", "light is 0 to 1e"),
 ])
 def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, reason) -> None:
     path = tmp_path / "env.exr"
@@ -142,14 +143,29 @@ def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, re
         path.write_text("not an image")
     elif case == "square":
         _exr(path, np.ones((32, 32, 3)))
-    elif case in ("negative", "nan"):
+    elif case in ("negative", "nan", "too bright"):
         img = np.ones((16, 32, 3))
-        img[3, 4, 1] = -1.0 if case == "negative" else np.nan
+        img[3, 4, 1] = {"negative": -1.0, "nan": np.nan, "too bright": 1.5e9}[case]
         _exr(path, img)
     sc = scene(shading={"environment": str(path)})
     with pytest.raises(SceneError, match=reason) as info:
         pyjulia4d.render(sc)
     assert info.value.key == "shading.environment" and "\n" not in str(info.value)
+
+
+def test_the_brightest_map_states_a_finite_noise(tmp_path) -> None:
+    """A map at its brightest (environment.MAX_RADIANCE), under the brightest ambient and sky the
+    keys take: every pixel's colour, variance and stated noise finite, and the noise not 0 where
+    paths differ (a map of 1e20 overflowed the film's squared deviations, and stated 0)."""
+    from pyjulia4d.pipeline.environment import MAX_RADIANCE
+    path = tmp_path / "env.exr"
+    img = np.full((16, 32, 3), 1e-3)
+    img[2:5, 8:12] = MAX_RADIANCE   # a small, very bright sun: paths that find it and paths that do not
+    _exr(path, img)
+    r = pyjulia4d.render(scene(image={"samples": 8}, shading={"environment": str(path), "ambient": 1e3,
+                                                              "sky": [1e3, 1e3, 1e3]}))
+    assert np.isfinite(r.color).all() and np.isfinite(r.film.variance).all() and np.isfinite(r.film.noise).all()
+    assert r.film.noise_stats()["p99"] > 0
 
 
 def test_a_bad_environment_on_the_command_line(tmp_path, capsys) -> None:
