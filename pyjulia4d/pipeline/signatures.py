@@ -111,7 +111,8 @@ NORMALS_JACOBIAN = Signature("normals_jacobian", "normals/jacobian", (
     P("global real4* normal"), P("global int* flags")))
 
 NORMALS_GRADIENT = Signature("normals_gradient", "normals/gradient", (
-    P("global const real4* point"), P("global const int* status"), *ORBIT, P("real h", "normals.step"), *BASIS,
+    P("global const real4* point"), P("global const int* status"), *ORBIT, P("real h", "normals.step"),
+    P("real h_per_distance", "normals.step_per_distance"), P("real4 eye", "camera.position"), *BASIS,
     P("global real4* normal"), P("global int* flags")))
 
 NORMALS_ZBUFFER = Signature("normals_zbuffer", "normals/zbuffer", (

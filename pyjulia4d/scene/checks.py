@@ -460,7 +460,7 @@ class ImageFile:
 
 
 class OrWord:
-    """The literal string ``word``, else what ``inner`` accepts."""
+    """The literal string ``word``, else what ``inner`` accepts (another OrWord: a second word)."""
 
     verbatim = False
 
@@ -474,7 +474,8 @@ class OrWord:
         if isinstance(v, str):
             if v == self.word:
                 return v
-            if self.inner.verbatim:   # the inner's own words (true, false), read from the text
+            # the inner's own words (true, false; a nested OrWord's word), read from the text
+            if self.inner.verbatim or isinstance(self.inner, OrWord):
                 try:
                     return self.inner(key, v)
                 except SceneError:

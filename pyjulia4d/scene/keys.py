@@ -49,7 +49,8 @@ MEANINGS = {
     "march.near": "start of the march along each ray; auto = entry into the bounding ball",
     "march.far": "end of the march; auto = exit from the bounding ball",
     "normals.method": "jacobian (analytic), gradient (6-point difference of the estimate) or zbuffer",
-    "normals.step": "gradient: difference step; auto = march.epsilon, at least 1e-5 (1e-8 double)",
+    "normals.step": "gradient: difference step; auto = march.epsilon, at least 1e-5 (1e-8 double); "
+                    "pixel = a pixel's footprint at the hit (smooth normals where the surface is rough below a pixel)",
     "shading.color": "surface colour, linear light",
     "shading.background": "colour where rays miss (alpha 0 there), linear light; fog fades toward it",
     "shading.background_gradient": "a gradient behind the set: stops [position, r, g, b] (sRGB) from the top (0) to the bottom (1) of the frame",

@@ -126,7 +126,7 @@ class Normals:
     """[normals]: how surface normals are estimated."""
 
     method: str = "jacobian"
-    step: Union[float, Auto] = "auto"
+    step: Union[float, Auto, Literal["pixel"]] = "auto"
 
     def __post_init__(self) -> None:
         check_section(self, "normals")

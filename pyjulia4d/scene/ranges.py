@@ -109,7 +109,7 @@ CHECKS: dict[str, dict[str, Checker]] = {
     },
     "normals": {
         "method": Choice("jacobian", "gradient", "zbuffer"),
-        "step": OrWord("auto", Real(1e-12, 1.0)),
+        "step": OrWord("auto", OrWord("pixel", Real(1e-12, 1.0))),
     },
     "shading": {
         "color": Vector((3,), 0.0, 1e3),
