@@ -17,9 +17,9 @@ inline real4 normal_gradient(real4 p, julia_params jp, real h, real4 right, real
                    de_field(p - h * forward, jp) - de_field(p + h * forward, jp), 0);
 }
 
-/* The step is h + h_per_distance |p - eye|: a fixed step, or (normals.step = "pixel") a pixel's
- * footprint at the hit, Hart, Sandin & Kauffman's linear clarity (1989, §4.2; pipeline/plan.py
- * gradient_step). */
+/* The step is max(h, h_per_distance |p - eye|): a fixed step, or (normals.step = "pixel") a
+ * pixel's footprint at the hit, Hart, Sandin & Kauffman's linear clarity (1989, §4.2;
+ * pipeline/plan.py gradient_step), no finer than h. */
 __kernel void normals_gradient(const int n_items, __global const real4 *point, __global const int *status,
                                const real4 c, const int max_iter, const real bailout,
                                const real h, const real h_per_distance, const real4 eye, const real4 right,
@@ -29,7 +29,7 @@ __kernel void normals_gradient(const int n_items, __global const real4 *point, _
     HITS_ONLY(i, n_items, status, normal[i] = (real4)(0));
     julia_params jp = { c, bailout * bailout, 0, max_iter };
     real4 e = point[i] - eye;
-    real hi = h + h_per_distance * sqrt(DOT4(e, e));   /* not length(): common/lanes.cl DOT3 */
+    real hi = fmax(h, h_per_distance * sqrt(DOT4(e, e)));   /* not length(): common/lanes.cl DOT3 */
     real4 n = normal_gradient(point[i], jp, hi, right, up, forward);
     real l = sqrt(DOT4(n, n));   /* not length(): common/lanes.cl DOT3 */
     /* a flat or non-finite difference: the view axis, flagged (common/codes.cl) in the pixel's

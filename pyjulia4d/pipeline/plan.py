@@ -334,18 +334,18 @@ GRADIENT_STEP_FLOOR = {"single": 1e-5, "double": 1e-8}
 
 
 def gradient_step(scene: Scene, frame: Frame) -> tuple[float, float]:
-    """The gradient normals' difference step, h + k d at a hit a distance d from the eye, as
+    """The gradient normals' difference step, max(h, k d) at a hit a distance d from the eye, as
     (h, k): normals.step as given (k = 0); for "auto" march.epsilon floored at
     GRADIENT_STEP_FLOOR[render.float]; for "pixel" the footprint of a pixel at the hit, k = 2
-    tan(fov / 2) / height (a pixel's height on the image plane at the view axis), h 0.  The
-    last is Hart, Sandin & Kauffman's "clarity" (1989, §4.2: an epsilon growing linearly with
-    the distance from the eye gives close and far parts the same detail): the difference then
-    spans what one pixel shows, so the normal follows the surface's shape at the pixel's
-    scale, where the exact normal (jacobian) follows wrinkles far below it - on a quaternion
-    cube at max_iter 50 one pixel in a few then faces the light among neighbours that do not,
-    a speckle no antialiasing short of many samples removes."""
+    tan(fov / 2) / height (a pixel's height on the image plane at the view axis), no finer than
+    that floor (h).  The last is Hart, Sandin & Kauffman's "clarity" (1989, §4.2: an epsilon
+    growing linearly with the distance from the eye gives close and far parts the same detail):
+    the difference spans what one pixel shows, so the normal follows the surface's shape at the
+    pixel's scale, where the exact normal (jacobian) follows wrinkles far below it - on a
+    quaternion cube at max_iter 50 about one pixel in a hundred then stands out, brighter or
+    darker than all its neighbours (tests/render/test_render.py)."""
     if scene.normals.step == "pixel":
-        return 0.0, 2.0 * frame.tan_half_fov / scene.image.height
+        return GRADIENT_STEP_FLOOR[scene.precision], 2.0 * frame.tan_half_fov / scene.image.height
     if scene.normals.step != "auto":
         return float(scene.normals.step), 0.0
     return max(scene.march.epsilon, GRADIENT_STEP_FLOOR[scene.precision]), 0.0

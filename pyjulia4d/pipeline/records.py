@@ -64,8 +64,8 @@ class ClipArgs:
 @dataclass(frozen=True)
 class NormalsArgs:
     method: str            # "jacobian", "gradient" or "zbuffer"
-    step: float            # the gradient's difference step (gradient_step), or
-    step_per_distance: float = 0.0   # per unit of the hit's distance from the eye (normals.step = "pixel")
+    step: float            # the gradient's difference step (gradient_step), at least
+    step_per_distance: float = 0.0   # times the hit's distance from the eye (normals.step = "pixel")
 
 
 @dataclass(frozen=True)

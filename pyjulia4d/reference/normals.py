@@ -104,14 +104,14 @@ def normal_gradient(p, c, max_iter, bailout, h, frame: Frame, formula: Formula =
 def normals_gradient(point, status, frame: Frame, march: MarchArgs, normals: NormalsArgs, guard=None,
                      formula: Formula = QUATERNION_SQR):
     """normals/gradient.cl with the same records (the march's c, max_iter, bailout; the
-    normals' difference step, h + k |p - eye|): unit normals of the hits, 0 elsewhere."""
+    normals' difference step, max(h, k |p - eye|)): unit normals of the hits, 0 elsewhere."""
     c, max_iter, bailout = march.c, march.max_iter, march.bailout
     out = np.zeros(point.shape[:-1] + (3,))
     hit = status == STATUS_HIT
     if hit.any():
         g = np.zeros(int(hit.sum()), np.int64)
         p = point[hit]
-        h = normals.step + normals.step_per_distance * np.linalg.norm(p - frame.position, axis=-1)[:, None]
+        h = np.maximum(normals.step, normals.step_per_distance * np.linalg.norm(p - frame.position, axis=-1))[:, None]
         with np.errstate(invalid="ignore"):
             out[hit] = to_camera_unit(normal_gradient(p, c, max_iter, bailout, h, frame, formula), g)
         if guard is not None:
