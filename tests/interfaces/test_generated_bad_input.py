@@ -86,15 +86,23 @@ def _out_of_range(rng: random.Random, valid, integer: bool) -> list:
     return vals
 
 
+def _words_and_inner(check) -> tuple[list[str], object]:
+    """A checker's words (an OrWord's, nested OrWords' too) and the checker beneath them."""
+    words = []
+    while type(check).__name__ == "OrWord":
+        words.append(check.word)
+        check = check.inner
+    return words, check
+
+
 def bad_values(rng: random.Random, key: str) -> list[str]:
     """--set values that are bad for ``key`` whatever the rest of the scene."""
     check = _check_of(key)
     kind = type(check).__name__
-    word = getattr(check, "word", None)
-    inner = getattr(check, "inner", check)
+    words, inner = _words_and_inner(check)
     inner_kind = type(inner).__name__
     vals: list[str] = []
-    garbage = [g for g in GARBAGE if g.strip() != word]
+    garbage = [g for g in GARBAGE if g.strip() not in words]
     vals += rng.sample(garbage, 3) + [_unicode(rng, rng.randint(1, 12))]
     if kind == "Bool":   # "true" and "false" (and with spaces around them) are its values
         return [v for v in vals if v.strip() not in ("true", "false")] + ["True", "yes", "1", "on"]
@@ -117,7 +125,7 @@ def bad_values(rng: random.Random, key: str) -> list[str]:
         vals = [v for v in vals if v.strip() not in ("", "[]")]
         return vals + ["[[0, 1, 0, 0]]", "[[0.5, 1, 0, 0], [0.2, 0, 0, 1]]", "[[0, 1, 0, 0], [1, 2, 0, 0]]",
                        "[[0, 1, 0], [1, 0, 0, 1]]", "[[0, 1, 0, 0], [1, nan, 0, 0]]", "[[0, 1, 0, 0], [1"]
-    if word:
+    for word in words:
         vals += [word.upper(), word + "s", f"[{word}]"]
     if inner_kind == "Real":
         vals += [rng.choice(NONFINITE)] + [_fmt(v) for v in rng.sample(_out_of_range(rng, inner.range, False), 3)]
@@ -209,8 +217,7 @@ def _toml_wrong_types(key: str) -> list[str]:
 
 def _toml_out_of_range(rng: random.Random, key: str) -> list[str]:
     """TOML literals of the right type but outside the key's range."""
-    check = _check_of(key)
-    inner = getattr(check, "inner", check)
+    inner = _words_and_inner(_check_of(key))[1]
     kind = type(inner).__name__
     if kind == "Real":
         return [_toml_float(v) for v in rng.sample(_out_of_range(rng, inner.range, False), 2)]

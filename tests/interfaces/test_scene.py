@@ -309,7 +309,9 @@ def _edges():
     every numeric key; vectors get every component at the edge."""
     for section, table in CHECKS.items():
         for key, check in table.items():
-            inner = getattr(check, "inner", check)  # "auto" or a number
+            inner = check
+            while hasattr(inner, "inner"):   # "auto" (or "auto" or "pixel") or a number
+                inner = inner.inner
             element = getattr(inner, "element", None)  # a vector's components
             rng = getattr(element or inner, "range", None)
             if rng is None:
