@@ -131,38 +131,11 @@ def record(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.stack(its, 1), np.stack(ts, 1), np.stack(ds, 1)
 
 
-def enclosure_iterations(o, d, t0, t1, c, max_iter, bailout, formula) -> np.ndarray:
-    """Per ray, 1 + the iterations its lane of reference/march.py enc_prove stays live: until its
-    form is outside the bailout or the ladder's radius (each component's too, for a split
-    algebra) or no longer hopeful, at most the kind's steps (kernels/march/proven.cl enc_prove)."""
-    K = formula.kind_enclose
-    E = K if formula.own_map else formula.enclose
-    steps = K.enc_steps(max_iter)
-    lad = K.ladder(c, max_iter, bailout, formula) if hasattr(K, "ladder") else None
-    thr, thr2, parts = lad if lad else ([bailout] * 8, [bailout * bailout] * 8, None)
-    j = min(steps, len(thr) - 1)
-    with np.errstate(all="ignore"):
-        e, p = K.enc_start(o, d, t0, t1, c, formula)
-        live = ~E.enc_outside(e, thr2[j])
-        n = np.ones(len(o), np.int64)
-        for k in range(steps):
-            if not live.any():
-                break
-            e = K.enc_next(e, p, formula)
-            n += live
-            j = min(steps - k - 1, len(thr) - 1)
-            out = E.enc_outside(e, thr2[j])
-            if parts:
-                out |= E.enc_outside_parts(e, parts[1][j], parts[3][j])
-            live &= ~out & E.enc_hopeful(e, bailout)
-    return n
-
-
 def record_proven(scene: Scene) -> np.ndarray:
-    """Every ray's cost at each step of the proven march (enclosure_iterations, from the float64
-    twin's own march at the scene's preset): an (n, steps) array, 0 beyond its last step.  The
-    twin's enc_prove is wrapped for the run; rays are told apart by their directions (one ray a
-    pixel)."""
+    """Every ray's cost at each step of the proven march, from the float64 twin's own march at
+    the scene's preset (reference/march.py enc_prove counts 1 plus the iterations its lane
+    stays live): an (n, steps) array, 0 beyond its last step.  The twin's enc_prove is wrapped
+    for the run; rays are told apart by their directions (one ray a pixel)."""
     rm = importlib.import_module("pyjulia4d.reference.march")
     W, H = scene.image.width, scene.image.height
     o, d = (np.asarray(a, np.float64) for a in generate_rays(camera_frame(scene), W, H)[:2])
@@ -171,9 +144,11 @@ def record_proven(scene: Scene) -> np.ndarray:
     original = rm.enc_prove
 
     def counted(o_, d_, t0, t1, c, max_iter, bailout, formula):
-        for row, k in zip(d_, enclosure_iterations(o_, d_, t0, t1, c, max_iter, bailout, formula)):
+        slots = np.zeros(len(o_), np.int64)
+        out = original(o_, d_, t0, t1, c, max_iter, bailout, formula, iterations=slots)
+        for row, k in zip(d_, slots):
             rows[index[row.tobytes()]].append(int(k))
-        return original(o_, d_, t0, t1, c, max_iter, bailout, formula)
+        return out
 
     rm.enc_prove = counted
     try:

@@ -178,13 +178,15 @@ def march_de(o, d, near, far, c, max_iter, bailout, epsilon, z_resolution, post_
 
 # ------------------------------------------------------------------- march/proven.cl
 
-def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
+def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula, iterations=None):
     """Per ray: whether [t0, t1] is proven empty - an enclosure of its points' orbits
     (reference/enclose/) outside the bailout ball at some n <= max_iter, or outside the
     radius that passes it within the max_iter - n iterations left (the kind's ladder) -, the
     largest enc_margin over the iterations (0 where none is positive), and the largest s in
     [-1, 1] whose part [-1, s] of the segment some iteration's enclosure keeps outside (1 where
-    proven, -1 where none, or where the enclosure piece has no enc_prefix) (march/proven.cl)."""
+    proven, -1 where none, or where the enclosure piece has no enc_prefix) (march/proven.cl).
+    ``iterations`` (int array, optional) gets 1 (the start and its tests) plus the iterations each
+    ray's form stayed live: the lane-slots it holds in a packet (benchmarks/studies/march_levers.py)."""
     K = formula.kind_enclose
     E = K if formula.own_map else formula.enclose   # a kind with a map of its own encloses all of it
     enc_prefix = getattr(E, "enc_prefix", None)
@@ -200,12 +202,16 @@ def enc_prove(o, d, t0, t1, c, max_iter, bailout, formula: Formula):
         e, p = K.enc_start(o, d, t0, t1, c, formula)
         proven = E.enc_outside(e, thr2[j])
         live = ~proven
+        if iterations is not None:
+            iterations += 1
         best = np.fmax(E.enc_margin(e, thr[j]), 0.0)
         pre = enc_prefix(e, thr[j]) if enc_prefix else np.full(len(o), -1.0)
         for n in range(steps):
             if not live.any():
                 break
             e = K.enc_next(e, p, formula)
+            if iterations is not None:
+                iterations += live
             j = min(steps - n - 1, LADDER_N - 1)
             # only where the form may pass a test (march/proven.cl ENC_GATE)
             near = live & enc_gate(e, thr[j]) if enc_gate else live

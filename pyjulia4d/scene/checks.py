@@ -462,6 +462,16 @@ class ImageFile:
 class OrWord:
     """The literal string ``word``, else what ``inner`` accepts (another OrWord: a second word)."""
 
+    @staticmethod
+    def split(check: Any) -> tuple[tuple[str, ...], Any]:
+        """A key's checker as (its words, the checker beneath them): nested OrWords' words in
+        order, ((), check) for any other checker."""
+        words = []
+        while isinstance(check, OrWord):
+            words.append(check.word)
+            check = check.inner
+        return tuple(words), check
+
     verbatim = False
 
     def __init__(self, word: str, inner: Any) -> None:

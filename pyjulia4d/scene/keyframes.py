@@ -54,8 +54,7 @@ CAMERA_VECTORS = ("camera.position", "camera.target", "camera.up", "camera.limbo
 def _numeric(check: Any) -> Any:
     """The numeric checker behind a scene key's checker, or None for a non-numeric key
     (a choice, a boolean, the clip planes); "eye"/"auto" words are not interpolated."""
-    while isinstance(check, OrWord):   # "auto" or "pixel" or a number: the number
-        check = check.inner
+    check = OrWord.split(check)[1]   # "auto" (or "auto" or "pixel") or a number: the number
     return check if isinstance(check, (Real, Integer, Vector)) else None
 
 

@@ -26,6 +26,7 @@ import pytest
 
 import pyjulia4d
 from pyjulia4d.app import cli
+from pyjulia4d.scene.checks import OrWord
 from pyjulia4d.scene.ranges import CHECKS
 
 PKG_ROOT = str(Path(pyjulia4d.__file__).resolve().parent.parent)
@@ -86,20 +87,11 @@ def _out_of_range(rng: random.Random, valid, integer: bool) -> list:
     return vals
 
 
-def _words_and_inner(check) -> tuple[list[str], object]:
-    """A checker's words (an OrWord's, nested OrWords' too) and the checker beneath them."""
-    words = []
-    while type(check).__name__ == "OrWord":
-        words.append(check.word)
-        check = check.inner
-    return words, check
-
-
 def bad_values(rng: random.Random, key: str) -> list[str]:
     """--set values that are bad for ``key`` whatever the rest of the scene."""
     check = _check_of(key)
     kind = type(check).__name__
-    words, inner = _words_and_inner(check)
+    words, inner = OrWord.split(check)
     inner_kind = type(inner).__name__
     vals: list[str] = []
     garbage = [g for g in GARBAGE if g.strip() not in words]
@@ -217,7 +209,7 @@ def _toml_wrong_types(key: str) -> list[str]:
 
 def _toml_out_of_range(rng: random.Random, key: str) -> list[str]:
     """TOML literals of the right type but outside the key's range."""
-    inner = _words_and_inner(_check_of(key))[1]
+    inner = OrWord.split(_check_of(key))[1]
     kind = type(inner).__name__
     if kind == "Real":
         return [_toml_float(v) for v in rng.sample(_out_of_range(rng, inner.range, False), 2)]

@@ -12,8 +12,8 @@ import pytest
 
 from pyjulia4d.scene.model import SECTIONS, Scene
 
+from pyjulia4d.scene.checks import OrWord, SceneError
 from pyjulia4d.scene.ranges import CHECKS, valid_range
-from pyjulia4d.scene.checks import SceneError
 from pyjulia4d.fractal.registry import march_method
 
 if sys.version_info >= (3, 11):
@@ -309,9 +309,7 @@ def _edges():
     every numeric key; vectors get every component at the edge."""
     for section, table in CHECKS.items():
         for key, check in table.items():
-            inner = check
-            while hasattr(inner, "inner"):   # "auto" (or "auto" or "pixel") or a number
-                inner = inner.inner
+            inner = OrWord.split(check)[1]   # "auto" (or "auto" or "pixel") or a number
             element = getattr(inner, "element", None)  # a vector's components
             rng = getattr(element or inner, "range", None)
             if rng is None:
