@@ -20,10 +20,24 @@ machine, and the kernels' times follow them).
   march/cone.cl's), started a little in front of the bounding ball so that every ray of the
   block begins behind it; each ray then runs the proven march from where the beam's proofs
   ended.  Printed: enclosures per pixel, the beam's share included.
+* lengths known in advance (an oracle): each step the longest segment an enclosure proves,
+  searched on lengths floor x 2^(k/3), until not even the floor proves (where the march finds
+  the surface).  Printed: its enclosures and iterations per ray against the march's own (each
+  enclosure costing 1 plus the iterations it stays live, as a packet's lanes are held:
+  reference/march.py enc_prove ``iterations``): what no rule for the next length can beat.
+* affine beams: one form per B x B block for the whole slab of its rays between two depths,
+  with three noise symbols - along the rays and across them in x and y - so that the spread
+  across the block is carried to first order as a tangent, not as a ball (affine arithmetic:
+  Stolfi & de Figueiredo, "Self-Validated Numerical Methods and Applications", 1997, §3; the
+  cone-widened beam above carries it as a ball).  Quaternion squares only.  The slab marches
+  by the proven march's rule for its lengths; each ray then marches from the slab's end.
+  Printed: iterations per ray with the beams' counted at COST_3 times a ray's per iteration,
+  spread over the block's rays (a beam iterates ten quaternion products to a ray's three).
 
 Appends a section to benchmarks/results/proof_budget.md.
 
-    python benchmarks/studies/proof_budget.py [--size 80x60] [--beam-size 320x240]
+    python benchmarks/studies/proof_budget.py [--size 80x60] [--beam-size 320x240] [--affine-size 640x480]
+        [--affine-block 8] [--affine-stride 7]
 """
 from __future__ import annotations
 
@@ -43,7 +57,8 @@ from benchmarks.lib.runlog import append_study, git_commit, utc_now  # noqa: E40
 
 from pyjulia4d import Scene  # noqa: E402
 from pyjulia4d.pipeline.plan import make_plan  # noqa: E402
-from pyjulia4d.reference.algebra.quaternion import alg_cube, alg_sqr  # noqa: E402
+from pyjulia4d.reference.algebra.quaternion import alg_cube, alg_mul, alg_sqr  # noqa: E402
+from pyjulia4d.reference.enclose.julia import LADDER_N, ladder  # noqa: E402
 from pyjulia4d.reference.cone import centre_rays, cone_of_pixels  # noqa: E402
 from pyjulia4d.reference.formula import formula_of  # noqa: E402
 from pyjulia4d.reference.iterate import julia_distance_formula  # noqa: E402
@@ -134,6 +149,151 @@ def ball_march(o, d, near, far, c, max_iter, bailout, degree, floor):
     return steps
 
 
+def march_iterations(plan, F, o, d, near, far):
+    """The proven march's enclosures and iterations per ray (each enclosure 1 plus the iterations
+    it stays live)."""
+    ma, real, tot = plan.march, rm.enc_prove, [0, 0]
+
+    def counted(*a, **k):
+        it = np.zeros(len(a[0]), int)
+        got = real(*a, iterations=it, **k)
+        tot[0] += len(a[0])
+        tot[1] += int(it.sum())
+        return got
+
+    rm.enc_prove = counted
+    try:
+        rm.march_proven(o, d, near, far, np.asarray(ma.c, float), ma.max_iter, ma.bailout, ma.epsilon,
+                        ma.z_resolution, ma.post_steps, 20000, True, F)
+    finally:
+        rm.enc_prove = real
+    return tot[0] / len(o), tot[1] / len(o)
+
+
+def oracle_march(plan, F, o, d, near, far):
+    """Segments each the longest an enclosure proves, of lengths floor x 2^(k/3) (module
+    docstring), until not even the floor proves: enclosures and iterations per ray (only the
+    proof that is kept is counted), the rays that ended so, and the p10, p50 and p90 of those
+    lengths over the distance estimate where each began."""
+    ma = plan.march
+    c = np.asarray(ma.c, float)
+    floor = (far - near) / ma.z_resolution
+    t, active = near.copy(), np.ones(len(o), bool)
+    enc, its, stuck = np.zeros(len(o)), np.zeros(len(o)), np.zeros(len(o), bool)
+    per_estimate = []
+    while active.any():
+        k = np.nonzero(active)[0]
+        best, cost = np.zeros(k.size), np.zeros(k.size)
+        for f in 2.0 ** (np.arange(60) / 3.0):
+            h = floor[k] * f
+            fits = h <= (far[k] - near[k]) * 1.0001
+            if not fits.any():
+                break
+            t1 = np.minimum(t[k] + h, far[k])
+            it = np.zeros(k.size, int)
+            ok = rm.enc_prove(o[k], d[k], t[k], t1, c, ma.max_iter, ma.bailout, F, iterations=it)[0] & fits
+            longer = ok & (t1 - t[k] > best)
+            best, cost = np.where(longer, t1 - t[k], best), np.where(longer, it, cost)
+        got = best > 0
+        dist = julia_distance_formula(o[k] + t[k, None] * d[k], c, ma.max_iter, ma.bailout, F)[0]
+        per_estimate.append((best / dist)[got & (dist > 0)])
+        enc[k] += got
+        its[k] += cost
+        t[k] += best
+        stuck[k[~got]] = True
+        active[k[~got | (t[k] >= far[k] - 1e-12)]] = False
+    return enc.mean(), its.mean(), int(stuck.sum()), np.percentile(np.concatenate(per_estimate), [10, 50, 90])
+
+
+COST_3 = 10 / 3   # a three-symbol iteration's quaternion products over a one-symbol one's (module docstring)
+
+
+def slab_prove(o, D0, Du, Dv, ta, tb, c, max_iter, bailout, thr):
+    """Whether the slab {o + tau (D0 + u Du + v Dv): tau in [ta, tb], u, v in [-1, 1]} holds no point
+    of the truncated set of q^2 + c, per slab: one affine form q = m + s a + u b + v e + B(r),
+    squared as enclose/ball.cl squares its one symbol - each symbol's square half in the centre
+    and half in the ball, the cross terms s u (a b + b a) and the like in the ball, |J[E]| <=
+    2 |m| r and the error's products with the tangents and itself, 2 (|a| + |b| + |e|) r + r^2;
+    outside where the least |m + s a| over s, less |b| + |e| + r, is past the ladder's radius
+    ``thr`` for the iterations left.  Returns (proven, iterations + 1, margin)."""
+    tm, th = (ta + tb) / 2, (tb - ta) / 2
+    m, a = o + tm[:, None] * D0, th[:, None] * D0
+    b, e = tm[:, None] * Du, tm[:, None] * Dv
+    r = th * (np.linalg.norm(Du, axis=1) + np.linalg.norm(Dv, axis=1))   # the products s u, s v
+    n = np.linalg.norm
+
+    def test(m, a, b, e, r, j):
+        aa, ma_ = np.sum(a * a, 1), np.sum(m * a, 1)
+        s = np.clip(-ma_ / np.where(aa > 0, aa, 1.0), -1, 1)
+        least = n(m + s[:, None] * a, axis=1) - n(b, axis=1) - n(e, axis=1) - r
+        return least > thr[j], (n(m, axis=1) - thr[j]) / (n(a, axis=1) + n(b, axis=1) + n(e, axis=1) + r)
+
+    with np.errstate(all="ignore"):   # forms far past the bailout overflow: no proof there, as in the kernel
+        proven, margin = test(m, a, b, e, r, min(max_iter, LADDER_N - 1))
+        margin = np.fmax(margin, 0.0)
+        live, its = ~proven, np.ones(len(ta), int)
+        for it in range(max_iter):
+            if not live.any():
+                break
+            lm, la, lb, le = (n(x, axis=1) for x in (m, a, b, e))
+            cross = sum(n(alg_mul(x, y) + alg_mul(y, x), axis=1) for x, y in ((a, b), (a, e), (b, e)))
+            r = 2 * (lm + la + lb + le) * r + r * r + (la ** 2 + lb ** 2 + le ** 2) / 2 + cross
+            m, a, b, e = (alg_sqr(m) + c + (alg_sqr(a) + alg_sqr(b) + alg_sqr(e)) / 2,
+                          alg_mul(m, a) + alg_mul(a, m), alg_mul(m, b) + alg_mul(b, m), alg_mul(m, e) + alg_mul(e, m))
+            its += live
+            out, mg = test(m, a, b, e, r, min(max_iter - it - 1, LADDER_N - 1))
+            proven |= out & live
+            margin = np.where(live, np.fmax(margin, mg), margin)
+            live &= ~out & (la + lb + le + r < 2 * (lm + bailout))   # enclose/ball.cl enc_hopeful
+    return proven, its, margin
+
+
+def affine_beams(plan, F, w, h, block, stride):
+    """Every ``stride``-th block's slab march (slab_prove, the proven march's length rule, until a
+    failed try is under 1/500 of the span) and then its rays' proven marches from the slab's end:
+    (rays, the beams' iterations per ray weighted by COST_3, the rays' iterations per ray from
+    the slab's end, from their entry, the share of hits alike)."""
+    ma, fr = plan.march, plan.frame
+    c = np.asarray(ma.c, float)
+    thr = ladder(c, ma.max_iter, ma.bailout, F)[0]
+    ux = lambda x: (2 * (x + 0.5) / w - 1) * fr.tan_half_fov * w / h   # rays.py generate_rays
+    vy = lambda y: (1 - 2 * (y + 0.5) / h) * fr.tan_half_fov
+    nbx = w // block
+    ids = np.arange(nbx * (h // block))[::stride]
+    x0, y0 = (ids % nbx) * block, (ids // nbx) * block
+    D0 = fr.forward + ((ux(x0) + ux(x0 + block - 1)) / 2)[:, None] * fr.right +         ((vy(y0) + vy(y0 + block - 1)) / 2)[:, None] * fr.up
+    Du = ((ux(x0 + block - 1) - ux(x0)) / 2)[:, None] * fr.right
+    Dv = ((vy(y0) - vy(y0 + block - 1)) / 2)[:, None] * fr.up
+    jj, ii = np.mgrid[0:block, 0:block]
+    px, py = (x0[:, None] + ii.ravel()).ravel(), (y0[:, None] + jj.ravel()).ravel()
+    D = fr.forward + ux(px)[:, None] * fr.right + vy(py)[:, None] * fr.up
+    blk = np.repeat(np.arange(ids.size), block * block)
+    dn = np.linalg.norm(D, axis=1)
+    d, o = D / dn[:, None], np.tile(fr.position, (len(D), 1))
+    near, far, live = rm.ball_span(o, d, ma.radius, ma.near, ma.far)
+    live &= far >= near
+    lo = np.full(ids.size, np.inf)
+    hi = np.full(ids.size, -np.inf)
+    np.minimum.at(lo, blk[live], (near / dn)[live])
+    np.maximum.at(hi, blk[live], (far / dn)[live])
+    tau, step = lo.copy(), (hi - lo) * rm.PROVEN_FIRST
+    active, its = np.isfinite(lo) & (hi > lo), np.zeros(ids.size)
+    while active.any():
+        k = np.nonzero(active)[0]
+        t1 = np.minimum(tau[k] + step[k], hi[k])
+        ok, it, mg = slab_prove(fr.position, D0[k], Du[k], Dv[k], tau[k], t1, c, ma.max_iter, ma.bailout, thr)
+        its[k] += it
+        fac = np.sqrt(np.maximum(np.nan_to_num(mg) * rm.PROVEN_GAIN, 0.0))   # march/proven.cl's steering
+        tau[k] = np.where(ok, t1, tau[k])
+        step[k] = np.where(ok, step[k] * np.clip(fac, 1, 4), step[k] * np.clip(fac, 1 / 64, 0.5))
+        active[k[(~ok & (step[k] < (hi[k] - lo[k]) / 500)) | (t1 >= hi[k])]] = False
+    start = np.clip(np.maximum(near, tau[blk] * dn), near, far)
+    o, d, near, far, start = o[live], d[live], near[live], far[live], start[live]
+    after = march_iterations(plan, F, o, d, start, far)[1]
+    plain = march_iterations(plan, F, o, d, near, far)[1]
+    return int(live.sum()), its.sum() * COST_3 / live.sum(), after, plain
+
+
 def beam_starts(plan, F, w, h, lead):
     """(t_lo, t_last) per 4x4 block: the block's centre ray proven with widened enclosures from
     ``lead`` in front of its entry of the bounding ball; the number of enclosures."""
@@ -179,6 +339,9 @@ def main(argv=None) -> int:
     ap = Parser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="80x60")
     ap.add_argument("--beam-size", default="320x240", help="the beam start's image (its cone depends on the pixel size)")
+    ap.add_argument("--affine-size", default="640x480", help="the affine beams' image")
+    ap.add_argument("--affine-block", type=int, default=8, help="the affine beams' block of pixels, a side")
+    ap.add_argument("--affine-stride", type=int, default=7, help="every how many blocks an affine beam is tried")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     a = ap.parse_args(argv)
     w, h = size_of(a.size)
@@ -218,7 +381,8 @@ def main(argv=None) -> int:
     behind = (start[blive] > bnear[blive]) & np.isfinite(bdepth)
     gap_left = float(np.median((bdepth - start[blive])[behind])) if behind.any() else float("nan")
     text = [f"\n## {utc_now()}, commit {git_commit()}\n\n",
-            f"`python benchmarks/studies/proof_budget.py --size {w}x{h} --beam-size {bw}x{bh}`: the default scene's "
+            f"`python benchmarks/studies/proof_budget.py --size {w}x{h} --beam-size {bw}x{bh} --affine-size "
+            f"{a.affine_size} --affine-block {a.affine_block} --affine-stride {a.affine_stride}`: the default scene's "
             f"{len(o)} rays that meet the bounding ball, float64 twin.\n\n",
             "| march | per ray |\n| --- | --- |\n", "\n".join(lines) + "\n\n",
             f"- Proven march, enclosures per hit ray by distance in front of its depth: {spread}.\n",
@@ -228,6 +392,20 @@ def main(argv=None) -> int:
             f"the beam plus {beam_count / (bw * bh):.2f} for the beams ({beam_count / len(cone[0]):.1f} per block); "
             f"{np.mean(start[blive] > bnear[blive]) * 100:.0f} % of the rays started behind a beam, "
             f"the hits among them a median {gap_left:.2f} in front of their depth.\n"]
+    oe, oi, stuck, q_est = oracle_march(plan, F, o, d, near, far)
+    me, mi = march_iterations(plan, F, o, d, near, far)
+    last = stuck * (1 + ma.max_iter) / len(o)   # the surface's floor segment, one full enclosure each
+    text.append(f"- Lengths known in advance (at {w}x{h}): {oe:.1f} enclosures and {oi:.0f} iterations per ray to "
+                f"where not even the floor proves ({stuck} rays; one full enclosure more for each, {last:.0f} per "
+                f"ray), against the march's {me:.1f} and {mi:.0f} to its hit or exit: {(oi + last) / mi:.2f}x its "
+                f"iterations. Those lengths over the distance estimate where each began: p10 {q_est[0]:.2f}, p50 "
+                f"{q_est[1]:.2f}, p90 {q_est[2]:.2f}.\n")
+    aw, ah = size_of(a.affine_size)
+    n, beam, after, plain = affine_beams(setup(aw, ah)[0], F, aw, ah, a.affine_block, a.affine_stride)
+    text.append(f"- Affine beams of {a.affine_block}x{a.affine_block} pixels at {aw}x{ah} (one block in "
+                f"{a.affine_stride}, {n} rays): {beam:.1f} iterations per ray for the beams (x{COST_3:.2f}) "
+                f"and {after:.1f} for the rays after them, against {plain:.1f} from the entry: "
+                f"{(beam + after) / plain:.2f}x.\n")
     print("".join(text))
     append_study(a.out, "benchmarks/studies/proof_budget.py", "Where a proof of the space in front spends its work", "".join(text))
     return 0

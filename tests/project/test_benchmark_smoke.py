@@ -521,11 +521,63 @@ def test_proof_budget_ball_is_proven_and_the_largest():
     assert pb.best_ball(np.zeros((1, 4)), np.zeros(4), 12, 4.0, 2)[0] == 0.0   # 0 is inside for c = 0
 
 
+def test_proof_budget_slab_is_proven():
+    """benchmarks/studies/proof_budget.py's affine slab (three noise symbols): every point drawn in a
+    slab it proves - any depth in it, anywhere across the block, the block's corners included -
+    escapes (|q_k| > bailout for some k <= max_iter, iterated in float64); slabs through the set
+    are not proven; and the margin grows as the slab shortens."""
+    from pyjulia4d.reference.algebra.quaternion import alg_sqr
+    from pyjulia4d.reference.enclose.julia import ladder
+    from pyjulia4d.reference.formula import formula_of
+    from pyjulia4d.reference.iterate import julia_inside
+    from pyjulia4d.scene.model import Scene
+    pb = load("proof_budget")
+    rng = np.random.default_rng(8)
+    s = Scene.default()
+    c, mi, b = np.asarray(s.fractal.c, float), s.fractal.max_iter, s.fractal.bailout
+    thr = ladder(c, mi, b, formula_of(s.fractal))[0]
+    o = np.array([0.0, 0.0, -3.0, 0.0])
+    D0 = np.column_stack([rng.normal(0, 0.15, 60), rng.normal(0, 0.15, 60), np.ones(60), np.zeros(60)])
+    # slabs ending a little in front of where the centre ray meets the set (a scan of 3000 steps),
+    # where a proof takes many iterations and every bound counts; the rays that meet it
+    tau = np.linspace(0.0, 4.0, 3001)
+    inside = julia_inside((o + tau[:, None, None] * D0[None]).reshape(-1, 4), c, mi, b).reshape(len(tau), 60)
+    D0 = D0[inside.any(axis=0)][:24]
+    n = len(D0)
+    assert n >= 12
+    hit = tau[inside[:, inside.any(axis=0)][:, :24].argmax(axis=0)]
+    Du, Dv = np.tile([0.002, 0, 0, 0], (n, 1)), np.tile([0, 0.002, 0, 0], (n, 1))
+    tb = hit - rng.uniform(0.02, 0.1, n)
+    ta = tb - rng.uniform(0.005, 0.05, n)
+    proven, its, margin = pb.slab_prove(o, D0, Du, Dv, ta, tb, c, mi, b, thr)
+    assert 6 <= proven.sum() < n and its[proven].max() >= 6
+    for i in np.nonzero(proven)[0]:
+        tau = rng.uniform(ta[i], tb[i], 300)
+        uv = np.vstack([rng.uniform(-1, 1, (296, 2)), [[-1, -1], [-1, 1], [1, -1], [1, 1]]])
+        q = o + tau[:, None] * (D0[i] + uv[:, :1] * Du[i] + uv[:, 1:] * Dv[i])
+        escaped = np.linalg.norm(q, axis=1) > b
+        for _ in range(mi):
+            q = np.where(escaped[:, None], q, alg_sqr(q) + c)
+            escaped |= np.linalg.norm(q, axis=1) > b
+        assert escaped.all(), i
+    # slabs across the first crossing hold a point of the set, short or long: a long one's centre
+    # escapes early, and only the form's second-order terms keep it from being proven (without
+    # them, slabs of 0.2 and 0.5 here were)
+    for before in (0.01, 0.2, 0.5, 1.0):
+        for after in (0.0015, 0.01):
+            assert not pb.slab_prove(o, D0, Du, Dv, hit - before, hit + after, c, mi, b, thr)[0].any()
+    short = pb.slab_prove(o, D0[:1], Du[:1], Dv[:1], ta[:1], ta[:1] + 0.001, c, mi, b, thr)[2]
+    long_ = pb.slab_prove(o, D0[:1], Du[:1], Dv[:1], ta[:1], ta[:1] + 0.3, c, mi, b, thr)[2]
+    assert short[0] >= long_[0]
+
+
 def test_proof_budget_report_runs(tmp_path):
     """benchmarks/studies/proof_budget.py, tiny (the float64 twin, no OpenCL): every row."""
-    assert load("proof_budget").main(["--size", "16x12", "--beam-size", "32x24", "--out", str(tmp_path)]) == 0
+    assert load("proof_budget").main(["--size", "16x12", "--beam-size", "32x24", "--affine-size", "48x32",
+                                      "--affine-stride", "2", "--out", str(tmp_path)]) == 0
     md = (tmp_path / "proof_budget.md").read_text()
     assert "commit" in md and "| proven march, normal preset |" in md and "Beam start at 32x24" in md
+    assert "Lengths known in advance (at 16x12)" in md and "Affine beams of 8x8 pixels at 48x32" in md
 
 
 def test_path_noise_sources_report_runs(tmp_path):
