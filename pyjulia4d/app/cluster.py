@@ -31,6 +31,7 @@ import numpy as np
 
 from pyjulia4d.pipeline import film
 from pyjulia4d.pipeline.backdrop import check_backdrop
+from pyjulia4d.pipeline.environment import check_environment
 from pyjulia4d.pipeline.workload import OUTPUTS
 from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
@@ -442,6 +443,7 @@ def render_on_cluster(scene: Scene, workers: int | None = None, scheduler: str |
     check_where(workers, scheduler)
     require_cluster(workers, scheduler)
     film.check_denoiser(scene)
+    check_environment(scene)
     check_backdrop(scene)
     check(scene, check_device(device, scheduler), force=force, outputs=outputs)
     with cluster(workers, scheduler, device) as client:

@@ -3,6 +3,7 @@ writers (atomic: pyjulia4d/files.py) and the reader of their headers."""
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import re
 import stat
@@ -427,6 +428,19 @@ def closing_line(out: Path, scene: Any, result: Any, tail: str, verbose: bool, w
     return head + (result.brief(chosen) if hasattr(result, "brief") else "") + framed + hint
 
 
+@contextlib.contextmanager
+def library_quiet(name: str) -> Iterator[None]:
+    """The log records of the library logging as ``name`` dropped while in the block: tifffile
+    logs what it finds wrong with a damaged file to the standard error, where the caller's one
+    line, naming the file, says it already."""
+    log = logging.getLogger(name)
+    was, log.disabled = log.disabled, True
+    try:
+        yield
+    finally:
+        log.disabled = was
+
+
 def read_header(path: str | Path) -> dict[str, str] | None:
     """An image's header entries (PNG text chunks, EXR string attributes), as write_image
     wrote them; None if it cannot be read (OutputError if ``path`` is no path at all)."""
@@ -440,7 +454,7 @@ def read_header(path: str | Path) -> dict[str, str] | None:
             import json
 
             import tifffile
-            with tifffile.TiffFile(path) as t:
+            with library_quiet("tifffile"), tifffile.TiffFile(path) as t:
                 description = t.pages[0].description or "{}"
             try:   # another program's description (not our JSON object) is no damage: no entries
                 text = json.loads(description)

@@ -17,7 +17,7 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from pyjulia4d.app.output import OutputError, check_directory, output_errors
+from pyjulia4d.app.output import OutputError, check_directory, library_quiet, output_errors
 from pyjulia4d.files import atomic_write, path_text, quoted_path, shown_path
 from pyjulia4d.resources import module_installed
 
@@ -86,7 +86,8 @@ def _read_rgb(p: Path) -> np.ndarray:
     if p.suffix.lower() in (".tif", ".tiff"):   # 8 or 16 bits a channel (image.bits)
         import tifffile
 
-        rgba = tifffile.imread(p)
+        with library_quiet("tifffile"):
+            rgba = tifffile.imread(p)
         return (rgba[..., :3] >> 8).astype(np.uint8) if rgba.dtype == np.uint16 else rgba[..., :3]
     from PIL import Image
 

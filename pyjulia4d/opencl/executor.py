@@ -22,6 +22,7 @@ from pyjulia4d.opencl.failures import DeviceFailure, on_device
 from pyjulia4d.opencl.lanes import lanes_for, march_lanes, packet_pairs
 from pyjulia4d.opencl.passes import kernel_seconds, run_plan, run_tiles
 from pyjulia4d.pipeline.backdrop import check_backdrop
+from pyjulia4d.pipeline.environment import check_environment
 from pyjulia4d.pipeline.film import check_denoiser, finish
 from pyjulia4d.opencl.runner import TileRunner, local_size, march_items
 from pyjulia4d.pipeline import workload
@@ -74,6 +75,7 @@ def render(scene: Scene, device: cl.Device | str | None = None, progress: bool =
     if not isinstance(store, ImageStore):
         raise SceneError("store", f"expected a pyjulia4d.pipeline.store.ImageStore, got {type(store).__name__}")
     check_denoiser(scene)
+    check_environment(scene)
     if args.region is None:
         check_backdrop(scene)
     if fallback is not None:

@@ -78,6 +78,16 @@ def load(value: str) -> Environment:
     return _load(str(p), st.st_size, st.st_mtime_ns, value)
 
 
+def check_environment(scene) -> None:
+    """The map a scene names in shading.environment read and checked before any render, whatever
+    its integrator (only the path tracer's light comes from it): a file named that cannot be
+    used is one SceneError, as a backdrop image's is, not a scene that renders until its
+    integrator changes.  The words ("uniform" and the packaged images') need no reading."""
+    value = scene.shading.environment
+    if value != "uniform" and value not in SHIPPED:
+        load(value)
+
+
 @functools.lru_cache(maxsize=4)
 def _load(path: str, size: int, mtime: int, value: str) -> Environment:
     import OpenImageIO as oiio

@@ -115,6 +115,24 @@ def test_render_an_image_bad(tmp_path: Path, capsys, make, why) -> None:
     assert set(tmp_path.iterdir()) == before
 
 
+@pytest.mark.parametrize("name,data,what", [
+    ("src.tif", b"II*\x00garbage", "TIF"),              # tifffile logs what it found wrong: not shown
+    ("src.tif", b"MM\x00*\x00\x00\x00\x08" + b"\xff" * 40, "TIF"),
+    ("src.exr", b"v/1\x01" + b"\x00" * 50, "EXR"),
+    ("src.png", b"\x89PNG\r\n\x1a\n" + b"\x00" * 20, "PNG"),
+])
+def test_a_damaged_image_is_one_line(tmp_path: Path, name, data, what) -> None:
+    """In a process of its own, where nothing catches a library's log records: the one line and
+    nothing else on the standard error (this process's own test logging would hide them)."""
+    src = tmp_path / name
+    src.write_bytes(data)
+    p = _cli(["render", str(src), "-o", str(tmp_path / "out.png")], tmp_path)
+    assert p.returncode == 2
+    assert p.stderr == f"pyjulia4d: error: {src}: not a readable {what} file (damaged, truncated or another " \
+                       f"format)\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+
+
 @pytest.mark.parametrize("description", ["{", "[" * 100000 + "]" * 100000, '"a string"', "made by a scanner"])
 def test_a_tiff_described_by_another_program_holds_no_scene(tmp_path: Path, capsys, description) -> None:
     """A readable TIFF whose description is not pyjulia4d's JSON object: it holds no scene (it was

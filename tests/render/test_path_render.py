@@ -129,12 +129,15 @@ def _exr(path, img) -> None:
     out.close()
 
 
+@pytest.mark.parametrize("integrator", ["path", "direct"])
 @pytest.mark.parametrize("case, reason", [
     ("missing", "cannot read it"), ("truncated", "cannot read its pixels|not an image"), ("text", "not an image"),
     ("square", "not an equirectangular map"), ("negative", "not light"), ("nan", "not light"),
     ("too bright", "light is 0 to 1e"),
 ])
-def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, reason) -> None:
+def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, reason, integrator) -> None:
+    """Refused before any kernel runs, with the direct integrator too, which takes no light from
+    the map: a scene naming a file it cannot use is wrong whatever renders it."""
     path = tmp_path / "env.exr"
     if case == "truncated":
         _exr(path, np.ones((64, 128, 3)))
@@ -147,7 +150,7 @@ def test_a_bad_environment_file_is_one_line_before_the_render(tmp_path, case, re
         img = np.ones((16, 32, 3))
         img[3, 4, 1] = {"negative": -1.0, "nan": np.nan, "too bright": 1.5e9}[case]
         _exr(path, img)
-    sc = scene(shading={"environment": str(path)})
+    sc = scene(shading={"environment": str(path), "integrator": integrator})
     with pytest.raises(SceneError, match=reason) as info:
         pyjulia4d.render(sc)
     assert info.value.key == "shading.environment" and "\n" not in str(info.value)
@@ -168,11 +171,13 @@ def test_the_brightest_map_states_a_finite_noise(tmp_path) -> None:
     assert r.film.noise_stats()["p99"] > 0
 
 
-def test_a_bad_environment_on_the_command_line(tmp_path, capsys) -> None:
+@pytest.mark.parametrize("integrator", ["path", "direct"])
+def test_a_bad_environment_on_the_command_line(tmp_path, capsys, integrator) -> None:
     from pyjulia4d.app import cli
     out = tmp_path / "x.png"
-    code = cli.main(["render", "--set", "shading.integrator=path", "--set", f"shading.environment={tmp_path}/no.hdr",
-                     "--set", "image.width=8", "--set", "image.height=6", "-o", str(out)])
+    code = cli.main(["render", "--set", f"shading.integrator={integrator}", "--set",
+                     f"shading.environment={tmp_path}/no.hdr", "--set", "image.width=8", "--set", "image.height=6",
+                     "-o", str(out)])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "shading.environment" in err
     assert list(tmp_path.iterdir()) == []
