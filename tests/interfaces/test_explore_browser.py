@@ -1,6 +1,7 @@
 """The explorer in a real browser: headless Chromium (Debian's chromium and chromium-driver)
 driven by selenium opens the page `pyjulia4d explore` serves, moves its controls, drags the
-picture, and saves the scene, which `pyjulia4d render` turns into the same picture.
+picture, saves the scene, which `pyjulia4d render` turns into the same picture, and watches a
+path-traced picture refine at rest and its lens focus where the picture is clicked.
 
 Skipped, with the reason, where no browser is installed (.ci/run installs one)."""
 import base64
@@ -169,3 +170,45 @@ def test_the_saved_scene_renders_to_the_same_picture_from_the_command_line(page,
                    check=True, capture_output=True, timeout=120)
     cli = np.asarray(Image.open(out))[..., :3]
     assert np.array_equal(cli, shown)
+
+
+def facts_shown(driver) -> dict:
+    """The facts panel's terms and values, read in one go (the page replaces them whole)."""
+    return driver.execute_script("""
+        const out = {};
+        for (const dt of document.querySelectorAll('#facts dt')) out[dt.textContent] = dt.nextElementSibling.textContent;
+        return out;""")
+
+
+def paths_shown(driver) -> int:
+    """The paths per pixel the facts panel gives (0 where it gives none)."""
+    got = facts_shown(driver).get("paths per pixel", "")
+    return int(got) if got.isdigit() else 0
+
+
+def test_a_path_traced_picture_refines_at_rest_and_a_click_focuses_its_lens(page):
+    """The path tracer in the page: at rest its paths accumulate (2, then 4, 8 and 16 a pixel),
+    each picture with its stated noise; a click on the picture focuses the lens on the surface
+    there (camera.focus), and the page says so."""
+    from selenium.webdriver.support.ui import Select
+
+    type_into(page, "image.samples", "16")
+    Select(field(page, "shading.integrator")).select_by_value("path")
+    seen = set()
+
+    def refined(d):
+        seen.add(paths_shown(d))
+        return paths_shown(d) == 16
+
+    WebDriverWait(page, 120, poll_frequency=0.05).until(refined)
+    assert len(seen - {0}) >= 2 and seen <= {0, 2, 4, 8, 16}, seen   # the page may skip a batch it was sent late
+    facts = facts_shown(page)
+    assert facts["noise"] and facts["noise"] != "-", facts
+    img = picture(page)
+    assert 0.05 < np.mean(np.any(img > 8, axis=2)) < 0.95
+    r = view(page).rect
+    ActionChains(page).move_to_element_with_offset(view(page), 0, 0).click().perform()   # its centre
+    WebDriverWait(page, 30).until(lambda d: d.find_element(By.ID, "status").text.startswith("focus: "))
+    status = page.find_element(By.ID, "status").text
+    assert "along the view axis (camera.focus)" in status and r["width"] > 0
+    assert page.find_element(By.ID, "error").text == ""
