@@ -206,9 +206,7 @@ def test_a_path_traced_picture_refines_at_rest_and_a_click_focuses_its_lens(page
     assert facts["noise"] and facts["noise"] != "-", facts
     img = picture(page)
     assert 0.05 < np.mean(np.any(img > 8, axis=2)) < 0.95
-    r = view(page).rect
-    ActionChains(page).move_to_element_with_offset(view(page), 0, 0).click().perform()   # its centre
+    ActionChains(page).move_to_element(view(page)).click().perform()   # the picture's centre, on the set
     WebDriverWait(page, 30).until(lambda d: d.find_element(By.ID, "status").text.startswith("focus: "))
-    status = page.find_element(By.ID, "status").text
-    assert "along the view axis (camera.focus)" in status and r["width"] > 0
+    assert "along the view axis (camera.focus)" in page.find_element(By.ID, "status").text
     assert page.find_element(By.ID, "error").text == ""
