@@ -166,10 +166,19 @@ def compile_error(device: cl.Device) -> str:
 
 
 def cannot_compile(device: cl.Device) -> DeviceError:
-    """The one-line error for a device whose OpenCL compiler fails."""
-    return DeviceError(f"device '{device.name.strip()}' ({device.platform.name.strip()}) cannot "
-                       f"compile OpenCL C: {compile_error(device)}; pick another with --device "
-                       f"(a CPU unknown to PyPI's PoCL: install Debian's pocl-opencl-icd)")
+    """The one-line error for a device whose OpenCL compiler fails; where Intel's CPU runtime
+    from PyPI, which would have compiled for a CPU, could not be registered (a cache folder that
+    cannot be written), that is the cause, and it says so."""
+    from pyjulia4d.opencl import runtimes
+
+    why = f"device '{device.name.strip()}' ({device.platform.name.strip()}) cannot compile OpenCL C: " \
+          f"{compile_error(device)}"
+    if device_type(device) == "CPU" and runtimes.registered["failed"]:
+        return DeviceError(f"{why}, and Intel's CPU runtime from PyPI is not registered: "
+                           f"{runtimes.registered['failed']} in {cache_dir()}; point PYJULIA4D_CACHE at a folder "
+                           f"that can be written")
+    return DeviceError(f"{why}; pick another with --device (a CPU unknown to PyPI's PoCL: install Debian's "
+                       f"pocl-opencl-icd)")
 
 
 _keys: dict[int, str] = {}

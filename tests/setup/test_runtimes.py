@@ -125,7 +125,8 @@ def test_a_device_compiles_with_no_system_driver(tmp_path: Path) -> None:
 def test_an_unwritable_cache_costs_the_runtime_only(tmp_path: Path) -> None:
     """A cache folder that cannot be written: no exception at import, a reason recorded, and
     said in the closing line where another CPU runtime takes over (it was said by `devices`
-    alone, while a render went on on PoCL)."""
+    alone, while a render went on on PoCL), or in the one-line error where none that is left
+    compiles (PyPI's PoCL on a CPU its LLVM does not know)."""
     blocker = tmp_path / "file"
     blocker.write_text("")
     p = _python("import pyjulia4d; from pyjulia4d import runtimes; print(repr(runtimes.registered['why_not']))",
@@ -137,6 +138,10 @@ def test_an_unwritable_cache_costs_the_runtime_only(tmp_path: Path) -> None:
                  PYJULIA4D_CACHE=str(blocker / "cache"))
         if q.returncode == 0 and "no GPU" in q.stdout:   # a CPU took it: another runtime than Intel's
             assert "Intel's CPU runtime from PyPI is not registered: cannot write the vendors folder" in q.stdout
+        elif q.returncode == 2 and "cannot compile OpenCL C" in q.stderr:   # none that is left compiles here
+            # the cause named, not "pick another --device" where there is no other
+            assert q.stderr.count("\n") == 1 and "Intel's CPU runtime from PyPI is not registered: cannot write " \
+                "the vendors folder" in q.stderr and "point PYJULIA4D_CACHE at a folder that can be written" in q.stderr
 
 
 # ------------------------------------------------------------------ which CPU runtime
