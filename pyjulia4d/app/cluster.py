@@ -129,16 +129,29 @@ def render_unit(scene: Scene, device: str | None = None, outputs=None, region=No
     return result, info
 
 
+def worker_scratch() -> str | None:
+    """Where a unit keeps its temporary files: its Dask worker's own folder (under the local
+    cluster's, which the command removes however its workers end; on another cluster, where
+    Dask clears a dead worker's folder when it next starts one), else the system's (None)."""
+    try:
+        from distributed import get_worker
+        return get_worker().local_directory
+    except (ImportError, ValueError):   # not on a worker: rendered in this process
+        return None
+
+
 def _encode(result: Any, suffix: str, header: dict) -> EncodedImage:
     """output.write_image's file, as bytes (written to a private temp folder and read back,
-    so that the bytes are exactly what write_image writes)."""
+    so that the bytes are exactly what write_image writes).  The folder lies in the worker's
+    scratch (worker_scratch): a worker killed while it encodes leaves nothing in the system's
+    temporary folder."""
     import tempfile
     from pathlib import Path
 
     from pyjulia4d.app.output import write_image
 
     report, _ = result.report()
-    with tempfile.TemporaryDirectory(prefix="pyjulia4d-") as d:
+    with tempfile.TemporaryDirectory(prefix="pyjulia4d-", dir=worker_scratch()) as d:
         path = Path(d) / f"frame{suffix}"
         write_image(path, result, {**header, **report})
         data = path.read_bytes()
@@ -301,16 +314,29 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
     # dashboard, on port 8787 unless told: where another cluster held it, Dask warned.  The
     # workers' own log of a failed unit (with its traceback) is left out: the unit's error
     # comes back to the client, which says it in one line.
-    lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                      dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+    # The workers' folders (Dask's scratch, the units' temporary files) in one of the
+    # command's own, removed when the cluster closes: a worker killed while it wrote leaves
+    # nothing behind.
+    import shutil
+    import tempfile
+
+    import dask
+
+    scratch = tempfile.mkdtemp(prefix="pyjulia4d-cluster-")
     try:
-        client = Client(lc, set_as_default=False)
-        try:
-            yield client
-        finally:
-            client.close()
+        with dask.config.set({"temporary-directory": scratch}):   # Dask's own lock files too
+            lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, local_directory=scratch,
+                              dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+            try:
+                client = Client(lc, set_as_default=False)
+                try:
+                    yield client
+                finally:
+                    client.close()
+            finally:
+                lc.close()
     finally:
-        lc.close()
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 # ---------------------------------------------------------------- frames and tiles

@@ -57,10 +57,14 @@ def test_a_worker_killed_mid_animation_loses_no_frame(cluster, tmp_path):
     """SIGKILL the worker process that is rendering while frames are coming back: the
     scheduler hands its frames to the other worker (and the nanny restarts it); every frame
     is written once, each equal bit for bit to a single-process render."""
+    import tempfile
+
     lc, client = cluster
     n = 24
     anim = _morph(n, 96, 72)
     pids = client.run(os.getpid)  # worker address -> pid
+    ours = lambda: set(Path(tempfile.gettempdir()).glob("pyjulia4d-*"))   # noqa: E731
+    before = ours()
     written: list[int] = []
     killed: dict = {}
 
@@ -77,6 +81,9 @@ def test_a_worker_killed_mid_animation_loses_no_frame(cluster, tmp_path):
                 on_written=on_written)
     assert killed and killed["busy"] >= 1
     assert sorted(written) == list(range(n)) and len(written) == n  # each exactly once
+    # a unit's encoding folder lies in its worker's scratch: killed while encoding, it left one
+    # in the system's temporary folder
+    assert ours() == before
     assert sorted(s.rendered) == list(range(n))
     # the scheduler saw the worker go: its address is gone from the cluster
     client.wait_for_workers(2, timeout=60)
@@ -237,7 +244,11 @@ def test_a_unit_that_fails_on_its_worker_is_one_line(tmp_path):
     import subprocess
     import sys
 
-    env = dict(os.environ, PYJULIA4D_DEVICE="no-such-device")
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    env = dict(os.environ, PYJULIA4D_DEVICE="no-such-device", TMPDIR=str(temp))
     with socket.socket() as held:
         try:
             held.bind(("127.0.0.1", 8787))
@@ -245,8 +256,28 @@ def test_a_unit_that_fails_on_its_worker_is_one_line(tmp_path):
         except OSError:
             pass   # already taken: the same for the test
         p = subprocess.run([sys.executable, "-m", "pyjulia4d", "render", "--width", "8", "--height", "6",
-                            "-o", str(tmp_path / "x.png"), "--workers", "1"],
+                            "-o", str(out / "x.png"), "--workers", "1"],
                            capture_output=True, text=True, timeout=300, env=env)
     assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
     assert "device 'no-such-device': no matching OpenCL device" in p.stderr
-    assert list(tmp_path.iterdir()) == []
+    assert list(out.iterdir()) == [] and list(temp.iterdir()) == []   # the cluster's own folders too
+
+
+def test_a_cluster_command_leaves_nothing_in_the_temporary_folder(tmp_path):
+    """An animation on a local cluster of 2 workers: its frames, and nothing of the cluster's -
+    Dask's scratch and lock files, the units' encoding folders - left in $TMPDIR."""
+    import subprocess
+    import sys
+
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    scene = tmp_path / "anim.toml"
+    scene.write_text("[fractal]\nmax_iter = 8\n[image]\nwidth = 24\nheight = 18\n[animation]\nframes = 3\n"
+                     "[[keyframe]]\nframe = 0\nfractal.c = [0.0, 0.0, 0.0, 0.0]\n"
+                     "[[keyframe]]\nframe = 2\nfractal.c = [-0.8, -0.4, 0.0, 0.0]\n")
+    p = subprocess.run([sys.executable, "-m", "pyjulia4d", "animate", str(scene), "--workers", "2",
+                        "-o", str(tmp_path / "f" / "a_#.png")], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, TMPDIR=str(temp)))
+    assert p.returncode == 0, p.stderr
+    assert sorted(x.name for x in (tmp_path / "f").iterdir()) == ["a_0.png", "a_1.png", "a_2.png"]
+    assert list(temp.iterdir()) == []
