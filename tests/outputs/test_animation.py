@@ -296,12 +296,16 @@ def _env() -> dict:
 def test_sigkill_mid_run_then_resume_renders_each_missing_frame_once(tmp_path):
     """SIGKILL an animation (a 1-worker local cluster, the default on a CPU) once some of its
     frames are written; the rerun renders exactly the missing ones, leaves no temporary
-    file, and the frames equal an uninterrupted (in-process) run's."""
+    file - in the frames' folder, nor in $TMPDIR, where it removes the killed run's cluster
+    folder - and the frames equal an uninterrupted (in-process) run's."""
     n = 40
     scene = morph_file(tmp_path, frames=n, w=96, h=72)
     pattern = str(tmp_path / "run" / "m_###.png")
     cmd = [sys.executable, "-m", "pyjulia4d", "animate", str(scene), "-o", pattern, "--workers", "1"]
-    proc = subprocess.Popen(cmd, cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    temp = tmp_path / "temp"   # the runs' $TMPDIR: what the killed run's cluster left there
+    temp.mkdir()
+    env = {**_env(), "TMPDIR": str(temp)}
+    proc = subprocess.Popen(cmd, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 60
     try:
         while time.monotonic() < deadline:
@@ -325,8 +329,10 @@ def test_sigkill_mid_run_then_resume_renders_each_missing_frame_once(tmp_path):
     # a temp file the kill may have left (and one planted as a kill mid-write leaves it)
     (tmp_path / "run" / ".m_039.k1ll_ed2.png").write_bytes(b"\x89PNG partial")
 
-    again = subprocess.run(cmd, cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=120)
+    assert [p.name.split("-")[2] for p in temp.iterdir()] == [str(proc.pid)]   # the killed run's own folder
+    again = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
+    assert list(temp.iterdir()) == []   # the rerun removed it, and its own
     m = re.search(r"rendered (\d+) frames? .*; (\d+) already up to date", again.stdout)
     assert m, again.stdout
     assert int(m.group(1)) == n - len(survived) and int(m.group(2)) == len(survived)

@@ -281,3 +281,26 @@ def test_a_cluster_command_leaves_nothing_in_the_temporary_folder(tmp_path):
     assert p.returncode == 0, p.stderr
     assert sorted(x.name for x in (tmp_path / "f").iterdir()) == ["a_0.png", "a_1.png", "a_2.png"]
     assert list(temp.iterdir()) == []
+
+
+def test_a_new_cluster_folder_removes_those_of_runs_that_are_gone(tmp_path, monkeypatch):
+    """cluster_scratch: the folders of commands whose process no longer exists are removed (a
+    SIGKILLed run could not remove its own), those of running ones and names not its own kept."""
+    import subprocess
+    import sys
+    import tempfile
+
+    from pyjulia4d.app.cluster import SCRATCH_PREFIX, cluster_scratch
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    dead = tmp_path / f"{SCRATCH_PREFIX}{gone}-abc"
+    (dead / "dask-scratch-space").mkdir(parents=True)
+    alive = tmp_path / f"{SCRATCH_PREFIX}{os.getppid()}-def"
+    alive.mkdir()
+    other = tmp_path / f"{SCRATCH_PREFIX}notapid"
+    other.mkdir()
+    new = Path(cluster_scratch())
+    assert not dead.exists() and alive.exists() and other.exists()
+    assert new.parent == tmp_path and new.name.startswith(f"{SCRATCH_PREFIX}{os.getpid()}-")
