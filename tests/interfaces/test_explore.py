@@ -304,12 +304,12 @@ def test_generated_junk_requests_never_raise(tmp_path):
     s, got = make_session(tmp_path)
     junk = [None, True, 0, -1, 1e308, float("inf"), "", "x", [], {}, [1], {"a": 1}, "../../x", "\x00"]
     ops = ["set", "orbit", "turn_w", "zoom", "refine", "save_scene", "render_file", "keyframe", "clear_keyframes",
-           "save_animation", "nope", None, 3]
+           "save_animation", "focus", "frame", "nope", None, 3]
     try:
         for _ in range(1500):
             msg = {"op": rng.choice(ops)}
             for k in rng.sample(["values", "moving", "yaw", "pitch", "degrees", "factor", "name", "frames", "fps",
-                                 "interpolation"], rng.randint(0, 3)):
+                                 "interpolation", "x", "y"], rng.randint(0, 3)):
                 msg[k] = rng.choice(junk)
             s.handle(msg)
         for m in got.of("error"):
