@@ -114,8 +114,13 @@ def _file_mode() -> int:
 
 @contextlib.contextmanager
 def atomic_write(path: str | Path) -> Iterator[Path]:
-    """Yield a temp path beside ``path``; move it onto ``path`` only on success."""
+    """Yield a temp path beside ``path``; move it onto ``path`` only on success.  A ``path`` that
+    is a symbolic link is written through: the file it names is replaced, beside itself, and
+    the link stays (as a shell's ``>`` writes through one; a render to latest.png, a link to
+    the newest picture, updates that picture)."""
     p = Path(path)
+    if p.is_symlink():
+        p = Path(os.path.realpath(p))
     prefix, suffix = temp_affixes(p, path_limit(p.parent, "PC_NAME_MAX", NAME_MAX))
     tmp: Path | None = None
     try:

@@ -15,7 +15,7 @@ import pytest
 from PIL import Image
 
 from pyjulia4d.app import output
-from pyjulia4d.app.output import OutputError, check_output_path, write_exr, write_image, write_png
+from pyjulia4d.app.output import OutputError, check_output_path, read_header, write_exr, write_image, write_png
 
 H, W = 5, 7
 EXR_NAMES = ["R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z", "P.X", "P.Y", "P.Z", "P.W"]
@@ -139,6 +139,28 @@ def test_failed_write_keeps_previous_file(tmp_path, monkeypatch) -> None:
         write_image(path, FakeResult(*_color_alpha()), {})
     assert path.read_bytes() == b"old"
     assert [p.name for p in tmp_path.iterdir()] == ["out.png"]
+
+
+@pytest.mark.parametrize("fmt", ["png", "exr", "tif"])
+def test_a_link_is_written_through(tmp_path, fmt: str) -> None:
+    """An output path that is a symbolic link: the file it names is replaced and the link stays
+    (latest.png, a link to the newest picture, updates that picture); a link to a folder that
+    does not exist is one line, with nothing written anywhere."""
+    pics = tmp_path / "pics"
+    pics.mkdir()
+    (pics / f"a.{fmt}").write_bytes(b"old")
+    link = tmp_path / f"latest.{fmt}"
+    link.symlink_to(pics / f"a.{fmt}")
+    write_image(link, FakeResult(*_color_alpha()), {"k": "v"})
+    assert link.is_symlink() and os.readlink(link) == str(pics / f"a.{fmt}")
+    assert (pics / f"a.{fmt}").read_bytes()[:3] != b"old" and _names(pics) == [f"a.{fmt}"]
+    assert read_header(link)["k"] == "v"
+    dangling = tmp_path / f"gone.{fmt}"
+    dangling.symlink_to(tmp_path / "nowhere" / f"x.{fmt}")
+    with pytest.raises(OutputError, match="No such file or directory") as info:
+        write_image(dangling, FakeResult(*_color_alpha()), {})
+    assert "\n" not in str(info.value) and dangling.is_symlink()
+    assert _names(tmp_path) == sorted([f"gone.{fmt}", f"latest.{fmt}", "pics"])
 
 
 # ------------------------------------------------------------ names, paths, signals
