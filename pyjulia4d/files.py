@@ -136,3 +136,24 @@ def atomic_write(path: str | Path) -> Iterator[Path]:
             with signals_held():  # a second signal must not cut the clean-up short
                 tmp.unlink(missing_ok=True)
         raise
+
+
+def process_scratch(prefix: str) -> str:
+    """A new folder in $TMPDIR named for this process (``prefix`` PID-...), for files that
+    must all go when it ends.  First the folders of ``prefix`` whose process is gone are
+    removed: one killed outright (SIGKILL) could not remove its own, nor its children, which
+    end with it, their files there.  Only this user's folders, of processes that no longer
+    exist; a process id taken again by another process keeps its folder until that one ends."""
+    import shutil
+
+    for old in Path(tempfile.gettempdir()).glob(prefix + "*"):
+        pid = old.name[len(prefix):].split("-", 1)[0]
+        try:
+            if not pid.isdigit() or old.stat().st_uid != os.getuid():
+                continue
+            os.kill(int(pid), 0)   # still running (or another user's): kept
+        except ProcessLookupError:
+            shutil.rmtree(old, ignore_errors=True)
+        except OSError:
+            continue
+    return tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-")

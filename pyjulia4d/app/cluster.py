@@ -37,6 +37,7 @@ from pyjulia4d.pipeline.progress import Progress
 from pyjulia4d.pipeline.result import RenderResult, add_counts
 from pyjulia4d.scene.model import Scene
 from pyjulia4d.scene.checks import SceneError, show
+from pyjulia4d.files import process_scratch
 from pyjulia4d.resources import module_installed
 
 
@@ -283,30 +284,7 @@ def reach_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
     raise SceneError("--scheduler", f"cannot connect to {show(address)}: {why}")
 
 
-SCRATCH_PREFIX = "pyjulia4d-cluster-"
-
-
-def cluster_scratch() -> str:
-    """A new folder in $TMPDIR for a local cluster's files, named for this process
-    (pyjulia4d-cluster-PID-...).  First the folders of runs whose process is gone are removed:
-    a command killed outright (SIGKILL) could not remove its own, and its workers, which end
-    with it, left theirs there too.  Only this user's folders, of processes that no longer
-    exist; a process id taken again by another process keeps its folder until that one ends."""
-    import shutil
-    import tempfile
-    from pathlib import Path
-
-    for old in Path(tempfile.gettempdir()).glob(SCRATCH_PREFIX + "*"):
-        pid = old.name[len(SCRATCH_PREFIX):].split("-", 1)[0]
-        try:
-            if not pid.isdigit() or old.stat().st_uid != os.getuid():
-                continue
-            os.kill(int(pid), 0)   # still running (or another user's): kept
-        except ProcessLookupError:
-            shutil.rmtree(old, ignore_errors=True)
-        except OSError:
-            continue
-    return tempfile.mkdtemp(prefix=f"{SCRATCH_PREFIX}{os.getpid()}-")
+SCRATCH_PREFIX = "pyjulia4d-cluster-"   # a local cluster's folder in $TMPDIR (files.process_scratch)
 
 
 @contextlib.contextmanager
@@ -342,12 +320,12 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
     # comes back to the client, which says it in one line.
     # The workers' folders (Dask's scratch, the units' temporary files) in one of the
     # command's own, removed when the cluster closes: a worker killed while it wrote leaves
-    # nothing behind (nor, by the next run, a command killed itself: cluster_scratch).
+    # nothing behind (nor, by the next run, a command killed itself: files.process_scratch).
     import shutil
 
     import dask
 
-    scratch = cluster_scratch()
+    scratch = process_scratch(SCRATCH_PREFIX)
     try:
         with dask.config.set({"temporary-directory": scratch}):   # Dask's own lock files too
             lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, local_directory=scratch,

@@ -277,13 +277,15 @@ def test_a_cluster_command_leaves_nothing_in_the_temporary_folder(tmp_path):
 
 
 def test_a_new_cluster_folder_removes_those_of_runs_that_are_gone(tmp_path, monkeypatch):
-    """cluster_scratch: the folders of commands whose process no longer exists are removed (a
-    SIGKILLed run could not remove its own), those of running ones and names not its own kept."""
+    """files.process_scratch, the local cluster's folder: the folders of commands whose process
+    no longer exists are removed (a SIGKILLed run could not remove its own), those of running
+    ones and names not its own kept."""
     import subprocess
     import sys
     import tempfile
 
-    from pyjulia4d.app.cluster import SCRATCH_PREFIX, cluster_scratch
+    from pyjulia4d.app.cluster import SCRATCH_PREFIX
+    from pyjulia4d.files import process_scratch
 
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
@@ -294,6 +296,6 @@ def test_a_new_cluster_folder_removes_those_of_runs_that_are_gone(tmp_path, monk
     alive.mkdir()
     other = tmp_path / f"{SCRATCH_PREFIX}notapid"
     other.mkdir()
-    new = Path(cluster_scratch())
+    new = Path(process_scratch(SCRATCH_PREFIX))
     assert not dead.exists() and alive.exists() and other.exists()
     assert new.parent == tmp_path and new.name.startswith(f"{SCRATCH_PREFIX}{os.getpid()}-")
