@@ -712,3 +712,16 @@ def test_text_controls_take_what_set_takes_and_give_it_back():
     assert set(typed) <= set(texts) and apply_values(Scene.default(), texts) == s
     with pytest.raises(SceneError, match="shading.lights"):
         apply_values(Scene.default(), {"shading.lights": "[{position = [3, 1"})
+
+
+def test_the_facts_say_what_is_proven_and_how_to_have_it():
+    """The panel's depth error: the statement where the march proves the space in front of its
+    hits, else that it states none and which quality would (as the command line's closing line)."""
+    from pyjulia4d import render
+
+    s = Scene.default().with_overrides(["image.width=24", "image.height=18"])
+    estimate = loop_mod.facts(render(s), "final")
+    assert estimate["error"].startswith("not stated") and "quality 'normal' proves it" in estimate["error"]
+    assert estimate["unresolved"] == "every ray"
+    proven = loop_mod.facts(render(s.with_overrides(["march.quality=normal"])), "final")
+    assert proven["error"].startswith("p50=") and "not stated" not in proven["error"], proven["error"]

@@ -137,7 +137,8 @@ def facts(result: Any, stage: str) -> dict:
             "hit": f"{100 * result.hit_fraction:.1f} %",
             "bracket": header["pyjulia4d.depth_bracket"] or "none hit",
             "error": (header["pyjulia4d.depth_error"] if result.proven else
-                      "not stated: this march proves no space in front of its hits empty"),
+                      "not stated: this march proves no space in front of its hits empty (quality "
+                      "'normal' proves it)"),
             "unresolved": (f"{un['hit']} hits, {un['miss']} misses" if result.proven else "every ray"),
             "capped": str(result.capped),
             "guards": ", ".join(f"{k} {v}" for k, v in result.guards.items() if v) or "none",
