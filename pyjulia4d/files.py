@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import signal
 import tempfile
 import threading
@@ -144,8 +145,6 @@ def process_scratch(prefix: str) -> str:
     removed: one killed outright (SIGKILL) could not remove its own, nor its children, which
     end with it, their files there.  Only this user's folders, of processes that no longer
     exist; a process id taken again by another process keeps its folder until that one ends."""
-    import shutil
-
     for old in Path(tempfile.gettempdir()).glob(prefix + "*"):
         pid = old.name[len(prefix):].split("-", 1)[0]
         try:

@@ -82,15 +82,19 @@ def setup(w: int, h: int):
 
 
 def proven_counted(plan, F, o, d, start, far):
-    """march_proven from ``start``, every enclosure it asks for recorded as (ray, t0)."""
+    """march_proven from ``start``, every enclosure it asks for recorded as (ray, t0), and the
+    iterations all of them took (each 1 plus the iterations it stays live: enc_prove's)."""
     ma = plan.march
     rows = {bytes(x): i for i, x in enumerate(np.ascontiguousarray(d))}
     log: list[tuple[np.ndarray, np.ndarray]] = []
-    real = rm.enc_prove
+    real, iterations = rm.enc_prove, [0]
 
     def counted(oo, dd, t0, t1, *a, **k):
         log.append((np.array([rows[bytes(x)] for x in np.ascontiguousarray(dd)]), np.array(t0, float)))
-        return real(oo, dd, t0, t1, *a, **k)
+        it = np.zeros(len(oo), int)
+        got = real(oo, dd, t0, t1, *a, iterations=it, **k)
+        iterations[0] += int(it.sum())
+        return got
 
     rm.enc_prove = counted
     try:
@@ -100,7 +104,7 @@ def proven_counted(plan, F, o, d, start, far):
         rm.enc_prove = real
     ids = np.concatenate([a for a, _ in log]) if log else np.zeros(0, int)
     t0 = np.concatenate([b for _, b in log]) if log else np.zeros(0)
-    return out[0], ids, t0
+    return out[0], ids, t0, iterations[0]
 
 
 def best_ball(p, c, max_iter, bailout, degree):
@@ -147,27 +151,6 @@ def ball_march(o, d, near, far, c, max_iter, bailout, degree, floor):
         active[k[inside]] = False
         t[k] += np.maximum(r, floor[k])
     return steps
-
-
-def march_iterations(plan, F, o, d, near, far):
-    """The proven march's enclosures and iterations per ray (each enclosure 1 plus the iterations
-    it stays live)."""
-    ma, real, tot = plan.march, rm.enc_prove, [0, 0]
-
-    def counted(*a, **k):
-        it = np.zeros(len(a[0]), int)
-        got = real(*a, iterations=it, **k)
-        tot[0] += len(a[0])
-        tot[1] += int(it.sum())
-        return got
-
-    rm.enc_prove = counted
-    try:
-        rm.march_proven(o, d, near, far, np.asarray(ma.c, float), ma.max_iter, ma.bailout, ma.epsilon,
-                        ma.z_resolution, ma.post_steps, 20000, True, F)
-    finally:
-        rm.enc_prove = real
-    return tot[0] / len(o), tot[1] / len(o)
 
 
 def oracle_march(plan, F, o, d, near, far):
@@ -289,8 +272,8 @@ def affine_beams(plan, F, w, h, block, stride):
         active[k[(~ok & (step[k] < (hi[k] - lo[k]) / 500)) | (t1 >= hi[k])]] = False
     start = np.clip(np.maximum(near, tau[blk] * dn), near, far)
     o, d, near, far, start = o[live], d[live], near[live], far[live], start[live]
-    after = march_iterations(plan, F, o, d, start, far)[1]
-    plain = march_iterations(plan, F, o, d, near, far)[1]
+    after = proven_counted(plan, F, o, d, start, far)[3] / len(o)
+    plain = proven_counted(plan, F, o, d, near, far)[3] / len(o)
     return int(live.sum()), its.sum() * COST_3 / live.sum(), after, plain
 
 
@@ -351,7 +334,7 @@ def main(argv=None) -> int:
     c = np.asarray(ma.c, float)
     degree = 2 if plan.fractal.function == "sqr" else 3   # the default scene: a quaternion square
     de_t, _, de_n, *_ = rm.march_de(o, d, near, far, c, ma.max_iter, ma.bailout, 1e-3, 250, 4, 20000, True, F)
-    depth, ids, t0 = proven_counted(plan, F, o, d, near, far)
+    depth, ids, t0, its = proven_counted(plan, F, o, d, near, far)
     hit = np.isfinite(depth)
     per_ray = np.bincount(ids, minlength=len(o))
     lines = [f"| estimate march (no proof) | {de_n.mean():.1f} estimates |",
@@ -376,7 +359,7 @@ def main(argv=None) -> int:
     t_lo, t_last = cone_of_pixels(cone, (0, 0, bw, bh))
     start = np.where(blive & (t_last > bnear) & (bnear >= t_lo) & (t_last < bfar), t_last, bnear)
     base = proven_counted(bplan, F, bo[blive], bd[blive], bnear[blive], bfar[blive])[1].size / (bw * bh)
-    bdepth, bids, _ = proven_counted(bplan, F, bo[blive], bd[blive], start[blive], bfar[blive])
+    bdepth, bids, _, _ = proven_counted(bplan, F, bo[blive], bd[blive], start[blive], bfar[blive])
     beamed = bids.size / (bw * bh)
     behind = (start[blive] > bnear[blive]) & np.isfinite(bdepth)
     gap_left = float(np.median((bdepth - start[blive])[behind])) if behind.any() else float("nan")
@@ -393,7 +376,7 @@ def main(argv=None) -> int:
             f"{np.mean(start[blive] > bnear[blive]) * 100:.0f} % of the rays started behind a beam, "
             f"the hits among them a median {gap_left:.2f} in front of their depth.\n"]
     oe, oi, stuck, q_est = oracle_march(plan, F, o, d, near, far)
-    me, mi = march_iterations(plan, F, o, d, near, far)
+    me, mi = ids.size / len(o), its / len(o)
     last = stuck * (1 + ma.max_iter) / len(o)   # the surface's floor segment, one full enclosure each
     text.append(f"- Lengths known in advance (at {w}x{h}): {oe:.1f} enclosures and {oi:.0f} iterations per ray to "
                 f"where not even the floor proves ({stuck} rays; one full enclosure more for each, {last:.0f} per "

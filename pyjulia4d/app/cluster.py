@@ -327,8 +327,8 @@ def cluster(workers: int | None = None, scheduler: str | None = None,
 
     scratch = process_scratch(SCRATCH_PREFIX)
     try:
-        with dask.config.set({"temporary-directory": scratch}):   # Dask's own lock files too
-            lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, local_directory=scratch,
+        with dask.config.set({"temporary-directory": scratch}):   # its lock files and the workers' folders
+            lc = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                               dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
             try:
                 client = Client(lc, set_as_default=False)
